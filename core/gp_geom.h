@@ -1,0 +1,70 @@
+/* gp_geom.h -- planar polygon geometry on double coordinates.
+ *
+ * Polygons are arrays of vertices, implicitly closed (the last vertex joins the first), in
+ * either orientation unless a function says otherwise. Functions tolerate duplicate
+ * consecutive vertices and collinear runs. Nothing here allocates except where stated, and
+ * nothing keeps state: every function is safe to call from several threads.
+ */
+#ifndef GP_GEOM_H
+#define GP_GEOM_H
+
+#include <stddef.h>
+
+#include "gp_error.h"
+
+typedef struct gp_vec2 {
+    double x, y;
+} gp_vec2;
+
+/* Signed area (positive for counter-clockwise), by the shoelace formula evaluated about the
+ * first vertex so that huge coordinates with a small polygon keep their precision. */
+double gp_poly_signed_area(const gp_vec2 *p, size_t n);
+double gp_poly_area(const gp_vec2 *p, size_t n);
+double gp_poly_perimeter(const gp_vec2 *p, size_t n);
+
+/* Area centroid. GP_ERR_DEGENERATE when the area is zero (then *c is the vertex mean). */
+gp_status gp_poly_centroid(const gp_vec2 *p, size_t n, gp_vec2 *c, gp_error *err);
+
+/* Point in polygon (even-odd rule): 1 strictly inside, 0 outside; a point on an edge (within
+ * a relative tolerance of ~1e-12 of the polygon's size) counts as inside (returns 1). */
+int gp_poly_contains(const gp_vec2 *p, size_t n, gp_vec2 q);
+
+/* Convex hull by Andrew's monotone chain: writes h (capacity >= n) counter-clockwise, starting
+ * from the lowest-then-leftmost point, without collinear or duplicate points; returns its vertex
+ * count (0 for n == 0, 1 or 2 for degenerate input). */
+size_t gp_convex_hull(const gp_vec2 *p, size_t n, gp_vec2 *h);
+
+/* Smallest circle enclosing all points (Welzl, deterministic move-to-front, expected O(n)). */
+gp_status gp_min_enclosing_circle(const gp_vec2 *p, size_t n, gp_vec2 *center, double *radius,
+                                  gp_error *err);
+
+/* Largest circle inside a simple polygon: centre and radius with |r - r_true| <= tol
+ * (grid refinement with a distance bound, "pole of inaccessibility"). tol <= 0 picks
+ * 1e-6 of the polygon's bounding-box size. */
+gp_status gp_max_inscribed_circle(const gp_vec2 *p, size_t n, double tol, gp_vec2 *center,
+                                  double *radius, gp_error *err);
+
+/* Minimum caliper (Feret) width by rotating calipers on the hull. The minimum width S is
+ * measured across direction angle_rad + pi/2; angle_rad (in (-pi/2, pi/2]) is the direction of
+ * the grain's long axis (Mollon & Zhao Fig. 1a: theta), and length is the extent L of the
+ * polygon along that direction. So elongation = width / length. */
+gp_status gp_min_caliper(const gp_vec2 *p, size_t n, double *width, double *angle_rad,
+                         double *length, gp_error *err);
+
+/* Distance from q to the segment [a, b]. */
+double gp_segment_distance(gp_vec2 q, gp_vec2 a, gp_vec2 b);
+
+/* Distance from q to the polygon boundary (unsigned). */
+double gp_poly_boundary_distance(const gp_vec2 *p, size_t n, gp_vec2 q);
+
+/* 1 if the polygon is simple (no two non-adjacent edges intersect), else 0. O(n^2): meant for
+ * checks and tests, not hot loops. */
+int gp_poly_is_simple(const gp_vec2 *p, size_t n);
+
+/* 1 if polygon a lies inside polygon b (every vertex of a inside b and no edges crossing). */
+int gp_poly_inside_poly(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t nb);
+
+/* 1 if the interiors of two simple polygons overlap (edge crossing or one inside the other). */
+int gp_poly_overlap(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t nb);
+
+#endif /* GP_GEOM_H */
