@@ -1,0 +1,79 @@
+/* gp_spec.h -- the JSON Schemas of a job spec, a validator that interprets them, and the
+ * parsers from a valid spec to the core's spec structs.
+ *
+ * Single source of truth: schema/fourier-voronoi-2d.schema.json and
+ * schema/spheres-3d.schema.json (JSON Schema 2020-12), embedded into the library at build
+ * time. The validator interprets those documents (type, properties, required,
+ * additionalProperties, minimum/maximum/exclusiveMinimum/exclusiveMaximum, minItems/maxItems,
+ * items, prefixItems, enum, const, oneOf, uniqueItems, minLength/maxLength, local $ref) and
+ * the defaults are read from their "default" keywords.
+ *
+ * GET /v1/schema serves gp_schema_document(): one document
+ *   {"$schema": ".../2020-12/schema", "$id": "...", "title": ..., "description": ...,
+ *    "oneOf": [{"$ref": "#/$defs/fourier-voronoi-2d"}, {"$ref": "#/$defs/spheres-3d"}],
+ *    "$defs": {"fourier-voronoi-2d": <2D schema>, "spheres-3d": <3D schema>}}
+ * (each kind's schema is a complete embedded schema resource with its own $id).
+ *
+ * Problems. The FIRST problem found (instance keys in document order, then missing required
+ * fields) is reported:
+ *   http_status 400, code "invalid_spec"  -- the spec breaks its schema (wrong type, range,
+ *                                            unknown field, missing field, bad enum, unknown
+ *                                            kind, ...);
+ *   http_status 422, code "invalid_spec"  -- the spec fits the schema but is not meaningful
+ *                                            (self-intersecting polygon, hole outside the
+ *                                            container, sieve rows not increasing, largest
+ *                                            sieve diameter larger than the box, ...);
+ *   http_status 500, code "internal"      -- out of memory, broken embedded schema.
+ * pointer is an RFC 6901 JSON pointer into the spec ("" is the whole document, keys escaped
+ * with ~0/~1). For a missing required field the pointer names the missing field itself
+ * (e.g. "/imc/error"). message is one human line that starts with the pointer, e.g.
+ *   /size/cov: expected a number >= 0, got "abc"
+ *   /kind: unknown kind "x"; expected one of "fourier-voronoi-2d", "spheres-3d"
+ *   /container/polygon: expected at least 3 items, got 2
+ *   /particles: unknown field (allowed here: ...)
+ * Thread-safe: the embedded schemas are parsed once (pthread_once) and only read afterwards.
+ */
+#ifndef GP_SPEC_H
+#define GP_SPEC_H
+
+#include <jansson.h>
+
+#include "gp_specimen2d.h"
+
+typedef struct gp_spec_problem {
+    int http_status;            /* 400, 422 or 500 (0 when no problem) */
+    char code[32];              /* "invalid_spec" or "internal" */
+    char pointer[256];          /* RFC 6901 pointer of the first bad field */
+    char message[512];          /* "<pointer>: expected ..., got ..." */
+} gp_spec_problem;
+
+/* The kinds, NULL-terminated: {"fourier-voronoi-2d", "spheres-3d", NULL}. */
+const char *const *gp_spec_kinds(void);
+
+/* The combined schema document served at GET /v1/schema (static, NUL-terminated JSON). */
+const char *gp_schema_document(void);
+
+/* The schema text of one kind, or NULL for an unknown kind. */
+const char *gp_schema_text(const char *kind);
+
+/* Validates a spec against the schema of its "kind" AND runs the semantic checks that the
+ * schema cannot express. Returns 0 when valid, else -1 and fills *p (p may be NULL). */
+int gp_spec_validate(const json_t *spec, gp_spec_problem *p);
+
+/* A new reference to a copy of a valid spec with every default filled in (for storing the
+ * effective spec and echoing it back). NULL (and *p filled) when the spec is invalid. */
+json_t *gp_spec_with_defaults(const json_t *spec, gp_spec_problem *p);
+
+/* Validates and parses a spec of kind "fourier-voronoi-2d" into *out, defaults applied
+ * (out->threads is set to 0: the caller picks). Returns 0 on success; *out then owns its
+ * arrays (outer.pts, holes[*].pts, holes, spectrum) and must be released with
+ * gp_spec_2d_free(). On failure returns -1, fills *p, and *out owns nothing (freeing it is
+ * still allowed). */
+int gp_spec_parse_2d(const json_t *spec, gp_spec2d *out, gp_spec_problem *p);
+void gp_spec_2d_free(gp_spec2d *s);
+
+/* 3D: gp_spec_parse_3d(const json_t *, gp_spec3d *, gp_spec_problem *) and gp_spec_3d_free()
+ * are added once core/gp_specimen3d.h pins gp_spec3d. Until then validate with
+ * gp_spec_validate() and read the fields from gp_spec_with_defaults(). */
+
+#endif /* GP_SPEC_H */
