@@ -1052,6 +1052,11 @@ static int semantic_3d(const json_t *full, gp_spec_problem *p)
                         "percent passing must not decrease: %.15g follows %.15g", q, prev_q);
             return -1;
         }
+        if (i == 0 && q != 0) {
+            set_problem(p, 422, "/sieve/0/1",
+                        "the first sieve row must pass 0 %% (the smallest grain), got %.15g", q);
+            return -1;
+        }
         prev_d = d;
         prev_q = q;
     }
@@ -1072,5 +1077,75 @@ static int semantic_3d(const json_t *full, gp_spec_problem *p)
                     "%.6g m); check sieve_units", prev_d * scale, bmin);
         return -1;
     }
+    return 0;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* 3D parser */
+
+void gp_spec_3d_free(gp_spec3d *s)
+{
+    if (!s) return;
+    free((gp_sieve_row *)s->sieve);
+    memset(s, 0, sizeof *s);
+}
+
+int gp_spec_parse_3d(const json_t *spec, gp_spec3d *out, gp_spec_problem *p)
+{
+    gp_spec_problem local;
+    if (!p) p = &local;
+    clear_problem(p);
+    memset(out, 0, sizeof *out);
+    json_t *full = gp_spec_with_defaults(spec, p);
+    if (!full) return -1;
+    if (strcmp(json_string_value(json_object_get(full, "kind")), g_kinds[1]) != 0) {
+        set_problem(p, 400, "/kind", "expected \"%s\" here, got \"%s\"", g_kinds[1],
+                    json_string_value(json_object_get(full, "kind")));
+        json_decref(full);
+        return -1;
+    }
+    out->seed = (uint64_t)json_number_value(json_object_get(full, "seed"));
+    const json_t *box = json_object_get(full, "box");
+    for (size_t i = 0; i < 3; i++) out->box[i] = json_number_value(json_array_get(box, i));
+    const char *units = json_string_value(json_object_get(full, "sieve_units"));
+    double scale = !strcmp(units, "m") ? 1.0 : 1e-3;
+    const json_t *sieve = json_object_get(full, "sieve");
+    size_t n = json_array_size(sieve);
+    gp_sieve_row *rows = malloc(n * sizeof *rows);
+    if (!rows) {
+        set_problem(p, 500, "", "out of memory");
+        json_decref(full);
+        return -1;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const json_t *row = json_array_get(sieve, i);
+        rows[i].diameter = json_number_value(json_array_get(row, 0)) * scale;
+        rows[i].passing = json_number_value(json_array_get(row, 1));
+    }
+    out->sieve = rows;
+    out->nsieve = n;
+    out->porosity = num(full, "porosity");
+    const json_t *m = json_object_get(full, "material");
+    out->material.density = num(m, "density");
+    out->material.young = num(m, "young");
+    out->material.poisson = num(m, "poisson");
+    out->material.friction_deg = num(m, "friction_deg");
+    out->material.damping = num(m, "damping");
+    const json_t *tiling = json_object_get(full, "tiling");
+    for (size_t i = 0; i < 3; i++)
+        out->tiling[i] = tiling ? (int)json_number_value(json_array_get(tiling, i)) : 1;
+    size_t i;
+    const json_t *o;
+    json_array_foreach(json_object_get(full, "outputs"), i, o) {
+        const char *str = json_string_value(o);
+        if (!strcmp(str, "spheres")) out->outputs |= GP_OUT3_SPHERES;
+        else if (!strcmp(str, "contacts")) out->outputs |= GP_OUT3_CONTACTS;
+        else if (!strcmp(str, "fabric")) out->outputs |= GP_OUT3_FABRIC;
+        else if (!strcmp(str, "stress")) out->outputs |= GP_OUT3_STRESS;
+    }
+    out->threads = 0;
+    out->max_steps = 0;
+    out->tile_relax_steps = 0;
+    json_decref(full);
     return 0;
 }

@@ -39,6 +39,7 @@
 #include <jansson.h>
 
 #include "gp_specimen2d.h"
+#include "gp_specimen3d.h"
 
 typedef struct gp_spec_problem {
     int http_status;            /* 400, 422 or 500 (0 when no problem) */
@@ -72,8 +73,10 @@ json_t *gp_spec_with_defaults(const json_t *spec, gp_spec_problem *p);
 int gp_spec_parse_2d(const json_t *spec, gp_spec2d *out, gp_spec_problem *p);
 void gp_spec_2d_free(gp_spec2d *s);
 
-/* 3D: gp_spec_parse_3d(const json_t *, gp_spec3d *, gp_spec_problem *) and gp_spec_3d_free()
- * are added once core/gp_specimen3d.h pins gp_spec3d. Until then validate with
- * gp_spec_validate() and read the fields from gp_spec_with_defaults(). */
+/* The same for kind "spheres-3d": sieve diameters converted to metres (sieve_units), tiling
+ * {1, 1, 1} when absent; threads, max_steps and tile_relax_steps are set to 0 (the caller
+ * picks). *out owns its sieve array; release with gp_spec_3d_free(). */
+int gp_spec_parse_3d(const json_t *spec, gp_spec3d *out, gp_spec_problem *p);
+void gp_spec_3d_free(gp_spec3d *s);
 
 #endif /* GP_SPEC_H */

@@ -154,6 +154,45 @@ static void test_examples(void)
     CHECK(full != NULL);
     CHECK(json_equal(full, j)); /* every field was given */
     json_decref(full);
+    gp_spec3d t;
+    CHECK(gp_spec_parse_3d(j, &t, &p) == 0);
+    CHECK(t.seed == 7);
+    CHECK_NEAR(t.box[0], 0.5, 0);
+    CHECK_NEAR(t.box[2], 0.5, 0);
+    CHECK(t.nsieve == 5);
+    CHECK_NEAR(t.sieve[0].diameter, 0.010, 1e-15);
+    CHECK_NEAR(t.sieve[2].diameter, 0.050, 1e-15);
+    CHECK_NEAR(t.sieve[2].passing, 50, 0);
+    CHECK_NEAR(t.sieve[4].passing, 100, 0);
+    CHECK_NEAR(t.porosity, 0.38, 0);
+    CHECK_NEAR(t.material.density, 2600, 0);
+    CHECK_NEAR(t.material.young, 15e6, 0);
+    CHECK_NEAR(t.material.poisson, 0.5, 0);
+    CHECK_NEAR(t.material.friction_deg, 18, 0);
+    CHECK_NEAR(t.material.damping, 0.2, 0);
+    CHECK(t.tiling[0] == 4 && t.tiling[1] == 4 && t.tiling[2] == 4);
+    CHECK(t.outputs == (GP_OUT3_SPHERES | GP_OUT3_CONTACTS | GP_OUT3_FABRIC | GP_OUT3_STRESS));
+    gp_spec_3d_free(&t);
+    CHECK(t.sieve == NULL);
+    json_decref(j);
+
+    /* defaults and metres */
+    j = load("{\"kind\": \"spheres-3d\", \"sieve\": [[0.001, 0], [0.002, 100]], \"sieve_units\": \"m\"}");
+    CHECK(gp_spec_parse_3d(j, &t, &p) == 0);
+    CHECK_NEAR(t.sieve[1].diameter, 0.002, 0);
+    CHECK(t.tiling[0] == 1 && t.tiling[1] == 1 && t.tiling[2] == 1);
+    CHECK(t.outputs == GP_OUT3_SPHERES);
+    CHECK_NEAR(t.box[1], 0.5, 0);
+    gp_spec_3d_free(&t);
+    json_decref(j);
+    /* a 2D spec is not a 3D one */
+    j = load(EX2D);
+    CHECK(gp_spec_parse_3d(j, &t, &p) != 0 && !strcmp(p.pointer, "/kind"));
+    gp_spec_3d_free(&t);
+    json_decref(j);
+    j = load("{\"kind\": \"spheres-3d\", \"porosity\": 2}");
+    CHECK(gp_spec_parse_3d(j, &t, &p) != 0 && !strcmp(p.pointer, "/porosity"));
+    gp_spec_3d_free(&t);
     json_decref(j);
 }
 
@@ -358,6 +397,7 @@ static void test_bad_3d(void)
     BAD3("/sieve/2/0", "20", "/sieve/2/0", 422, "increase strictly");
     BAD3("/sieve/2/1", "1", "/sieve/2/1", 422, "must not decrease");
     BAD3("/sieve/4/1", "99", "/sieve/4/1", 422, "100");
+    BAD3("/sieve/0/1", "1", "/sieve/0/1", 422, "0 %");
     BAD3("/sieve_units", "\"cm\"", "/sieve_units", 400, "\"mm\", \"m\"");
     BAD3("/sieve_units", "\"m\"", "/sieve/4/0", 422, "does not fit");
     BAD3("/porosity", "1", "/porosity", 400, "(0, 1)");
