@@ -1,0 +1,200 @@
+/* main.c -- grainpackd: options, start-up, signals, graceful shutdown.
+ *
+ *   grainpackd [--listen HOST:PORT] [--db PATH] [--workers N] [--log-level L] ...
+ * Settings come from the command line, else the environment (GRAINPACK_*), else the defaults.
+ * With port 0 the kernel picks a free port; the first line on stdout is always
+ *   listening on http://HOST:PORT
+ * Logs go to stderr. SIGTERM/SIGINT: stop accepting, requeue running jobs, close the database.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <limits.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "http.h"
+#include "store.h"
+#include "workers.h"
+
+#ifndef GPD_VERSION
+#define GPD_VERSION "0.1.0"
+#endif
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: grainpackd [options]\n"
+            "\n"
+            "The grainpack job service: accepts packing specs over HTTP (see /v1/schema),\n"
+            "queues them in SQLite, runs them on worker threads, serves results and SVG.\n"
+            "\n"
+            "options (environment variable in brackets; the command line wins):\n"
+            "  --listen HOST:PORT     address to listen on [GRAINPACK_LISTEN]\n"
+            "                         (default 127.0.0.1:8080; port 0 = pick a free port;\n"
+            "                         the first stdout line is 'listening on http://HOST:PORT')\n"
+            "  --db PATH              SQLite job database [GRAINPACK_DB] (default ./grainpack.db)\n"
+            "  --workers N            worker threads running jobs [GRAINPACK_WORKERS]\n"
+            "                         (default: the number of CPU cores)\n"
+            "  --log-level LEVEL      error|warn|info|debug [GRAINPACK_LOG_LEVEL] (default info;\n"
+            "                         debug logs every request)\n"
+            "  --http-threads N       HTTP thread pool size [GRAINPACK_HTTP_THREADS] (default 4)\n"
+            "  --max-connections N    concurrent connection limit [GRAINPACK_MAX_CONNECTIONS]\n"
+            "                         (default 1024)\n"
+            "  --timeout S            idle timeout per connection, seconds [GRAINPACK_TIMEOUT]\n"
+            "                         (default 30)\n"
+            "  --max-body BYTES       request body limit, 413 above [GRAINPACK_MAX_BODY]\n"
+            "                         (default 1048576)\n"
+            "  --version              print the version and exit\n"
+            "  --help                 this text\n"
+            "\n"
+            "Restart rule: jobs found 'running' at start-up (the daemon crashed) are queued again,\n"
+            "up to %d attempts; a job interrupted %d times fails with error code 'interrupted'.\n"
+            "SIGTERM/SIGINT requeue running jobs without counting an attempt.\n",
+            STORE_MAX_ATTEMPTS, STORE_MAX_ATTEMPTS);
+}
+
+static int parse_long(const char *name, const char *s, long lo, long hi, long *out)
+{
+    char *end = NULL;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || !end || *end || end == s || v < lo || v > hi) {
+        fprintf(stderr, "grainpackd: %s expects an integer in [%ld, %ld], got \"%s\"\n", name,
+                lo, hi, s);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+static const char *env_or(const char *name, const char *dflt)
+{
+    const char *v = getenv(name);
+    return (v && *v) ? v : dflt;
+}
+
+int main(int argc, char **argv)
+{
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    if (ncpu < 1) ncpu = 1;
+    char ncpu_s[24];
+    snprintf(ncpu_s, sizeof ncpu_s, "%ld", ncpu);
+
+    const char *listen_s = env_or("GRAINPACK_LISTEN", "127.0.0.1:8080");
+    const char *db = env_or("GRAINPACK_DB", "./grainpack.db");
+    const char *workers_s = env_or("GRAINPACK_WORKERS", ncpu_s);
+    const char *level_s = env_or("GRAINPACK_LOG_LEVEL", "info");
+    const char *threads_s = env_or("GRAINPACK_HTTP_THREADS", "4");
+    const char *maxconn_s = env_or("GRAINPACK_MAX_CONNECTIONS", "1024");
+    const char *timeout_s = env_or("GRAINPACK_TIMEOUT", "30");
+    const char *maxbody_s = env_or("GRAINPACK_MAX_BODY", "1048576");
+
+    static const struct option opts[] = {
+        {"listen", required_argument, 0, 'l'},       {"db", required_argument, 0, 'd'},
+        {"workers", required_argument, 0, 'w'},      {"log-level", required_argument, 0, 'L'},
+        {"http-threads", required_argument, 0, 't'}, {"max-connections", required_argument, 0, 'c'},
+        {"timeout", required_argument, 0, 'T'},      {"max-body", required_argument, 0, 'b'},
+        {"help", no_argument, 0, 'h'},               {"version", no_argument, 0, 'V'},
+        {0, 0, 0, 0}};
+    int ch;
+    while ((ch = getopt_long(argc, argv, "l:d:w:L:t:c:T:b:hV", opts, NULL)) != -1) {
+        switch (ch) {
+        case 'l': listen_s = optarg; break;
+        case 'd': db = optarg; break;
+        case 'w': workers_s = optarg; break;
+        case 'L': level_s = optarg; break;
+        case 't': threads_s = optarg; break;
+        case 'c': maxconn_s = optarg; break;
+        case 'T': timeout_s = optarg; break;
+        case 'b': maxbody_s = optarg; break;
+        case 'h': usage(stdout); return 0;
+        case 'V': printf("grainpackd %s\n", GPD_VERSION); return 0;
+        default: usage(stderr); return 2;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "grainpackd: unexpected argument \"%s\"\n", argv[optind]);
+        usage(stderr);
+        return 2;
+    }
+    long nworkers, nthreads, maxconn, timeout, maxbody;
+    if (parse_long("--workers", workers_s, 1, 1024, &nworkers) ||
+        parse_long("--http-threads", threads_s, 1, 256, &nthreads) ||
+        parse_long("--max-connections", maxconn_s, 1, 1000000, &maxconn) ||
+        parse_long("--timeout", timeout_s, 1, 86400, &timeout) ||
+        parse_long("--max-body", maxbody_s, 1024, 1L << 30, &maxbody))
+        return 2;
+    int level = gpd_log_parse_level(level_s);
+    if (level < 0) {
+        fprintf(stderr, "grainpackd: --log-level expects error|warn|info|debug, got \"%s\"\n",
+                level_s);
+        return 2;
+    }
+    gpd_log_threshold = level;
+
+    /* Signals are handled by sigwait() in this thread only: block them before any thread. */
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &set, NULL);
+    signal(SIGPIPE, SIG_IGN);
+
+    if (store_open(db) != 0) {
+        fprintf(stderr, "grainpackd: cannot open the job database %s\n", db);
+        return 1;
+    }
+    int requeued = 0, failed = 0;
+    if (store_recover(&requeued, &failed) != 0) {
+        fprintf(stderr, "grainpackd: cannot recover interrupted jobs in %s\n", db);
+        store_close();
+        return 1;
+    }
+    if (requeued || failed)
+        gpd_log(GPD_LOG_WARN,
+                "recovered after an unclean stop: %d running job(s) requeued, %d failed after %d "
+                "attempts",
+                requeued, failed, STORE_MAX_ATTEMPTS);
+
+    char host[300];
+    int port = 0;
+    int fd = gpd_listen_socket(listen_s, host, sizeof host, &port);
+    if (fd < 0) {
+        store_close();
+        return 1;
+    }
+    if (workers_start((int)nworkers) != 0) {
+        workers_stop();
+        store_close();
+        return 1;
+    }
+    gpd_http_config cfg = {.listen_fd = fd,
+                           .threads = (unsigned)nthreads,
+                           .max_connections = (unsigned)maxconn,
+                           .timeout_s = (unsigned)timeout,
+                           .max_body = (size_t)maxbody};
+    if (gpd_http_start(&cfg) != 0) {
+        close(fd);
+        workers_stop();
+        store_close();
+        return 1;
+    }
+    printf("listening on http://%s:%d\n", host, port);
+    fflush(stdout);
+    gpd_log(GPD_LOG_INFO, "grainpackd %s: http://%s:%d, db %s, %ld workers, %ld http threads",
+            GPD_VERSION, host, port, db, nworkers, nthreads);
+
+    int sig = 0;
+    while (sigwait(&set, &sig) != 0) {
+    }
+    gpd_log(GPD_LOG_INFO, "signal %d: shutting down (running jobs are requeued)", sig);
+    gpd_http_stop();
+    workers_stop();
+    store_close();
+    gpd_log(GPD_LOG_INFO, "stopped cleanly");
+    return 0;
+}

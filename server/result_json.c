@@ -1,0 +1,154 @@
+/* result_json.c -- gp_specimen2d -> JSON (format in result_json.h). */
+#include "result_json.h"
+
+#include <math.h>
+
+json_t *gpd_jreal(double x)
+{
+    return isfinite(x) ? json_real(x) : json_null();
+}
+
+static json_t *reals(const double *v, size_t n)
+{
+    if (!v) return json_null();
+    json_t *a = json_array();
+    for (size_t i = 0; i < n; i++) json_array_append_new(a, gpd_jreal(v[i]));
+    return a;
+}
+
+static json_t *hist(const gp_hist *h)
+{
+    if (!h || h->nclasses == 0 || !h->edges) return json_null();
+    return json_pack("{s:o, s:o, s:o}", "edges", reals(h->edges, h->nclasses + 1), "target",
+                     reals(h->target, h->nclasses), "achieved", reals(h->achieved, h->nclasses));
+}
+
+static json_t *point(gp_vec2 p)
+{
+    return json_pack("[o, o]", gpd_jreal(p.x), gpd_jreal(p.y));
+}
+
+static json_t *ring(const gp_vec2 *p, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; i < n; i++) json_array_append_new(a, point(p[i]));
+    return a;
+}
+
+static json_t *descriptors(const gp_descriptors *d)
+{
+    return json_pack("{s:o, s:o, s:o, s:o}", "elongation", gpd_jreal(d->elongation), "roundness",
+                     gpd_jreal(d->roundness), "circularity", gpd_jreal(d->circularity),
+                     "regularity", gpd_jreal(d->regularity));
+}
+
+static const char *imc_measure(gp_imc_error_kind k)
+{
+    switch (k) {
+    case GP_IMC_E1: return "E1";
+    case GP_IMC_E2: return "E2";
+    default: return "E3";
+    }
+}
+
+json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_t *spec_json)
+{
+    json_t *r = json_object();
+    if (!r) return NULL;
+    unsigned out = spec->outputs;
+    json_object_set_new(r, "kind", json_string("fourier-voronoi-2d"));
+    json_object_set_new(r, "seed", json_integer((json_int_t)spec->seed));
+    json_t *o = json_object_get(spec_json, "outputs");
+    if (o) json_object_set(r, "outputs", o);
+    json_t *c = json_object_get(spec_json, "container");
+    if (c) json_object_set(r, "container", c);
+
+    json_t *st = json_object();
+    json_object_set_new(st, "particles",
+                        json_pack("{s:I, s:I}", "target", (json_int_t)spec->particles,
+                                  "achieved", (json_int_t)s->ngrains));
+    json_object_set_new(st, "imc_error",
+                        json_pack("{s:o, s:o, s:s, s:o, s:s}", "target",
+                                  gpd_jreal(spec->imc_threshold), "achieved",
+                                  gpd_jreal(s->imc_error), "measure",
+                                  imc_measure(spec->imc_error), "floor",
+                                  gpd_jreal(s->imc_error_floor), "stop_reason",
+                                  s->imc_stop_reason ? s->imc_stop_reason : ""));
+    json_object_set_new(st, "imc_steps",
+                        json_pack("{s:I, s:I}", "max", (json_int_t)spec->imc_max_steps,
+                                  "achieved", (json_int_t)s->imc_steps));
+    json_object_set_new(st, "solid_fraction",
+                        json_pack("{s:o, s:o}", "target", gpd_jreal(spec->solid_fraction),
+                                  "achieved", gpd_jreal(s->solid_fraction)));
+    json_object_set_new(st, "container_area", gpd_jreal(s->container_area));
+    json_object_set_new(st, "cells_target_met", json_integer((json_int_t)s->cells_target_met));
+    json_object_set_new(st, "mean_orientation_gap_deg", gpd_jreal(s->mean_orientation_gap_deg));
+    json_object_set_new(st, "size_histogram", hist(&s->size_hist));
+    json_object_set_new(st, "grain_size_histogram", hist(&s->grain_size_hist));
+    json_object_set_new(st, "orientation_histogram", hist(&s->orientation_hist));
+    if (out & GP_OUT_DESCRIPTORS) {
+        static const char *names[4] = {"elongation", "roundness", "circularity", "regularity"};
+        const double means[4] = {s->descriptor_mean.elongation, s->descriptor_mean.roundness,
+                                 s->descriptor_mean.circularity, s->descriptor_mean.regularity};
+        json_t *d = json_object();
+        for (int k = 0; k < 4; k++) {
+            json_t *h = hist(&s->descriptor_hist[k]);
+            if (!json_is_object(h)) {
+                json_decref(h);
+                h = json_object();
+            }
+            json_object_set_new(h, "mean", gpd_jreal(means[k]));
+            json_object_set_new(d, names[k], h);
+        }
+        json_object_set_new(st, "descriptors", d);
+    }
+    json_object_set_new(r, "stats", st);
+
+    json_object_set_new(
+        r, "timings",
+        json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}", "tessellation", gpd_jreal(s->t_tessellation),
+                  "imc", gpd_jreal(s->t_imc), "fill", gpd_jreal(s->t_fill), "odec",
+                  gpd_jreal(s->t_odec), "descriptors", gpd_jreal(s->t_descriptors), "total",
+                  gpd_jreal(s->t_total)));
+
+    if (out & (GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS)) {
+        json_t *ga = json_array();
+        for (size_t i = 0; i < s->ngrains; i++) {
+            const gp_grain2d *g = &s->grains[i];
+            json_t *gj = json_object();
+            json_object_set_new(gj, "id", json_integer((json_int_t)i));
+            json_object_set_new(gj, "cell", json_integer((json_int_t)g->cell));
+            json_object_set_new(gj, "contour", ring(g->contour, g->ncontour));
+            json_object_set_new(gj, "area", gpd_jreal(g->area));
+            json_object_set_new(gj, "orientation_deg", gpd_jreal(g->orientation_deg));
+            json_object_set_new(gj, "cell_fraction", gpd_jreal(g->cell_fraction));
+            if (out & GP_OUT_DESCRIPTORS)
+                json_object_set_new(gj, "descriptors", descriptors(&g->descriptors));
+            if (out & GP_OUT_ODEC) {
+                json_t *da = json_array();
+                for (size_t k = 0; k < g->ndiscs && g->discs; k++)
+                    json_array_append_new(da, json_pack("[o, o, o]", gpd_jreal(g->discs[3 * k]),
+                                                        gpd_jreal(g->discs[3 * k + 1]),
+                                                        gpd_jreal(g->discs[3 * k + 2])));
+                json_object_set_new(gj, "discs", da);
+            }
+            json_array_append_new(ga, gj);
+        }
+        json_object_set_new(r, "grains", ga);
+    }
+    if ((out & GP_OUT_CELLS) && s->cells) {
+        json_t *ca = json_array();
+        for (size_t i = 0; i < s->ncells; i++) {
+            const gp_cell2d *cl = &s->cells[i];
+            json_t *polys = json_array();
+            for (size_t k = 0; k < cl->npolygons; k++)
+                json_array_append_new(polys, ring(cl->polygons[k].pts, cl->polygons[k].n));
+            json_array_append_new(
+                ca, json_pack("{s:I, s:o, s:o, s:o, s:o}", "id", (json_int_t)i, "seed",
+                              point(cl->seed), "polygons", polys, "area", gpd_jreal(cl->area),
+                              "orientation_deg", gpd_jreal(cl->orientation_deg)));
+        }
+        json_object_set_new(r, "cells", ca);
+    }
+    return r;
+}

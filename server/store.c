@@ -1,0 +1,618 @@
+/* store.c -- SQLite job store (see store.h for the table and the restart rule). */
+#include "store.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <sqlite3.h>
+
+/* ------------------------------------------------------------------ logging */
+
+volatile int gpd_log_threshold = GPD_LOG_INFO;
+static pthread_mutex_t log_mu = PTHREAD_MUTEX_INITIALIZER;
+
+int gpd_log_parse_level(const char *s)
+{
+    if (!s) return -1;
+    if (!strcmp(s, "error")) return GPD_LOG_ERROR;
+    if (!strcmp(s, "warn") || !strcmp(s, "warning")) return GPD_LOG_WARN;
+    if (!strcmp(s, "info")) return GPD_LOG_INFO;
+    if (!strcmp(s, "debug")) return GPD_LOG_DEBUG;
+    return -1;
+}
+
+void gpd_log(gpd_log_level level, const char *fmt, ...)
+{
+    static const char *names[] = {"error", "warn", "info", "debug"};
+    if ((int)level > __atomic_load_n(&gpd_log_threshold, __ATOMIC_RELAXED)) return;
+    char ts[40];
+    gpd_now_rfc3339(ts, sizeof ts);
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    pthread_mutex_lock(&log_mu);
+    fprintf(stderr, "%s %-5s %s\n", ts, names[level], msg);
+    fflush(stderr);
+    pthread_mutex_unlock(&log_mu);
+}
+
+/* ------------------------------------------------------------------ time, ids */
+
+void gpd_now_rfc3339(char *buf, size_t len)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    struct tm tm;
+    gmtime_r(&ts.tv_sec, &tm);
+    size_t n = strftime(buf, len, "%Y-%m-%dT%H:%M:%S", &tm);
+    snprintf(buf + n, len - n, ".%03dZ", (int)(ts.tv_nsec / 1000000L));
+}
+
+double gpd_monotonic_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int gpd_new_id(char out[33])
+{
+    unsigned char b[16];
+    int fd = open("/dev/urandom", O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return -1;
+    size_t got = 0;
+    while (got < sizeof b) {
+        ssize_t r = read(fd, b + got, sizeof b - got);
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) {
+            close(fd);
+            return -1;
+        }
+        got += (size_t)r;
+    }
+    close(fd);
+    static const char hex[] = "0123456789abcdef";
+    for (int i = 0; i < 16; i++) {
+        out[2 * i] = hex[b[i] >> 4];
+        out[2 * i + 1] = hex[b[i] & 15];
+    }
+    out[32] = '\0';
+    return 0;
+}
+
+int gpd_id_is_plausible(const char *s)
+{
+    size_t n = 0;
+    for (; s[n]; n++) {
+        char c = s[n];
+        int ok = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
+                 c == '-' || c == '_';
+        if (!ok || n >= 64) return 0;
+    }
+    return n > 0;
+}
+
+/* ------------------------------------------------------------------ connections */
+
+static char *db_path = NULL;
+static pthread_key_t conn_key;
+static int closed = 0; /* guarded by path_mu */
+static pthread_mutex_t path_mu = PTHREAD_MUTEX_INITIALIZER;
+
+static void conn_destroy(void *p)
+{
+    if (p) sqlite3_close_v2((sqlite3 *)p);
+}
+
+static const char *SCHEMA_SQL =
+    "CREATE TABLE IF NOT EXISTS jobs("
+    " seq INTEGER PRIMARY KEY AUTOINCREMENT,"
+    " id TEXT NOT NULL UNIQUE,"
+    " kind TEXT NOT NULL,"
+    " spec TEXT NOT NULL,"
+    " status TEXT NOT NULL,"
+    " progress TEXT,"
+    " created_at TEXT NOT NULL,"
+    " started_at TEXT,"
+    " finished_at TEXT,"
+    " error TEXT,"
+    " result TEXT,"
+    " attempts INTEGER NOT NULL DEFAULT 0);"
+    "CREATE INDEX IF NOT EXISTS jobs_status_seq ON jobs(status, seq);";
+
+static sqlite3 *conn_open(void)
+{
+    pthread_mutex_lock(&path_mu);
+    if (closed || !db_path) {
+        pthread_mutex_unlock(&path_mu);
+        return NULL;
+    }
+    char *path = strdup(db_path);
+    pthread_mutex_unlock(&path_mu);
+    if (!path) return NULL;
+    sqlite3 *db = NULL;
+    int rc = sqlite3_open_v2(path, &db,
+                             SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
+                             NULL);
+    free(path);
+    if (rc != SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite open: %s", db ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
+        sqlite3_close_v2(db);
+        return NULL;
+    }
+    sqlite3_busy_timeout(db, 5000);
+    char *em = NULL;
+    if (sqlite3_exec(db, "PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON;", NULL, NULL, &em) !=
+        SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite pragma: %s", em ? em : "?");
+        sqlite3_free(em);
+        sqlite3_close_v2(db);
+        return NULL;
+    }
+    return db;
+}
+
+static sqlite3 *conn(void)
+{
+    sqlite3 *db = pthread_getspecific(conn_key);
+    if (db) return db;
+    db = conn_open();
+    if (db) pthread_setspecific(conn_key, db);
+    return db;
+}
+
+int store_open(const char *path)
+{
+    static int key_made = 0; /* store_open is called once, from main, before any thread */
+    if (!key_made) {
+        if (pthread_key_create(&conn_key, conn_destroy) != 0) return -1;
+        key_made = 1;
+    }
+    pthread_mutex_lock(&path_mu);
+    free(db_path);
+    db_path = strdup(path);
+    closed = 0;
+    pthread_mutex_unlock(&path_mu);
+    if (!db_path) return -1;
+    sqlite3 *db = conn();
+    if (!db) return -1;
+    char *em = NULL;
+    /* WAL is persistent in the file; set it once here. */
+    if (sqlite3_exec(db, "PRAGMA journal_mode=WAL;", NULL, NULL, &em) != SQLITE_OK ||
+        sqlite3_exec(db, SCHEMA_SQL, NULL, NULL, &em) != SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "cannot initialise database %s: %s", path, em ? em : "?");
+        sqlite3_free(em);
+        return -1;
+    }
+    return 0;
+}
+
+void store_thread_done(void)
+{
+    sqlite3 *db = pthread_getspecific(conn_key);
+    if (db) {
+        sqlite3_close_v2(db);
+        pthread_setspecific(conn_key, NULL);
+    }
+}
+
+void store_close(void)
+{
+    store_thread_done();
+    pthread_mutex_lock(&path_mu);
+    closed = 1;
+    free(db_path);
+    db_path = NULL;
+    pthread_mutex_unlock(&path_mu);
+}
+
+/* ------------------------------------------------------------------ helpers */
+
+static sqlite3_stmt *prep(sqlite3 *db, const char *sql)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite prepare: %s (%s)", sqlite3_errmsg(db), sql);
+        return NULL;
+    }
+    return st;
+}
+
+static void bind_text(sqlite3_stmt *st, int i, const char *s)
+{
+    if (s)
+        sqlite3_bind_text(st, i, s, -1, SQLITE_TRANSIENT);
+    else
+        sqlite3_bind_null(st, i);
+}
+
+static int step_done(sqlite3 *db, sqlite3_stmt *st)
+{
+    int rc = sqlite3_step(st);
+    if (rc != SQLITE_DONE && rc != SQLITE_ROW) {
+        gpd_log(GPD_LOG_ERROR, "sqlite step: %s", sqlite3_errmsg(db));
+        return -1;
+    }
+    return 0;
+}
+
+static json_t *json_col(sqlite3_stmt *st, int i)
+{
+    const unsigned char *t = sqlite3_column_text(st, i);
+    if (!t) return json_null();
+    json_t *j = json_loads((const char *)t, JSON_DECODE_ANY, NULL);
+    return j ? j : json_null();
+}
+
+static json_t *text_col(sqlite3_stmt *st, int i)
+{
+    const unsigned char *t = sqlite3_column_text(st, i);
+    return t ? json_string((const char *)t) : json_null();
+}
+
+/* job object columns */
+#define JOB_COLS "id, kind, status, created_at, started_at, finished_at, progress, error"
+
+static json_t *job_from_row(sqlite3_stmt *st)
+{
+    json_t *j = json_object();
+    json_object_set_new(j, "id", text_col(st, 0));
+    json_object_set_new(j, "kind", text_col(st, 1));
+    json_object_set_new(j, "status", text_col(st, 2));
+    json_object_set_new(j, "created_at", text_col(st, 3));
+    json_object_set_new(j, "started_at", text_col(st, 4));
+    json_object_set_new(j, "finished_at", text_col(st, 5));
+    json_t *p = json_col(st, 6);
+    if (json_is_null(p)) {
+        json_decref(p);
+        p = json_pack("{s:s, s:f, s:n, s:{}}", "phase", "queued", "fraction", 0.0, "eta_s",
+                      "detail");
+    }
+    json_object_set_new(j, "progress", p);
+    json_object_set_new(j, "error", json_col(st, 7));
+    return j;
+}
+
+/* ------------------------------------------------------------------ operations */
+
+int store_recover(int *requeued, int *failed)
+{
+    sqlite3 *db = conn();
+    if (!db) return -1;
+    char now[40];
+    gpd_now_rfc3339(now, sizeof now);
+    int rc = -1;
+    if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) return -1;
+    sqlite3_stmt *a = prep(db, "UPDATE jobs SET status='failed', finished_at=?1, error=?2 "
+                               "WHERE status='running' AND attempts >= ?3");
+    sqlite3_stmt *b = prep(db, "UPDATE jobs SET status='queued', started_at=NULL, progress=NULL "
+                               "WHERE status='running'");
+    if (a && b) {
+        char err[256];
+        snprintf(err, sizeof err,
+                 "{\"code\":\"interrupted\",\"message\":\"interrupted %d times (the daemon "
+                 "stopped while the job was running); not retried\"}",
+                 STORE_MAX_ATTEMPTS);
+        bind_text(a, 1, now);
+        bind_text(a, 2, err);
+        sqlite3_bind_int(a, 3, STORE_MAX_ATTEMPTS);
+        if (step_done(db, a) == 0) {
+            if (failed) *failed = sqlite3_changes(db);
+            if (step_done(db, b) == 0) {
+                if (requeued) *requeued = sqlite3_changes(db);
+                rc = 0;
+            }
+        }
+    }
+    sqlite3_finalize(a);
+    sqlite3_finalize(b);
+    sqlite3_exec(db, rc == 0 ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL);
+    return rc;
+}
+
+store_rc store_insert(const char *kind, const char *spec_json, char id_out[33])
+{
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
+    if (gpd_new_id(id_out) != 0) return STORE_ERROR;
+    char now[40];
+    gpd_now_rfc3339(now, sizeof now);
+    sqlite3_stmt *st = prep(db, "INSERT INTO jobs(id, kind, spec, status, created_at) "
+                                "VALUES (?1, ?2, ?3, 'queued', ?4)");
+    if (!st) return STORE_ERROR;
+    bind_text(st, 1, id_out);
+    bind_text(st, 2, kind);
+    bind_text(st, 3, spec_json);
+    bind_text(st, 4, now);
+    int rc = step_done(db, st);
+    sqlite3_finalize(st);
+    return rc == 0 ? STORE_OK : STORE_ERROR;
+}
+
+json_t *store_get_job(const char *id, store_rc *rc)
+{
+    sqlite3 *db = conn();
+    *rc = STORE_ERROR;
+    if (!db) return NULL;
+    sqlite3_stmt *st = prep(db, "SELECT " JOB_COLS " FROM jobs WHERE id=?1");
+    if (!st) return NULL;
+    bind_text(st, 1, id);
+    json_t *j = NULL;
+    int s = sqlite3_step(st);
+    if (s == SQLITE_ROW) {
+        j = job_from_row(st);
+        *rc = STORE_OK;
+    } else if (s == SQLITE_DONE) {
+        *rc = STORE_NOT_FOUND;
+    } else {
+        gpd_log(GPD_LOG_ERROR, "sqlite get: %s", sqlite3_errmsg(db));
+    }
+    sqlite3_finalize(st);
+    return j;
+}
+
+store_rc store_get_text(const char *id, const char *column, char **text, char status[16])
+{
+    *text = NULL;
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
+    const char *sql;
+    if (!strcmp(column, "result"))
+        sql = "SELECT status, result FROM jobs WHERE id=?1";
+    else if (!strcmp(column, "spec"))
+        sql = "SELECT status, spec FROM jobs WHERE id=?1";
+    else if (!strcmp(column, "kind"))
+        sql = "SELECT status, kind FROM jobs WHERE id=?1";
+    else
+        return STORE_ERROR;
+    sqlite3_stmt *st = prep(db, sql);
+    if (!st) return STORE_ERROR;
+    bind_text(st, 1, id);
+    store_rc rc = STORE_ERROR;
+    int s = sqlite3_step(st);
+    if (s == SQLITE_ROW) {
+        const unsigned char *stt = sqlite3_column_text(st, 0);
+        snprintf(status, 16, "%s", stt ? (const char *)stt : "");
+        const unsigned char *t = sqlite3_column_text(st, 1);
+        rc = STORE_OK;
+        if (t) {
+            *text = strdup((const char *)t);
+            if (!*text) rc = STORE_ERROR;
+        }
+    } else if (s == SQLITE_DONE) {
+        rc = STORE_NOT_FOUND;
+    } else {
+        gpd_log(GPD_LOG_ERROR, "sqlite get %s: %s", column, sqlite3_errmsg(db));
+    }
+    sqlite3_finalize(st);
+    return rc;
+}
+
+json_t *store_list(const char *status, int limit, const char *after, store_rc *rc)
+{
+    *rc = STORE_ERROR;
+    sqlite3 *db = conn();
+    if (!db) return NULL;
+    sqlite3_int64 after_seq = -1;
+    if (after) {
+        sqlite3_stmt *q = prep(db, "SELECT seq FROM jobs WHERE id=?1");
+        if (!q) return NULL;
+        bind_text(q, 1, after);
+        int s = sqlite3_step(q);
+        if (s == SQLITE_ROW) after_seq = sqlite3_column_int64(q, 0);
+        sqlite3_finalize(q);
+        if (s == SQLITE_DONE) {
+            *rc = STORE_NOT_FOUND;
+            return NULL;
+        }
+        if (s != SQLITE_ROW) return NULL;
+    }
+    sqlite3_stmt *st = prep(db, "SELECT " JOB_COLS " FROM jobs "
+                                "WHERE (?1 IS NULL OR status=?1) AND (?2 < 0 OR seq < ?2) "
+                                "ORDER BY seq DESC LIMIT ?3");
+    if (!st) return NULL;
+    bind_text(st, 1, status);
+    sqlite3_bind_int64(st, 2, after_seq);
+    sqlite3_bind_int(st, 3, limit + 1);
+    json_t *jobs = json_array();
+    int n = 0, s;
+    json_t *next = json_null();
+    while ((s = sqlite3_step(st)) == SQLITE_ROW) {
+        if (n == limit) {
+            /* there is more: the cursor is the last job returned */
+            json_t *last = json_array_get(jobs, (size_t)n - 1);
+            json_decref(next);
+            next = json_incref(json_object_get(last, "id"));
+            break;
+        }
+        json_array_append_new(jobs, job_from_row(st));
+        n++;
+    }
+    sqlite3_finalize(st);
+    if (s != SQLITE_ROW && s != SQLITE_DONE) {
+        gpd_log(GPD_LOG_ERROR, "sqlite list: %s", sqlite3_errmsg(db));
+        json_decref(jobs);
+        json_decref(next);
+        return NULL;
+    }
+    *rc = STORE_OK;
+    return json_pack("{s:o, s:o}", "jobs", jobs, "next", next);
+}
+
+store_rc store_counts(long *queued, long *running, long *succeeded, long *failed,
+                      long *cancelled)
+{
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
+    sqlite3_stmt *st = prep(db, "SELECT status, count(*) FROM jobs GROUP BY status");
+    if (!st) return STORE_ERROR;
+    long q = 0, r = 0, su = 0, f = 0, c = 0;
+    int s;
+    while ((s = sqlite3_step(st)) == SQLITE_ROW) {
+        const char *k = (const char *)sqlite3_column_text(st, 0);
+        long n = (long)sqlite3_column_int64(st, 1);
+        if (!k) continue;
+        if (!strcmp(k, "queued")) q = n;
+        else if (!strcmp(k, "running")) r = n;
+        else if (!strcmp(k, "succeeded")) su = n;
+        else if (!strcmp(k, "failed")) f = n;
+        else if (!strcmp(k, "cancelled")) c = n;
+    }
+    sqlite3_finalize(st);
+    if (s != SQLITE_DONE) return STORE_ERROR;
+    if (queued) *queued = q;
+    if (running) *running = r;
+    if (succeeded) *succeeded = su;
+    if (failed) *failed = f;
+    if (cancelled) *cancelled = c;
+    return STORE_OK;
+}
+
+store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts)
+{
+    *kind = NULL;
+    *spec_json = NULL;
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
+    char now[40];
+    gpd_now_rfc3339(now, sizeof now);
+    /* One statement: atomic with respect to every other connection. */
+    sqlite3_stmt *st = prep(
+        db, "UPDATE jobs SET status='running', started_at=?1, finished_at=NULL, "
+            "attempts=attempts+1, "
+            "progress='{\"phase\":\"starting\",\"fraction\":0,\"eta_s\":null,\"detail\":{}}' "
+            "WHERE seq=(SELECT seq FROM jobs WHERE status='queued' ORDER BY seq LIMIT 1) "
+            "AND status='queued' RETURNING id, kind, spec, attempts");
+    if (!st) return STORE_ERROR;
+    bind_text(st, 1, now);
+    store_rc rc = STORE_ERROR;
+    int s = sqlite3_step(st);
+    if (s == SQLITE_ROW) {
+        snprintf(id, 33, "%s", (const char *)sqlite3_column_text(st, 0));
+        *kind = strdup((const char *)sqlite3_column_text(st, 1));
+        *spec_json = strdup((const char *)sqlite3_column_text(st, 2));
+        *attempts = sqlite3_column_int(st, 3);
+        s = sqlite3_step(st); /* finish the statement so that the change commits */
+        rc = (s == SQLITE_DONE && *kind && *spec_json) ? STORE_OK : STORE_ERROR;
+        if (rc != STORE_OK) {
+            free(*kind);
+            free(*spec_json);
+            *kind = *spec_json = NULL;
+        }
+    } else if (s == SQLITE_DONE) {
+        rc = STORE_NOT_FOUND;
+    }
+    if (rc == STORE_ERROR) gpd_log(GPD_LOG_ERROR, "sqlite claim: %s", sqlite3_errmsg(db));
+    sqlite3_finalize(st);
+    return rc;
+}
+
+static store_rc update_running(const char *sql, const char *id, const char *a, const char *b,
+                               const char *c)
+{
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
+    sqlite3_stmt *st = prep(db, sql);
+    if (!st) return STORE_ERROR;
+    bind_text(st, 1, id);
+    int np = sqlite3_bind_parameter_count(st);
+    if (np >= 2) bind_text(st, 2, a);
+    if (np >= 3) bind_text(st, 3, b);
+    if (np >= 4) bind_text(st, 4, c);
+    int rc = step_done(db, st);
+    sqlite3_finalize(st);
+    if (rc) return STORE_ERROR;
+    return sqlite3_changes(db) > 0 ? STORE_OK : STORE_CONFLICT;
+}
+
+store_rc store_progress(const char *id, const char *progress_json)
+{
+    return update_running("UPDATE jobs SET progress=?2 WHERE id=?1 AND status='running'", id,
+                          progress_json, NULL, NULL);
+}
+
+store_rc store_succeed(const char *id, const char *result_json, const char *progress_json)
+{
+    char now[40];
+    gpd_now_rfc3339(now, sizeof now);
+    return update_running("UPDATE jobs SET status='succeeded', result=?2, progress=?3, "
+                          "finished_at=?4, error=NULL WHERE id=?1 AND status='running'",
+                          id, result_json, progress_json, now);
+}
+
+store_rc store_fail(const char *id, const char *code, const char *message)
+{
+    char now[40];
+    gpd_now_rfc3339(now, sizeof now);
+    json_t *e = json_pack("{s:s, s:s}", "code", code, "message", message ? message : "");
+    char *et = e ? json_dumps(e, JSON_COMPACT) : NULL;
+    json_decref(e);
+    store_rc rc = update_running("UPDATE jobs SET status='failed', error=?2, finished_at=?3 "
+                                 "WHERE id=?1 AND status='running'",
+                                 id, et, now, NULL);
+    free(et);
+    return rc;
+}
+
+store_rc store_requeue(const char *id)
+{
+    return update_running("UPDATE jobs SET status='queued', started_at=NULL, progress=NULL, "
+                          "attempts=max(attempts-1, 0) WHERE id=?1 AND status='running'",
+                          id, NULL, NULL, NULL);
+}
+
+store_rc store_cancel(const char *id, int *was_running, char status_out[16])
+{
+    *was_running = 0;
+    status_out[0] = '\0';
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
+    char now[40];
+    gpd_now_rfc3339(now, sizeof now);
+    if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite cancel begin: %s", sqlite3_errmsg(db));
+        return STORE_ERROR;
+    }
+    store_rc rc = STORE_ERROR;
+    sqlite3_stmt *q = prep(db, "SELECT status FROM jobs WHERE id=?1");
+    sqlite3_stmt *u = prep(db, "UPDATE jobs SET status='cancelled', finished_at=?2, "
+                               "error='{\"code\":\"cancelled\",\"message\":\"cancelled by a "
+                               "DELETE request\"}' WHERE id=?1");
+    if (q && u) {
+        bind_text(q, 1, id);
+        int s = sqlite3_step(q);
+        if (s == SQLITE_DONE) {
+            rc = STORE_NOT_FOUND;
+        } else if (s == SQLITE_ROW) {
+            snprintf(status_out, 16, "%s", (const char *)sqlite3_column_text(q, 0));
+            if (!strcmp(status_out, "queued") || !strcmp(status_out, "running")) {
+                *was_running = !strcmp(status_out, "running");
+                bind_text(u, 1, id);
+                bind_text(u, 2, now);
+                if (step_done(db, u) == 0) {
+                    rc = STORE_OK;
+                    snprintf(status_out, 16, "cancelled");
+                }
+            } else {
+                rc = STORE_CONFLICT;
+            }
+        }
+    }
+    sqlite3_finalize(q);
+    sqlite3_finalize(u);
+    if (sqlite3_exec(db, rc == STORE_OK ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK &&
+        rc == STORE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite cancel commit: %s", sqlite3_errmsg(db));
+        rc = STORE_ERROR;
+    }
+    return rc;
+}

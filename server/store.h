@@ -1,0 +1,104 @@
+/* store.h -- the SQLite job store of grainpackd, and the daemon's logger.
+ *
+ * One table, jobs (WAL journal, busy_timeout 5 s, synchronous=NORMAL... FULL for the commit of
+ * a result, see store.c):
+ *   seq         INTEGER PRIMARY KEY AUTOINCREMENT  submission order (newest = largest)
+ *   id          TEXT NOT NULL UNIQUE               32 hex digits, 128 random bits (/dev/urandom)
+ *   kind        TEXT NOT NULL
+ *   spec        TEXT NOT NULL                      the effective spec (defaults filled), JSON
+ *   status      TEXT NOT NULL                      queued|running|succeeded|failed|cancelled
+ *   progress    TEXT                               JSON {phase, fraction, eta_s, detail}
+ *   created_at, started_at, finished_at TEXT       RFC 3339 UTC with milliseconds
+ *   error       TEXT                               JSON {code, message} or NULL
+ *   result      TEXT                               JSON, written in the same statement as
+ *                                                  status='succeeded' (durable before it shows)
+ *   attempts    INTEGER NOT NULL DEFAULT 0         times a worker claimed the job
+ *
+ * Connections: one per thread (opened lazily, closed when the thread exits or on
+ * store_close()); every write is a single statement or an IMMEDIATE transaction, so claims and
+ * cancels are atomic across threads and processes.
+ *
+ * Restart rule (store_recover): a job found 'running' when the daemon starts was interrupted
+ * by a crash. It is put back in the queue unless it has already been claimed
+ * STORE_MAX_ATTEMPTS (3) times, in which case it fails with error
+ * {"code": "interrupted", "message": "interrupted 3 times ..."}. A graceful shutdown
+ * (SIGTERM/SIGINT) requeues running jobs without counting the attempt.
+ */
+#ifndef GPD_STORE_H
+#define GPD_STORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <jansson.h>
+
+/* ---- logging (stderr) ---- */
+typedef enum { GPD_LOG_ERROR = 0, GPD_LOG_WARN, GPD_LOG_INFO, GPD_LOG_DEBUG } gpd_log_level;
+extern volatile int gpd_log_threshold; /* messages above this level are dropped */
+/* Parses "error", "warn", "info", "debug"; -1 when unknown. */
+int gpd_log_parse_level(const char *s);
+void gpd_log(gpd_log_level level, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* ---- time and ids ---- */
+/* RFC 3339 UTC with milliseconds, e.g. "2026-11-23T17:25:47.123Z" (buf >= 32). */
+void gpd_now_rfc3339(char *buf, size_t len);
+double gpd_monotonic_s(void);
+/* 32 lower-case hex digits from /dev/urandom; 0 on success. */
+int gpd_new_id(char out[33]);
+/* 1 when s looks like a job id (1..64 chars of [0-9a-zA-Z_-]). */
+int gpd_id_is_plausible(const char *s);
+
+/* ---- the store ---- */
+#define STORE_MAX_ATTEMPTS 3
+
+typedef enum { STORE_OK = 0, STORE_NOT_FOUND = 1, STORE_CONFLICT = 2, STORE_ERROR = -1 } store_rc;
+
+/* Opens (creates) the database at path, sets WAL and creates the table. 0 on success. */
+int store_open(const char *path);
+/* Closes the calling thread's connection and forbids new ones. */
+void store_close(void);
+/* Closes the calling thread's connection (the next call opens a new one). */
+void store_thread_done(void);
+
+/* Crash recovery at startup (rule above). Returns the number of jobs requeued and failed. */
+int store_recover(int *requeued, int *failed);
+
+/* Inserts a queued job; fills id. */
+store_rc store_insert(const char *kind, const char *spec_json, char id_out[33]);
+
+/* The job object of api.md (a new reference), or NULL with *rc set. */
+json_t *store_get_job(const char *id, store_rc *rc);
+
+/* The raw text of one column ("result" or "spec") and the job's status; *text is malloc'ed
+ * (NULL when the column is NULL). STORE_NOT_FOUND for an unknown id. */
+store_rc store_get_text(const char *id, const char *column, char **text, char status[16]);
+
+/* Lists jobs newest first: status may be NULL (all), after is a job id (exclusive cursor) or
+ * NULL. Returns {"jobs": [...], "next": id|null}; *rc = STORE_NOT_FOUND when after is unknown. */
+json_t *store_list(const char *status, int limit, const char *after, store_rc *rc);
+
+/* Counts per status (any pointer may be NULL). */
+store_rc store_counts(long *queued, long *running, long *succeeded, long *failed,
+                      long *cancelled);
+
+/* Atomically claims the oldest queued job: status running, started_at now, attempts+1.
+ * Returns STORE_OK and malloc'ed id/kind/spec, STORE_NOT_FOUND when the queue is empty. */
+store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts);
+
+/* Progress of a running job (JSON text). STORE_CONFLICT when the job is no longer running
+ * (cancelled meanwhile). */
+store_rc store_progress(const char *id, const char *progress_json);
+
+/* Final transitions of a running job (no-ops returning STORE_CONFLICT when it is no longer
+ * running, e.g. cancelled by DELETE). */
+store_rc store_succeed(const char *id, const char *result_json, const char *progress_json);
+store_rc store_fail(const char *id, const char *code, const char *message);
+/* Back to queued (graceful shutdown): the attempt is not counted. */
+store_rc store_requeue(const char *id);
+
+/* DELETE: a queued or running job becomes cancelled (finished_at now). STORE_CONFLICT (with
+ * its status in status_out) when it has already finished, STORE_NOT_FOUND when unknown.
+ * was_running tells whether a worker must be told. */
+store_rc store_cancel(const char *id, int *was_running, char status_out[16]);
+
+#endif /* GPD_STORE_H */

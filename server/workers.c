@@ -1,0 +1,282 @@
+/* workers.c -- worker threads: claim, run, progress, cancel, requeue on shutdown. */
+#include "workers.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <jansson.h>
+
+#include "result_json.h"
+#ifdef GPD_HAVE_SCHEMA
+#include "gp_spec.h"
+#endif
+#ifdef GPD_HAVE_SPECIMEN2D
+#include "gp_specimen2d.h"
+#endif
+
+#define PROGRESS_MIN_INTERVAL_S 0.25 /* <= 4 Hz per job */
+
+typedef struct slot {
+    pthread_t thread;
+    int index;
+    char id[33];          /* job being run ("" when idle); guarded by reg_mu */
+    volatile int cancel;  /* read by the core; written with __atomic_store_n */
+} slot;
+
+static slot *slots = NULL;
+static int nslots = 0;
+static int started = 0;
+static pthread_mutex_t reg_mu = PTHREAD_MUTEX_INITIALIZER; /* claims, cancels, slot ids */
+static pthread_mutex_t wake_mu = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t wake_cv;
+static unsigned long wake_gen = 0; /* guarded by wake_mu */
+static int stopping = 0;           /* atomic */
+static int busy = 0;               /* atomic */
+
+int workers_total(void) { return nslots; }
+int workers_busy(void) { return __atomic_load_n(&busy, __ATOMIC_RELAXED); }
+
+void workers_notify(void)
+{
+    pthread_mutex_lock(&wake_mu);
+    wake_gen++;
+    pthread_cond_broadcast(&wake_cv);
+    pthread_mutex_unlock(&wake_mu);
+}
+
+store_rc workers_cancel(const char *id, char status_out[16])
+{
+    int was_running = 0;
+    pthread_mutex_lock(&reg_mu);
+    store_rc rc = store_cancel(id, &was_running, status_out);
+    if (rc == STORE_OK && was_running) {
+        for (int i = 0; i < nslots; i++)
+            if (!strcmp(slots[i].id, id)) __atomic_store_n(&slots[i].cancel, 1, __ATOMIC_RELAXED);
+    }
+    pthread_mutex_unlock(&reg_mu);
+    if (rc == STORE_OK) gpd_log(GPD_LOG_INFO, "job %s cancelled (was %s)", id,
+                                was_running ? "running" : "queued");
+    return rc;
+}
+
+/* ------------------------------------------------------------------ progress */
+
+typedef struct run_ctx {
+    slot *s;
+    const char *id;
+    double t0;
+    double last_write;
+} run_ctx;
+
+__attribute__((unused)) static char *progress_text(const char *phase, double fraction, double eta, long steps,
+                           double error, int with_detail)
+{
+    json_t *detail = json_object();
+    if (with_detail) {
+        json_object_set_new(detail, "steps", json_integer(steps));
+        json_object_set_new(detail, "error", gpd_jreal(error));
+    }
+    json_t *p = json_pack("{s:s, s:o, s:o, s:o}", "phase", phase ? phase : "", "fraction",
+                          gpd_jreal(fraction), "eta_s", gpd_jreal(eta), "detail", detail);
+    char *t = p ? json_dumps(p, JSON_COMPACT) : NULL;
+    json_decref(p);
+    return t;
+}
+
+#ifdef GPD_HAVE_SPECIMEN2D
+static int on_progress(void *user, const gp_progress *p)
+{
+    run_ctx *c = user;
+    if (__atomic_load_n(&c->s->cancel, __ATOMIC_RELAXED)) return 1;
+    double now = gpd_monotonic_s();
+    if (now - c->last_write < PROGRESS_MIN_INTERVAL_S) return 0;
+    c->last_write = now;
+    double f = p->fraction;
+    if (!(f >= 0)) f = 0;
+    if (f > 1) f = 1;
+    double elapsed = now - c->t0;
+    double eta = (f >= 0.01 && f < 1) ? elapsed * (1 - f) / f : (f >= 1 ? 0 : NAN);
+    char *t = progress_text(p->phase, f, eta, p->steps, p->error, 1);
+    if (t) {
+        if (store_progress(c->id, t) == STORE_CONFLICT) /* no longer running: cancelled */
+            __atomic_store_n(&c->s->cancel, 1, __ATOMIC_RELAXED);
+        free(t);
+    }
+    return __atomic_load_n(&c->s->cancel, __ATOMIC_RELAXED);
+}
+#endif
+
+/* ------------------------------------------------------------------ one job */
+
+static void finish_failed(const char *id, const char *code, const char *msg)
+{
+    if (store_fail(id, code, msg) == STORE_OK)
+        gpd_log(GPD_LOG_INFO, "job %s failed: %s: %s", id, code, msg);
+}
+
+static void run_2d(slot *s, const char *id, json_t *spec_json)
+{
+#if defined(GPD_HAVE_SCHEMA) && defined(GPD_HAVE_SPECIMEN2D)
+    gp_spec2d spec;
+    gp_spec_problem prob;
+    memset(&prob, 0, sizeof prob);
+    if (gp_spec_parse_2d(spec_json, &spec, &prob) != 0) {
+        gp_spec_2d_free(&spec);
+        finish_failed(id, "invalid_spec", prob.message);
+        return;
+    }
+    spec.threads = 1;
+    run_ctx ctx = {.s = s, .id = id, .t0 = gpd_monotonic_s(), .last_write = 0};
+    gp_specimen2d *out = NULL;
+    gp_error err;
+    gp_error_clear(&err);
+    gp_status st = gp_specimen2d_build(&spec, on_progress, &ctx, &s->cancel, &out, &err);
+    if (st == GP_OK && out) {
+        json_t *r = gpd_result_2d(out, &spec, spec_json);
+        gp_specimen2d_destroy(out);
+        char *text = r ? json_dumps(r, JSON_COMPACT) : NULL;
+        json_decref(r);
+        char *prog = progress_text("done", 1.0, 0.0, 0, 0, 0);
+        if (!text || !prog) {
+            finish_failed(id, "internal", "out of memory while serialising the result");
+        } else {
+            store_rc rc = store_succeed(id, text, prog);
+            if (rc == STORE_OK)
+                gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%zu bytes)", id,
+                        gpd_monotonic_s() - ctx.t0, strlen(text));
+            else if (rc == STORE_ERROR)
+                gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result", id);
+        }
+        free(text);
+        free(prog);
+    } else {
+        if (out) gp_specimen2d_destroy(out);
+        if (st == GP_ERR_CANCELLED || __atomic_load_n(&s->cancel, __ATOMIC_RELAXED)) {
+            if (__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
+                if (store_requeue(id) == STORE_OK)
+                    gpd_log(GPD_LOG_INFO, "job %s requeued (shutdown)", id);
+            }
+            /* else: a DELETE already marked it cancelled */
+        } else {
+            finish_failed(id, gp_status_name(st), err.message[0] ? err.message : "failed");
+        }
+    }
+    gp_spec_2d_free(&spec);
+#else
+    (void)s;
+    (void)spec_json;
+    finish_failed(id, "not_implemented",
+                  "this build of grainpackd has no 2D pipeline (core/gp_specimen2d.c or the "
+                  "schema parser is missing)");
+#endif
+}
+
+static void run_job(slot *s, const char *id, const char *kind, const char *spec_text)
+{
+    json_error_t je;
+    json_t *spec = json_loads(spec_text, 0, &je);
+    if (!spec) {
+        finish_failed(id, "internal", "stored spec is not valid JSON");
+        return;
+    }
+    if (!strcmp(kind, "fourier-voronoi-2d"))
+        run_2d(s, id, spec);
+    else
+        finish_failed(id, "not_implemented", "this kind is not available in this build");
+    json_decref(spec);
+}
+
+/* ------------------------------------------------------------------ threads */
+
+static void *worker_main(void *arg)
+{
+    slot *s = arg;
+    while (!__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
+        pthread_mutex_lock(&wake_mu);
+        unsigned long gen = wake_gen;
+        pthread_mutex_unlock(&wake_mu);
+
+        char id[33];
+        char *kind = NULL, *spec = NULL;
+        int attempts = 0;
+        pthread_mutex_lock(&reg_mu);
+        store_rc rc = STORE_NOT_FOUND;
+        if (!__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
+            rc = store_claim(id, &kind, &spec, &attempts);
+            if (rc == STORE_OK) {
+                snprintf(s->id, sizeof s->id, "%s", id);
+                __atomic_store_n(&s->cancel, 0, __ATOMIC_RELAXED);
+            }
+        }
+        pthread_mutex_unlock(&reg_mu);
+
+        if (rc == STORE_OK) {
+            __atomic_add_fetch(&busy, 1, __ATOMIC_RELAXED);
+            gpd_log(GPD_LOG_INFO, "job %s started on worker %d (attempt %d)", id, s->index,
+                    attempts);
+            run_job(s, id, kind, spec);
+            free(kind);
+            free(spec);
+            pthread_mutex_lock(&reg_mu);
+            s->id[0] = '\0';
+            pthread_mutex_unlock(&reg_mu);
+            __atomic_sub_fetch(&busy, 1, __ATOMIC_RELAXED);
+            continue;
+        }
+        if (rc == STORE_ERROR) gpd_log(GPD_LOG_WARN, "worker %d: claim failed", s->index);
+        /* idle: wait for a notification or poll again after a second */
+        struct timespec dl;
+        clock_gettime(CLOCK_MONOTONIC, &dl);
+        dl.tv_sec += 1;
+        pthread_mutex_lock(&wake_mu);
+        while (wake_gen == gen && !__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
+            if (pthread_cond_timedwait(&wake_cv, &wake_mu, &dl) != 0) break;
+        }
+        pthread_mutex_unlock(&wake_mu);
+    }
+    store_thread_done();
+    return NULL;
+}
+
+int workers_start(int n)
+{
+    pthread_condattr_t ca;
+    pthread_condattr_init(&ca);
+    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_cond_init(&wake_cv, &ca);
+    pthread_condattr_destroy(&ca);
+    slots = calloc((size_t)n, sizeof *slots);
+    if (!slots) return -1;
+    nslots = n;
+    for (int i = 0; i < n; i++) {
+        slots[i].index = i;
+        if (pthread_create(&slots[i].thread, NULL, worker_main, &slots[i]) != 0) {
+            gpd_log(GPD_LOG_ERROR, "cannot start worker %d", i);
+            nslots = i;
+            return -1;
+        }
+    }
+    started = 1;
+    return 0;
+}
+
+void workers_stop(void)
+{
+    if (!slots) return;
+    __atomic_store_n(&stopping, 1, __ATOMIC_RELAXED);
+    pthread_mutex_lock(&reg_mu);
+    for (int i = 0; i < nslots; i++)
+        if (slots[i].id[0]) __atomic_store_n(&slots[i].cancel, 1, __ATOMIC_RELAXED);
+    pthread_mutex_unlock(&reg_mu);
+    workers_notify();
+    for (int i = 0; i < nslots; i++) pthread_join(slots[i].thread, NULL);
+    free(slots);
+    slots = NULL;
+    nslots = 0;
+    pthread_cond_destroy(&wake_cv);
+    started = 0;
+}
