@@ -152,3 +152,89 @@ json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_
     }
     return r;
 }
+
+/* ------------------------------------------------------------------ 3D */
+
+static json_t *vec3(const double *v)
+{
+    return json_pack("[o, o, o]", gpd_jreal(v[0]), gpd_jreal(v[1]), gpd_jreal(v[2]));
+}
+
+static json_t *mat3(const double m[3][3])
+{
+    return json_pack("[o, o, o]", vec3(m[0]), vec3(m[1]), vec3(m[2]));
+}
+
+json_t *gpd_result_3d(const gp_specimen3d *s, const gp_spec3d *spec, const json_t *spec_json)
+{
+    json_t *r = json_object();
+    if (!r) return NULL;
+    unsigned out = spec->outputs;
+    const gp_stats3d *t = &s->stats;
+    json_object_set_new(r, "kind", json_string("spheres-3d"));
+    json_object_set_new(r, "seed", json_integer((json_int_t)spec->seed));
+    json_t *o = json_object_get(spec_json, "outputs");
+    if (o) json_object_set(r, "outputs", o);
+    json_object_set_new(r, "box", vec3(s->box));
+    json_object_set_new(r, "sample_box", vec3(s->sample_box));
+    json_object_set_new(r, "tiling", json_pack("[i, i, i]", spec->tiling[0], spec->tiling[1],
+                                               spec->tiling[2]));
+
+    json_t *st = json_object();
+    json_object_set_new(st, "porosity",
+                        json_pack("{s:o, s:o, s:o, s:o}", "target", gpd_jreal(t->porosity_target),
+                                  "achieved", gpd_jreal(t->porosity), "sample",
+                                  gpd_jreal(t->sample_porosity), "deposition",
+                                  gpd_jreal(t->deposition_porosity)));
+    json_object_set_new(st, "coordination_number", gpd_jreal(t->coordination_number));
+    json_object_set_new(st, "coordination_spheres", gpd_jreal(t->coordination_spheres));
+    if (out & GP_OUT3_FABRIC) json_object_set_new(st, "fabric", mat3(t->fabric));
+    if (out & GP_OUT3_STRESS) json_object_set_new(st, "stress", mat3(t->stress));
+    const gp_psd3d *p = &t->psd;
+    json_object_set_new(
+        st, "psd",
+        json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}", "diameters", reals(p->diameter, p->n),
+                  "target_weight", reals(p->target_weight, p->n), "achieved_weight",
+                  reals(p->achieved_weight, p->n), "target_number", reals(p->target_number, p->n),
+                  "target_number_midbin", reals(p->target_number_midbin, p->n),
+                  "achieved_number", reals(p->achieved_number, p->n)));
+    json_object_set_new(st, "particles", json_integer((json_int_t)t->particles));
+    json_object_set_new(st, "sample_particles", json_integer((json_int_t)t->sample_particles));
+    json_object_set_new(st, "contacts", json_integer((json_int_t)t->contacts));
+    json_object_set_new(st, "wall_contacts", json_integer((json_int_t)t->wall_contacts));
+    json_object_set_new(st, "stop_reason", json_string(t->stop_reason ? t->stop_reason : ""));
+    json_object_set_new(st, "stability", gpd_jreal(t->stability));
+    json_object_set_new(st, "tiled_stability", gpd_jreal(t->tiled_stability));
+    json_object_set_new(st, "compaction_friction_deg", gpd_jreal(t->compaction_friction_deg));
+    json_object_set_new(st, "steps", json_integer((json_int_t)t->steps));
+    json_object_set_new(st, "dt", gpd_jreal(t->dt));
+    json_object_set_new(r, "stats", st);
+
+    json_object_set_new(r, "timings",
+                        json_pack("{s:o, s:o, s:o, s:o, s:o}", "deposition",
+                                  gpd_jreal(s->t_deposition), "compaction",
+                                  gpd_jreal(s->t_compaction), "relaxation",
+                                  gpd_jreal(s->t_relaxation), "tiling", gpd_jreal(s->t_tiling),
+                                  "total", gpd_jreal(s->t_total)));
+    if ((out & GP_OUT3_SPHERES) && s->spheres) {
+        json_t *a = json_array();
+        for (size_t i = 0; i < s->count; i++) {
+            const double *q = s->spheres + 4 * i;
+            json_array_append_new(a, json_pack("[o, o, o, o]", gpd_jreal(q[0]), gpd_jreal(q[1]),
+                                               gpd_jreal(q[2]), gpd_jreal(q[3])));
+        }
+        json_object_set_new(r, "spheres", a);
+    }
+    if ((out & GP_OUT3_CONTACTS) && s->contacts) {
+        json_t *a = json_array();
+        for (size_t i = 0; i < s->ncontacts; i++) {
+            const gp_contact3d *c = &s->contacts[i];
+            json_array_append_new(a, json_pack("{s:I, s:I, s:o, s:o, s:o}", "i",
+                                               (json_int_t)c->i, "j", (json_int_t)c->j, "normal",
+                                               vec3(c->normal), "overlap", gpd_jreal(c->overlap),
+                                               "force", vec3(c->force)));
+        }
+        json_object_set_new(r, "contacts", a);
+    }
+    return r;
+}

@@ -24,6 +24,22 @@
  *              "discs": [[x,y,r],...] (output odec)}]   (with any of grains/odec/descriptors),
  *  "cells": [{"id", "seed": [x,y], "polygons": [[[x,y],...],...], "area",
  *             "orientation_deg"}]                      (with output "cells")}
+ *
+ * 3D ("spheres-3d"):
+ * {"kind": "spheres-3d", "seed": 7, "outputs": [...],
+ *  "box": [bx, by, bz] (m, the final (tiled) box), "sample_box": [bx, by, bz], "tiling": [nx,ny,nz],
+ *  "stats": {
+ *    "porosity": {"target", "achieved" (final packing), "sample", "deposition"},
+ *    "coordination_number": z (wall contacts counted), "coordination_spheres": z,
+ *    "fabric": [[3x3]] (output fabric), "stress": [[3x3]] Pa (output stress),
+ *    "psd": {"diameters": [n] (m), "target_weight", "achieved_weight", "target_number",
+ *            "target_number_midbin", "achieved_number"}  (percent passing),
+ *    "particles": n (final packing), "sample_particles", "contacts", "wall_contacts",
+ *    "stop_reason", "stability", "tiled_stability", "compaction_friction_deg", "steps", "dt"},
+ *  "timings": {"deposition", "compaction", "relaxation", "tiling", "total"} (seconds),
+ *  "spheres": [[x, y, z, r], ...] (output spheres),
+ *  "contacts": [{"i", "j", "normal": [3], "overlap", "force": [3]}] (output contacts; j < 0 is
+ *              wall -1-j, walls 0..5 = x-, x+, y-, y+, z-, z+)}
  * Histogram "target" is null where there is no target. Non-finite numbers are written as null.
  * The field names follow server/svg.h.
  */
@@ -33,10 +49,13 @@
 #include <jansson.h>
 
 #include "gp_specimen2d.h"
+#include "gp_specimen3d.h"
 
 /* A new reference (NULL on out of memory). spec_json is the effective spec (for the echoed
  * container, seed and outputs). */
 json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_t *spec_json);
+
+json_t *gpd_result_3d(const gp_specimen3d *s, const gp_spec3d *spec, const json_t *spec_json);
 
 /* A double as JSON: a real, or null when not finite. */
 json_t *gpd_jreal(double x);

@@ -14,9 +14,8 @@
 #ifdef GPD_HAVE_SCHEMA
 #include "gp_spec.h"
 #endif
-#ifdef GPD_HAVE_SPECIMEN2D
 #include "gp_specimen2d.h"
-#endif
+#include "gp_specimen3d.h"
 
 #define PROGRESS_MIN_INTERVAL_S 0.25 /* <= 4 Hz per job */
 
@@ -87,26 +86,39 @@ __attribute__((unused)) static char *progress_text(const char *phase, double fra
     return t;
 }
 
-#ifdef GPD_HAVE_SPECIMEN2D
-static int on_progress(void *user, const gp_progress *p)
+/* Throttled progress write; returns non-zero when the job must stop. */
+__attribute__((unused)) static int report(run_ctx *c, const char *phase, double f, long steps,
+                                          double error)
 {
-    run_ctx *c = user;
     if (__atomic_load_n(&c->s->cancel, __ATOMIC_RELAXED)) return 1;
     double now = gpd_monotonic_s();
     if (now - c->last_write < PROGRESS_MIN_INTERVAL_S) return 0;
     c->last_write = now;
-    double f = p->fraction;
     if (!(f >= 0)) f = 0;
     if (f > 1) f = 1;
     double elapsed = now - c->t0;
     double eta = (f >= 0.01 && f < 1) ? elapsed * (1 - f) / f : (f >= 1 ? 0 : NAN);
-    char *t = progress_text(p->phase, f, eta, p->steps, p->error, 1);
+    char *t = progress_text(phase, f, eta, steps, error, 1);
     if (t) {
         if (store_progress(c->id, t) == STORE_CONFLICT) /* no longer running: cancelled */
             __atomic_store_n(&c->s->cancel, 1, __ATOMIC_RELAXED);
         free(t);
     }
     return __atomic_load_n(&c->s->cancel, __ATOMIC_RELAXED);
+}
+
+#ifdef GPD_HAVE_SPECIMEN2D
+static int on_progress2d(void *user, const gp_progress *p)
+{
+    return report(user, p->phase, p->fraction, p->steps, p->error);
+}
+#endif
+#ifdef GPD_HAVE_SPECIMEN3D
+static int on_progress3d(void *user, const gp_progress3d *p)
+{
+    /* detail.error carries the current porosity during deposition/compaction and S_c after */
+    double e = (p->stability > 0) ? p->stability : p->porosity;
+    return report(user, p->phase, p->fraction, p->steps, e);
 }
 #endif
 
@@ -116,6 +128,51 @@ static void finish_failed(const char *id, const char *code, const char *msg)
 {
     if (store_fail(id, code, msg) == STORE_OK)
         gpd_log(GPD_LOG_INFO, "job %s failed: %s: %s", id, code, msg);
+}
+
+/* Stores a result (takes r) together with status succeeded. */
+__attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r)
+{
+    char *text = r ? json_dumps(r, JSON_COMPACT) : NULL;
+    json_decref(r);
+    char *prog = progress_text("done", 1.0, 0.0, 0, 0, 0);
+    if (!text || !prog) {
+        finish_failed(ctx->id, "internal", "out of memory while serialising the result");
+    } else {
+        store_rc rc = store_succeed(ctx->id, text, prog);
+        if (rc == STORE_OK)
+            gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%zu bytes)", ctx->id,
+                    gpd_monotonic_s() - ctx->t0, strlen(text));
+        else if (rc == STORE_ERROR)
+            gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result", ctx->id);
+    }
+    free(text);
+    free(prog);
+}
+
+/* A build that did not succeed: cancelled (by DELETE or shutdown) or failed. */
+__attribute__((unused)) static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err,
+                                                  const char *extra)
+{
+    if (st == GP_ERR_CANCELLED || __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED)) {
+        if (__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
+            if (store_requeue(ctx->id) == STORE_OK)
+                gpd_log(GPD_LOG_INFO, "job %s requeued (shutdown)", ctx->id);
+        }
+        /* else: a DELETE already marked it cancelled */
+        return;
+    }
+    char msg[GP_ERROR_MESSAGE_MAX + 128];
+    snprintf(msg, sizeof msg, "%s%s", err->message[0] ? err->message : gp_status_name(st),
+             extra ? extra : "");
+    finish_failed(ctx->id, gp_status_name(st), msg);
+}
+
+static void unavailable(const char *id, const char *kind)
+{
+    char msg[200];
+    snprintf(msg, sizeof msg, "kind %s is not available in this build of grainpackd", kind);
+    finish_failed(id, "not_implemented", msg);
 }
 
 static void run_2d(slot *s, const char *id, json_t *spec_json)
@@ -134,44 +191,56 @@ static void run_2d(slot *s, const char *id, json_t *spec_json)
     gp_specimen2d *out = NULL;
     gp_error err;
     gp_error_clear(&err);
-    gp_status st = gp_specimen2d_build(&spec, on_progress, &ctx, &s->cancel, &out, &err);
+    gp_status st = gp_specimen2d_build(&spec, on_progress2d, &ctx, &s->cancel, &out, &err);
     if (st == GP_OK && out) {
         json_t *r = gpd_result_2d(out, &spec, spec_json);
         gp_specimen2d_destroy(out);
-        char *text = r ? json_dumps(r, JSON_COMPACT) : NULL;
-        json_decref(r);
-        char *prog = progress_text("done", 1.0, 0.0, 0, 0, 0);
-        if (!text || !prog) {
-            finish_failed(id, "internal", "out of memory while serialising the result");
-        } else {
-            store_rc rc = store_succeed(id, text, prog);
-            if (rc == STORE_OK)
-                gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%zu bytes)", id,
-                        gpd_monotonic_s() - ctx.t0, strlen(text));
-            else if (rc == STORE_ERROR)
-                gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result", id);
-        }
-        free(text);
-        free(prog);
+        finish_succeeded(&ctx, r);
     } else {
         if (out) gp_specimen2d_destroy(out);
-        if (st == GP_ERR_CANCELLED || __atomic_load_n(&s->cancel, __ATOMIC_RELAXED)) {
-            if (__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
-                if (store_requeue(id) == STORE_OK)
-                    gpd_log(GPD_LOG_INFO, "job %s requeued (shutdown)", id);
-            }
-            /* else: a DELETE already marked it cancelled */
-        } else {
-            finish_failed(id, gp_status_name(st), err.message[0] ? err.message : "failed");
-        }
+        finish_not_ok(&ctx, st, &err, NULL);
     }
     gp_spec_2d_free(&spec);
 #else
     (void)s;
     (void)spec_json;
-    finish_failed(id, "not_implemented",
-                  "this build of grainpackd has no 2D pipeline (core/gp_specimen2d.c or the "
-                  "schema parser is missing)");
+    unavailable(id, "fourier-voronoi-2d");
+#endif
+}
+
+static void run_3d(slot *s, const char *id, json_t *spec_json)
+{
+#if defined(GPD_HAVE_SCHEMA) && defined(GPD_HAVE_SPECIMEN3D)
+    gp_spec3d spec;
+    gp_spec_problem prob;
+    memset(&prob, 0, sizeof prob);
+    if (gp_spec_parse_3d(spec_json, &spec, &prob) != 0) {
+        gp_spec_3d_free(&spec);
+        finish_failed(id, "invalid_spec", prob.message);
+        return;
+    }
+    spec.threads = 1;
+    run_ctx ctx = {.s = s, .id = id, .t0 = gpd_monotonic_s(), .last_write = 0};
+    gp_specimen3d *out = NULL;
+    gp_error err;
+    gp_error_clear(&err);
+    gp_status st = gp_specimen3d_build(&spec, on_progress3d, &ctx, &s->cancel, &out, &err);
+    if (st == GP_OK && out) {
+        json_t *r = gpd_result_3d(out, &spec, spec_json);
+        gp_specimen3d_destroy(out);
+        finish_succeeded(&ctx, r);
+    } else {
+        char extra[96] = "";
+        if (out && out->stats.stop_reason)
+            snprintf(extra, sizeof extra, " (stop reason: %s)", out->stats.stop_reason);
+        if (out) gp_specimen3d_destroy(out);
+        finish_not_ok(&ctx, st, &err, extra);
+    }
+    gp_spec_3d_free(&spec);
+#else
+    (void)s;
+    (void)spec_json;
+    unavailable(id, "spheres-3d");
 #endif
 }
 
@@ -185,8 +254,10 @@ static void run_job(slot *s, const char *id, const char *kind, const char *spec_
     }
     if (!strcmp(kind, "fourier-voronoi-2d"))
         run_2d(s, id, spec);
+    else if (!strcmp(kind, "spheres-3d"))
+        run_3d(s, id, spec);
     else
-        finish_failed(id, "not_implemented", "this kind is not available in this build");
+        unavailable(id, kind);
     json_decref(spec);
 }
 
