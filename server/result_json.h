@@ -40,7 +40,8 @@
  *  "spheres": [[x, y, z, r], ...] (output spheres),
  *  "contacts": [{"i", "j", "normal": [3], "overlap", "force": [3]}] (output contacts; j < 0 is
  *              wall -1-j, walls 0..5 = x-, x+, y-, y+, z-, z+)}
- * Histogram "target" is null where there is no target. Non-finite numbers are written as null.
+ * Histogram "target" is null where there is no target. Non-finite numbers are written as null;
+ * reals are printed with 15 significant digits.
  * The field names follow server/svg.h.
  */
 #ifndef GPD_RESULT_JSON_H

@@ -133,7 +133,7 @@ static void finish_failed(const char *id, const char *code, const char *msg)
 /* Stores a result (takes r) together with status succeeded. */
 __attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r)
 {
-    char *text = r ? json_dumps(r, JSON_COMPACT) : NULL;
+    char *text = r ? json_dumps(r, JSON_COMPACT | JSON_REAL_PRECISION(15)) : NULL;
     json_decref(r);
     char *prog = progress_text("done", 1.0, 0.0, 0, 0, 0);
     if (!text || !prog) {
