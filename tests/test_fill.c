@@ -1,0 +1,164 @@
+/* test_fill.c -- optimised cell filling (Mollon & Zhao 2012, Sect. 4.1, Eq. 19) against
+ * analytic truths: the largest Np-gon of a circle grain inside a square and a hexagon,
+ * exact hits of reachable targets, orientation following the cell, containment in a
+ * non-convex cell, scale invariance, determinism and bad input. */
+#include "gp_fill.h"
+#include "gp_geom.h"
+#include "gp_test.h"
+
+#include <string.h>
+
+#define NP 128
+
+static double D[NP / 2];
+
+static gp_fill_workspace *make(double fs, double d2, double d3, double d8, int centre)
+{
+    memset(D, 0, sizeof D);
+    D[0] = 1.0;
+    D[2] = d2;
+    D[3] = d3;
+    for (int n = 4; n < 8; n++) D[n] = d3 * pow(n / 3.0, -2.0);
+    D[8] = d8;
+    for (int n = 9; n < NP / 2; n++) D[n] = d8 * pow(n / 8.0, -2.0);
+    gp_fill_params p;
+    gp_fill_params_defaults(&p);
+    p.solid_fraction = fs;
+    p.D = D;
+    p.nmodes = NP / 2;
+    p.contour_points = NP;
+    p.optimise_centre = centre;
+    gp_error e;
+    gp_fill_workspace *ws = gp_fill_workspace_create(&p, &e);
+    if (!ws) fprintf(stderr, "create: %s\n", e.message);
+    return ws;
+}
+
+static void phases_fixed(double *ph)
+{
+    /* deterministic "random" phases for the modes that are not optimised */
+    for (int n = 0; n < NP / 2; n++) ph[n] = fmod(n * 2.39996322972865332, 2 * M_PI) - M_PI;
+}
+
+static double np_gon_area(double r) { return 0.5 * NP * r * r * sin(2 * M_PI / NP); }
+
+static void rect(gp_vec2 *p, double w, double h, double ang, double cx, double cy)
+{
+    double c = cos(ang), s = sin(ang);
+    double xs[4] = {-w / 2, w / 2, w / 2, -w / 2}, ys[4] = {-h / 2, -h / 2, h / 2, h / 2};
+    for (int k = 0; k < 4; k++) {
+        p[k].x = cx + c * xs[k] - s * ys[k];
+        p[k].y = cy + s * xs[k] + c * ys[k];
+    }
+}
+
+int main(void)
+{
+    double ph[NP / 2];
+    phases_fixed(ph);
+    gp_vec2 contour[NP];
+    gp_fill_result r;
+    gp_error e;
+
+    /* 1. circle grain, unit square, reachable target: hit exactly */
+    gp_vec2 sq[4];
+    rect(sq, 1, 1, 0, 0.5, 0.5);
+    gp_fill_workspace *ws = make(0.65, 0, 0, 0, 1);
+    CHECK(ws != NULL);
+    CHECK(gp_fill_cell(ws, sq, 4, ph, contour, &r, &e) == GP_OK);
+    CHECK_NEAR(r.fraction, 0.65, 1e-12);
+    CHECK(r.target_met);
+    CHECK_NEAR(r.centre.x, 0.5, 1e-12);
+    CHECK_NEAR(r.centre.y, 0.5, 1e-12);
+    CHECK(gp_poly_inside_poly(contour, NP, sq, 4));
+    CHECK(gp_poly_signed_area(contour, NP) > 0); /* counter-clockwise */
+    gp_fill_workspace_destroy(ws);
+
+    /* 2. circle grain, unreachable target 0.9: the largest is the Np-gon of radius 1/2 */
+    ws = make(0.9, 0, 0, 0, 1);
+    CHECK(gp_fill_cell(ws, sq, 4, ph, contour, &r, &e) == GP_OK);
+    CHECK(!r.target_met);
+    CHECK_NEAR(r.fraction, np_gon_area(0.5), 1e-8);
+    CHECK_NEAR(r.max_fraction, np_gon_area(0.5), 1e-8);
+    CHECK(gp_poly_inside_poly(contour, NP, sq, 4));
+    gp_fill_workspace_destroy(ws);
+
+    /* 3. regular hexagon of side 1: largest circle grain has the apothem as radius */
+    gp_vec2 hex[6];
+    for (int k = 0; k < 6; k++) {
+        hex[k].x = cos(M_PI / 6 + k * M_PI / 3);
+        hex[k].y = sin(M_PI / 6 + k * M_PI / 3);
+    }
+    ws = make(0.99, 0, 0, 0, 1);
+    CHECK(gp_fill_cell(ws, hex, 6, ph, contour, &r, &e) == GP_OK);
+    CHECK_NEAR(r.fraction, np_gon_area(sqrt(3) / 2) / (1.5 * sqrt(3)), 1e-8);
+    gp_fill_workspace_destroy(ws);
+
+    /* 4. elongated grain in a rotated 3:1 rectangle: it takes the cell's orientation and
+     * fills it better than a round grain could (a disc reaches pi/12 = 0.26 here) */
+    for (int deg = -60; deg <= 90; deg += 30) {
+        gp_vec2 rc[4];
+        double a = deg * M_PI / 180;
+        rect(rc, 3, 1, a, 10, -5);
+        ws = make(0.6, 0.2, 0.02, 0, 1);
+        CHECK(gp_fill_cell(ws, rc, 4, ph, contour, &r, &e) == GP_OK);
+        double w, ang, len;
+        CHECK(gp_min_caliper(contour, NP, &w, &ang, &len, NULL) == GP_OK);
+        double gap = fmod(fabs(ang - a), M_PI);
+        if (gap > M_PI / 2) gap = M_PI - gap;
+        CHECK(gap < 5 * M_PI / 180);
+        CHECK(r.fraction > 0.40);
+        CHECK(gp_poly_inside_poly(contour, NP, rc, 4));
+        gp_fill_workspace_destroy(ws);
+    }
+
+    /* 5. non-convex L-shaped cell: exact containment holds, a fraction is reported */
+    gp_vec2 L[6] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+    ws = make(0.65, 0.1, 0.05, 0.02, 1);
+    CHECK(gp_fill_cell(ws, L, 6, ph, contour, &r, &e) == GP_OK);
+    CHECK(gp_poly_inside_poly(contour, NP, L, 6));
+    CHECK(gp_poly_is_simple(contour, NP));
+    CHECK(r.fraction > 0.2 && r.fraction <= 0.65 + 1e-12);
+    gp_fill_workspace_destroy(ws);
+
+    /* 6. scale invariance: a cell at 1e-6 and one offset by 1e6 fill like the unit cell */
+    gp_vec2 tri[3] = {{0, 0}, {1, 0.2}, {0.3, 0.9}}, small[3], big[3];
+    for (int k = 0; k < 3; k++) {
+        small[k].x = tri[k].x * 1e-6;
+        small[k].y = tri[k].y * 1e-6;
+        big[k].x = tri[k].x + 1e6;
+        big[k].y = tri[k].y - 1e6;
+    }
+    ws = make(0.7, 0.1, 0.05, 0.0, 1);
+    gp_fill_result r1, r2, r3;
+    CHECK(gp_fill_cell(ws, tri, 3, ph, contour, &r1, &e) == GP_OK);
+    CHECK(gp_fill_cell(ws, small, 3, ph, contour, &r2, &e) == GP_OK);
+    CHECK(gp_poly_inside_poly(contour, NP, small, 3));
+    CHECK(gp_fill_cell(ws, big, 3, ph, contour, &r3, &e) == GP_OK);
+    CHECK(gp_poly_inside_poly(contour, NP, big, 3));
+    CHECK_NEAR(r2.fraction, r1.fraction, 1e-6);
+    CHECK_NEAR(r3.fraction, r1.fraction, 1e-6);
+
+    /* 7. determinism: the same cell twice gives the same bytes */
+    gp_vec2 c2[NP];
+    CHECK(gp_fill_cell(ws, tri, 3, ph, contour, &r1, &e) == GP_OK);
+    CHECK(gp_fill_cell(ws, tri, 3, ph, c2, &r2, &e) == GP_OK);
+    CHECK(memcmp(contour, c2, sizeof c2) == 0);
+    gp_fill_workspace_destroy(ws);
+
+    /* 8. bad input: errors, no crash */
+    ws = make(0.65, 0.1, 0.05, 0.02, 1);
+    gp_vec2 line[3] = {{0, 0}, {1, 1}, {2, 2}};
+    CHECK(gp_fill_cell(ws, line, 3, ph, contour, &r, &e) == GP_ERR_DEGENERATE);
+    CHECK(gp_fill_cell(ws, sq, 2, ph, contour, &r, &e) == GP_ERR_INVALID);
+    gp_fill_workspace_destroy(ws);
+    CHECK(make(1.5, 0, 0, 0, 1) == NULL);
+    CHECK(make(NAN, 0, 0, 0, 1) == NULL);
+    CHECK(make(0.5, -0.1, 0, 0, 1) == NULL);
+    /* a spectrum that is never star-shaped is reported, not returned as a broken grain */
+    ws = make(0.5, 0.9, 0.9, 0.0, 1);
+    CHECK(gp_fill_cell(ws, sq, 4, ph, contour, &r, &e) == GP_ERR_NOT_STAR);
+    gp_fill_workspace_destroy(ws);
+
+    return gp_test_summary();
+}
