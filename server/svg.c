@@ -1,0 +1,1201 @@
+/* svg.c -- SVG pictures of a result. See svg.h for the views and the result fields read.
+ *
+ * Conventions: pixel coordinates printed with one or two decimals (bounded output), y axis of
+ * data flipped so that up is up, legends and colour bars drawn with <rect>/<line>/<path> only so
+ * that the <polygon> / <circle> elements of a picture are exactly its grains, cells, seeds or
+ * sphere sections. Contours are decimated to about half a pixel (a 10,000-grain packing stays a
+ * few MB). */
+#include "svg.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define KIND_2D "fourier-voronoi-2d"
+#define KIND_3D "spheres-3d"
+#define VIEWS_2D "packing, cells, size, orientation, descriptors"
+#define VIEWS_3D "section, psd"
+
+/* ------------------------------------------------------------------------------------------ */
+/* string builder */
+
+typedef struct sb {
+    char *buf;
+    size_t len, cap;
+    int oom;
+} sb;
+
+static void sb_grow(sb *s, size_t need)
+{
+    if (s->oom || s->len + need + 1 <= s->cap) return;
+    size_t cap = s->cap ? s->cap : 4096;
+    while (cap < s->len + need + 1) cap *= 2;
+    char *b = realloc(s->buf, cap);
+    if (!b) {
+        s->oom = 1;
+        return;
+    }
+    s->buf = b;
+    s->cap = cap;
+}
+
+static void sb_printf(sb *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static void sb_printf(sb *s, const char *fmt, ...)
+{
+    if (s->oom) return;
+    va_list ap;
+    va_start(ap, fmt);
+    char tmp[512];
+    int n = vsnprintf(tmp, sizeof tmp, fmt, ap);
+    va_end(ap);
+    if (n < 0) return;
+    if ((size_t)n < sizeof tmp) {
+        sb_grow(s, (size_t)n);
+        if (s->oom) return;
+        memcpy(s->buf + s->len, tmp, (size_t)n + 1);
+        s->len += (size_t)n;
+        return;
+    }
+    sb_grow(s, (size_t)n);
+    if (s->oom) return;
+    va_start(ap, fmt);
+    vsnprintf(s->buf + s->len, (size_t)n + 1, fmt, ap);
+    va_end(ap);
+    s->len += (size_t)n;
+}
+
+static void sb_puts(sb *s, const char *str)
+{
+    size_t n = strlen(str);
+    sb_grow(s, n);
+    if (s->oom) return;
+    memcpy(s->buf + s->len, str, n + 1);
+    s->len += n;
+}
+
+/* text content with XML escaping */
+static void sb_text(sb *s, const char *str)
+{
+    for (; *str; str++) {
+        switch (*str) {
+        case '<': sb_puts(s, "&lt;"); break;
+        case '>': sb_puts(s, "&gt;"); break;
+        case '&': sb_puts(s, "&amp;"); break;
+        case '"': sb_puts(s, "&quot;"); break;
+        default: {
+            char c[2] = {*str, 0};
+            sb_puts(s, c);
+        }
+        }
+    }
+}
+
+static void text_at(sb *s, double x, double y, const char *anchor, const char *extra,
+                    const char *str)
+{
+    sb_printf(s, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"%s\"%s%s>", x, y, anchor,
+              extra && *extra ? " " : "", extra ? extra : "");
+    sb_text(s, str);
+    sb_puts(s, "</text>\n");
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* small helpers */
+
+static void seterr(char *errbuf, size_t errlen, int *status, int code, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+
+static void seterr(char *errbuf, size_t errlen, int *status, int code, const char *fmt, ...)
+{
+    if (status) *status = code;
+    if (!errbuf || !errlen) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(errbuf, errlen, fmt, ap);
+    va_end(ap);
+}
+
+static double jnum(const json_t *v, double dflt)
+{
+    return json_is_number(v) ? json_number_value(v) : dflt;
+}
+
+/* reads a numeric array (NULL-safe); returns a malloc'ed copy and its length, NULL if absent */
+static double *jarray(const json_t *a, size_t *n)
+{
+    *n = 0;
+    if (!json_is_array(a) || json_array_size(a) == 0) return NULL;
+    size_t m = json_array_size(a);
+    double *v = malloc(m * sizeof *v);
+    if (!v) return NULL;
+    for (size_t i = 0; i < m; i++) v[i] = jnum(json_array_get(a, i), NAN);
+    *n = m;
+    return v;
+}
+
+static void fmt_label(char *buf, size_t n, double v)
+{
+    if (fabs(v) < 1e-12) v = 0;
+    snprintf(buf, n, "%.4g", v);
+}
+
+/* viridis-like colour ramp, t in [0, 1] */
+static void ramp(double t, char *buf, size_t n)
+{
+    static const double st[6][3] = {{68, 1, 84},    {65, 68, 135},  {42, 120, 142},
+                                    {34, 168, 132}, {122, 209, 81}, {253, 231, 37}};
+    if (!(t >= 0)) t = 0;
+    if (t > 1) t = 1;
+    double u = t * 5;
+    int k = (int)u;
+    if (k > 4) k = 4;
+    double f = u - k;
+    int rgb[3];
+    for (int c = 0; c < 3; c++) rgb[c] = (int)lround(st[k][c] + f * (st[k + 1][c] - st[k][c]));
+    snprintf(buf, n, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
+}
+
+/* cyclic colour for an axial orientation in degrees (period 180) */
+static void cyclic(double deg, char *buf, size_t n)
+{
+    double h = fmod(deg + 90.0, 180.0);
+    if (h < 0) h += 180;
+    h *= 2; /* hue 0..360 */
+    double c = 0.75, x = c * (1 - fabs(fmod(h / 60.0, 2) - 1)), m = 0.15;
+    double r = 0, g = 0, b = 0;
+    if (h < 60) { r = c; g = x; }
+    else if (h < 120) { r = x; g = c; }
+    else if (h < 180) { g = c; b = x; }
+    else if (h < 240) { g = x; b = c; }
+    else if (h < 300) { r = x; b = c; }
+    else { r = c; b = x; }
+    snprintf(buf, n, "#%02x%02x%02x", (int)lround((r + m) * 255), (int)lround((g + m) * 255),
+             (int)lround((b + m) * 255));
+}
+
+/* "nice" tick step for about n ticks over [lo, hi] */
+static double nice_step(double lo, double hi, int n)
+{
+    double span = hi - lo;
+    if (!(span > 0)) return 1;
+    double raw = span / n, p = pow(10, floor(log10(raw))), f = raw / p;
+    double nf = f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10;
+    return nf * p;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* plot frames */
+
+typedef struct frame {
+    double x0, y0, w, h;            /* pixels: left, top, width, height */
+    double xmin, xmax, ymin, ymax;  /* data */
+    int xlog;
+} frame;
+
+static double fx(const frame *f, double x)
+{
+    if (f->xlog) return f->x0 + (log10(x) - log10(f->xmin)) / (log10(f->xmax) - log10(f->xmin)) * f->w;
+    return f->x0 + (x - f->xmin) / (f->xmax - f->xmin) * f->w;
+}
+
+static double fy(const frame *f, double y)
+{
+    return f->y0 + f->h - (y - f->ymin) / (f->ymax - f->ymin) * f->h;
+}
+
+static void doc_begin(sb *s, int w, int h, const char *title)
+{
+    sb_puts(s, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    sb_printf(s,
+              "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"%d\" height=\"%d\" "
+              "viewBox=\"0 0 %d %d\" font-family=\"Helvetica, Arial, sans-serif\" font-size=\"12\">\n",
+              w, h, w, h);
+    sb_puts(s, "<title>");
+    sb_text(s, title);
+    sb_puts(s, "</title>\n");
+    sb_printf(s, "<rect x=\"0\" y=\"0\" width=\"%d\" height=\"%d\" fill=\"#ffffff\"/>\n", w, h);
+    text_at(s, w / 2.0, 22, "middle", "font-size=\"15\" font-weight=\"bold\"", title);
+}
+
+static void doc_end(sb *s) { sb_puts(s, "</svg>\n"); }
+
+/* axes with ticks and labels; grid lines when grid */
+static void axes(sb *s, const frame *f, const char *xlabel, const char *ylabel, int grid)
+{
+    sb_puts(s, "<g class=\"axes\" stroke=\"#000000\" stroke-width=\"1\">\n");
+    sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0, f->y0 + f->h,
+              f->x0 + f->w, f->y0 + f->h);
+    sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0, f->y0, f->x0,
+              f->y0 + f->h);
+    sb_puts(s, "</g>\n<g class=\"ticks\" stroke=\"#000000\">\n");
+    char lab[64];
+    /* x ticks */
+    if (f->xlog) {
+        int d0 = (int)floor(log10(f->xmin) + 1e-9), d1 = (int)ceil(log10(f->xmax) - 1e-9);
+        for (int d = d0; d <= d1; d++)
+            for (int m = 1; m <= 9; m++) {
+                double v = m * pow(10, d);
+                if (v < f->xmin * (1 - 1e-9) || v > f->xmax * (1 + 1e-9)) continue;
+                double x = fx(f, v);
+                int major = m == 1, labelled = m == 1 || m == 2 || m == 5;
+                if (grid && major)
+                    sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n",
+                              x, f->y0, x, f->y0 + f->h);
+                sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", x,
+                          f->y0 + f->h, x, f->y0 + f->h + (major ? 6 : 3));
+                if (labelled) {
+                    fmt_label(lab, sizeof lab, v);
+                    text_at(s, x, f->y0 + f->h + 19, "middle", "stroke=\"none\"", lab);
+                }
+            }
+    } else {
+        double st = nice_step(f->xmin, f->xmax, 6);
+        for (double v = ceil(f->xmin / st - 1e-9) * st; v <= f->xmax + st * 1e-9; v += st) {
+            double x = fx(f, v);
+            if (grid)
+                sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n",
+                          x, f->y0, x, f->y0 + f->h);
+            sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", x,
+                      f->y0 + f->h, x, f->y0 + f->h + 6);
+            fmt_label(lab, sizeof lab, v);
+            text_at(s, x, f->y0 + f->h + 19, "middle", "stroke=\"none\"", lab);
+        }
+    }
+    /* y ticks */
+    double st = nice_step(f->ymin, f->ymax, 5);
+    for (double v = ceil(f->ymin / st - 1e-9) * st; v <= f->ymax + st * 1e-9; v += st) {
+        double y = fy(f, v);
+        if (grid)
+            sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n",
+                      f->x0, y, f->x0 + f->w, y);
+        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0 - 6, y,
+                  f->x0, y);
+        fmt_label(lab, sizeof lab, v);
+        text_at(s, f->x0 - 9, y + 4, "end", "stroke=\"none\"", lab);
+    }
+    sb_puts(s, "</g>\n");
+    text_at(s, f->x0 + f->w / 2, f->y0 + f->h + 38, "middle", NULL, xlabel);
+    sb_printf(s, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" transform=\"rotate(-90 %.1f %.1f)\">",
+              f->x0 - 52, f->y0 + f->h / 2, f->x0 - 52, f->y0 + f->h / 2);
+    sb_text(s, ylabel);
+    sb_puts(s, "</text>\n");
+}
+
+typedef struct legend_item {
+    const char *label;
+    const char *style; /* "bar", "line", "dash", "marker" */
+    const char *color;
+} legend_item;
+
+static void legend(sb *s, double x, double y, const legend_item *it, int n)
+{
+    double w = 0;
+    for (int i = 0; i < n; i++) w = fmax(w, 7.0 * strlen(it[i].label));
+    sb_printf(s, "<g class=\"legend\">\n<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" "
+                 "fill=\"#ffffff\" fill-opacity=\"0.85\" stroke=\"#999999\"/>\n",
+              x, y, w + 46, 8 + 18 * n);
+    for (int i = 0; i < n; i++) {
+        double yy = y + 16 + 18 * i;
+        if (!strcmp(it[i].style, "bar"))
+            sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"22\" height=\"10\" fill=\"%s\" "
+                         "fill-opacity=\"0.7\" stroke=\"%s\"/>\n",
+                      x + 8, yy - 9, it[i].color, it[i].color);
+        else
+            sb_printf(s, "<path d=\"M%.1f %.1fh22\" stroke=\"%s\" stroke-width=\"2\"%s/>\n", x + 8,
+                      yy - 4, it[i].color,
+                      !strcmp(it[i].style, "dash") ? " stroke-dasharray=\"5 3\"" : "");
+        if (!strcmp(it[i].style, "marker"))
+            sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"6\" height=\"6\" fill=\"%s\"/>\n",
+                      x + 16, yy - 7, it[i].color);
+        text_at(s, x + 38, yy, "start", NULL, it[i].label);
+    }
+    sb_puts(s, "</g>\n");
+}
+
+/* a marker as a small square path (not a <circle>, see the conventions above) */
+static void marker(sb *s, double x, double y, const char *color)
+{
+    sb_printf(s, "<path d=\"M%.1f %.1fh6v6h-6z\" fill=\"%s\"/>\n", x - 3, y - 3, color);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* 2D geometry */
+
+typedef struct bounds {
+    double xmin, xmax, ymin, ymax;
+} bounds;
+
+static void bounds_init(bounds *b)
+{
+    b->xmin = b->ymin = INFINITY;
+    b->xmax = b->ymax = -INFINITY;
+}
+
+static void bounds_add(bounds *b, double x, double y)
+{
+    if (!isfinite(x) || !isfinite(y)) return;
+    b->xmin = fmin(b->xmin, x);
+    b->xmax = fmax(b->xmax, x);
+    b->ymin = fmin(b->ymin, y);
+    b->ymax = fmax(b->ymax, y);
+}
+
+static void bounds_ring(bounds *b, const json_t *ring)
+{
+    size_t i;
+    const json_t *p;
+    json_array_foreach(ring, i, p) {
+        bounds_add(b, jnum(json_array_get(p, 0), NAN), jnum(json_array_get(p, 1), NAN));
+    }
+}
+
+static int bounds_ok(const bounds *b) { return b->xmax >= b->xmin && b->ymax >= b->ymin; }
+
+/* a map frame with equal scales on both axes, fitting width px */
+static frame map_frame(bounds b, int width, int *height)
+{
+    double dx = b.xmax - b.xmin, dy = b.ymax - b.ymin;
+    double d = fmax(dx, dy);
+    if (!(d > 0)) d = 1;
+    if (!(dx > 0)) { b.xmin -= d / 2; b.xmax += d / 2; dx = d; }
+    if (!(dy > 0)) { b.ymin -= d / 2; b.ymax += d / 2; dy = d; }
+    frame f;
+    f.x0 = 80;
+    f.y0 = 40;
+    f.w = width - 80 - 110; /* room for the colour bar on the right */
+    f.h = f.w * dy / dx;
+    if (f.h > 2.0 * width) {
+        f.h = 2.0 * width;
+        f.w = f.h * dx / dy;
+    }
+    if (f.h < 120) f.h = 120, f.w = fmin(width - 190.0, f.h * dx / dy);
+    f.xmin = b.xmin;
+    f.xmax = b.xmin + dx * 1.0;
+    f.ymin = b.ymin;
+    f.ymax = b.ymax;
+    /* keep the scales equal: widen the data range to the pixel aspect */
+    double sx = f.w / dx, sy = f.h / dy, sc = fmin(sx, sy);
+    double cx = (b.xmin + b.xmax) / 2, cy = (b.ymin + b.ymax) / 2;
+    f.xmin = cx - f.w / sc / 2;
+    f.xmax = cx + f.w / sc / 2;
+    f.ymin = cy - f.h / sc / 2;
+    f.ymax = cy + f.h / sc / 2;
+    f.xlog = 0;
+    *height = (int)ceil(f.y0 + f.h + 60);
+    return f;
+}
+
+/* "x,y x,y ..." of a ring, decimated to min_px; returns points written */
+static size_t ring_points(sb *s, const frame *f, const json_t *ring, double min_px)
+{
+    size_t n = json_array_size(ring), written = 0;
+    double lx = NAN, ly = NAN;
+    double fx0 = NAN, fy0 = NAN;
+    for (size_t i = 0; i < n; i++) {
+        const json_t *p = json_array_get(ring, i);
+        double x = fx(f, jnum(json_array_get(p, 0), NAN)), y = fy(f, jnum(json_array_get(p, 1), NAN));
+        if (!isfinite(x) || !isfinite(y)) continue;
+        int last = i + 1 == n;
+        if (written && !last && fabs(x - lx) < min_px && fabs(y - ly) < min_px) continue;
+        if (written && last && fabs(x - lx) < min_px && fabs(y - ly) < min_px && written >= 3) continue;
+        sb_printf(s, "%s%.1f,%.1f", written ? " " : "", x, y);
+        if (!written) fx0 = x, fy0 = y;
+        lx = x;
+        ly = y;
+        written++;
+    }
+    (void)fx0;
+    (void)fy0;
+    return written;
+}
+
+/* the container outline (from result.container), as a path */
+static void container_outline(sb *s, const frame *f, const json_t *container)
+{
+    if (!json_is_object(container)) return;
+    const json_t *circle = json_object_get(container, "circle");
+    if (json_is_object(circle)) {
+        const json_t *c = json_object_get(circle, "center");
+        double cx = jnum(json_array_get(c, 0), NAN), cy = jnum(json_array_get(c, 1), NAN);
+        double r = jnum(json_object_get(circle, "radius"), NAN);
+        if (!isfinite(cx) || !isfinite(cy) || !(r > 0)) return;
+        double px = fx(f, cx), py = fy(f, cy), pr = fx(f, cx + r) - px;
+        sb_printf(s, "<path class=\"container\" d=\"M%.1f %.1fa%.1f %.1f 0 1 0 %.1f 0a%.1f %.1f 0 1 0 %.1f 0z\" "
+                     "fill=\"none\" stroke=\"#000000\" stroke-width=\"1.5\"/>\n",
+                  px - pr, py, pr, pr, 2 * pr, pr, pr, -2 * pr);
+        return;
+    }
+    const json_t *poly = json_object_get(container, "polygon");
+    if (!json_is_array(poly)) return;
+    sb_puts(s, "<path class=\"container\" fill=\"none\" stroke=\"#000000\" stroke-width=\"1.5\" d=\"");
+    sb_puts(s, "M");
+    ring_points(s, f, poly, 0);
+    sb_puts(s, "z");
+    size_t i;
+    const json_t *h;
+    json_array_foreach(json_object_get(container, "holes"), i, h) {
+        sb_puts(s, " M");
+        ring_points(s, f, h, 0);
+        sb_puts(s, "z");
+    }
+    sb_puts(s, "\"/>\n");
+}
+
+static void container_bounds(bounds *b, const json_t *container)
+{
+    if (!json_is_object(container)) return;
+    const json_t *circle = json_object_get(container, "circle");
+    if (circle) {
+        const json_t *c = json_object_get(circle, "center");
+        double cx = jnum(json_array_get(c, 0), NAN), cy = jnum(json_array_get(c, 1), NAN);
+        double r = jnum(json_object_get(circle, "radius"), NAN);
+        bounds_add(b, cx - r, cy - r);
+        bounds_add(b, cx + r, cy + r);
+        return;
+    }
+    bounds_ring(b, json_object_get(container, "polygon"));
+}
+
+/* vertical colour bar with a gradient; cyc = orientation colours */
+static void colorbar(sb *s, double x, double y, double h, double lo, double hi, int cyc,
+                     int logscale, const char *label)
+{
+    sb_puts(s, "<defs><linearGradient id=\"cbar\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">\n");
+    for (int k = 0; k <= 10; k++) {
+        char c[16];
+        if (cyc) cyclic(-90 + 18.0 * k, c, sizeof c);
+        else ramp(k / 10.0, c, sizeof c);
+        sb_printf(s, "<stop offset=\"%.1f\" stop-color=\"%s\"/>\n", k / 10.0, c);
+    }
+    sb_puts(s, "</linearGradient></defs>\n");
+    sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"16\" height=\"%.1f\" fill=\"url(#cbar)\" stroke=\"#000000\"/>\n",
+              x, y, h);
+    for (int k = 0; k <= 4; k++) {
+        double t = k / 4.0;
+        double v = logscale ? lo * pow(hi / lo, t) : lo + t * (hi - lo);
+        char lab[64];
+        fmt_label(lab, sizeof lab, v);
+        double yy = y + h - t * h;
+        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#000000\"/>\n",
+                  x + 16, yy, x + 20, yy);
+        text_at(s, x + 23, yy + 4, "start", NULL, lab);
+    }
+    text_at(s, x + 8, y - 8, "middle", NULL, label);
+}
+
+static char *finish(sb *s, size_t *len, int *status, char *errbuf, size_t errlen)
+{
+    if (s->oom) {
+        free(s->buf);
+        seterr(errbuf, errlen, status, 500, "out of memory while drawing");
+        return NULL;
+    }
+    if (len) *len = s->len;
+    if (status) *status = 200;
+    return s->buf;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* 2D views */
+
+static char *view_packing(const json_t *res, const gp_svg_options *opt, int width, size_t *len,
+                          int *status, char *eb, size_t el)
+{
+    const json_t *grains = json_object_get(res, "grains");
+    const char *color = opt && opt->color && *opt->color ? opt->color : "size";
+    int by_orient = !strcmp(color, "orientation");
+    if (!by_orient && strcmp(color, "size") != 0) {
+        seterr(eb, el, status, 400, "unknown color \"%s\"; valid: size, orientation", color);
+        return NULL;
+    }
+    if (!json_is_array(grains)) {
+        seterr(eb, el, status, 409, "view \"packing\" needs the grains: the spec did not ask for output \"grains\"");
+        return NULL;
+    }
+    bounds b;
+    bounds_init(&b);
+    container_bounds(&b, json_object_get(res, "container"));
+    size_t i, ng = json_array_size(grains);
+    const json_t *g;
+    double amin = INFINITY, amax = -INFINITY;
+    json_array_foreach(grains, i, g) {
+        bounds_ring(&b, json_object_get(g, "contour"));
+        double a = jnum(json_object_get(g, "area"), NAN);
+        if (a > 0) amin = fmin(amin, a), amax = fmax(amax, a);
+    }
+    if (!bounds_ok(&b)) b.xmin = b.ymin = 0, b.xmax = b.ymax = 1;
+    if (!(amax >= amin)) amin = amax = 1;
+    int logscale = amax > 10 * amin;
+    int height;
+    frame f = map_frame(b, width, &height);
+    sb s = {0};
+    char title[160];
+    const json_t *stats = json_object_get(res, "stats");
+    double sf = jnum(json_object_get(stats, "solid_fraction"), NAN);
+    if (isfinite(sf))
+        snprintf(title, sizeof title, "Packing: %zu grains, solid fraction %.3f", ng, sf);
+    else
+        snprintf(title, sizeof title, "Packing: %zu grains", ng);
+    doc_begin(&s, width, height, title);
+    axes(&s, &f, "x (m)", "y (m)", 0);
+    double min_px = ng > 2000 ? 0.6 : 0.3;
+    sb_puts(&s, "<g class=\"grains\" stroke=\"#222222\" stroke-width=\"0.4\">\n");
+    json_array_foreach(grains, i, g) {
+        char c[16];
+        if (by_orient) {
+            cyclic(jnum(json_object_get(g, "orientation_deg"), 0), c, sizeof c);
+        } else {
+            double a = jnum(json_object_get(g, "area"), amin), t;
+            if (amax > amin)
+                t = logscale ? log(a / amin) / log(amax / amin) : (a - amin) / (amax - amin);
+            else t = 0.5;
+            ramp(t, c, sizeof c);
+        }
+        sb_printf(&s, "<polygon fill=\"%s\" points=\"", c);
+        ring_points(&s, &f, json_object_get(g, "contour"), min_px);
+        sb_puts(&s, "\"/>\n");
+    }
+    sb_puts(&s, "</g>\n");
+    container_outline(&s, &f, json_object_get(res, "container"));
+    double cbx = f.x0 + f.w + 30, cbh = fmin(f.h - 30, 300);
+    if (by_orient) colorbar(&s, cbx, f.y0 + 24, cbh, -90, 90, 1, 0, "orientation (deg)");
+    else colorbar(&s, cbx, f.y0 + 24, cbh, amin, amax, 0, logscale, "area (m²)");
+    doc_end(&s);
+    return finish(&s, len, status, eb, el);
+}
+
+static char *view_cells(const json_t *res, int width, size_t *len, int *status, char *eb, size_t el)
+{
+    const json_t *cells = json_object_get(res, "cells");
+    if (!json_is_array(cells)) {
+        seterr(eb, el, status, 409, "view \"cells\" needs the cells: the spec did not ask for output \"cells\"");
+        return NULL;
+    }
+    bounds b;
+    bounds_init(&b);
+    container_bounds(&b, json_object_get(res, "container"));
+    size_t i, j, nc = json_array_size(cells);
+    const json_t *c, *poly;
+    double amin = INFINITY, amax = -INFINITY;
+    json_array_foreach(cells, i, c) {
+        json_array_foreach(json_object_get(c, "polygons"), j, poly) bounds_ring(&b, poly);
+        double a = jnum(json_object_get(c, "area"), NAN);
+        if (a > 0) amin = fmin(amin, a), amax = fmax(amax, a);
+    }
+    if (!bounds_ok(&b)) b.xmin = b.ymin = 0, b.xmax = b.ymax = 1;
+    if (!(amax >= amin)) amin = amax = 1;
+    int height;
+    frame f = map_frame(b, width, &height);
+    sb s = {0};
+    char title[160];
+    snprintf(title, sizeof title, "Voronoi cells: %zu cells and their seeds", nc);
+    doc_begin(&s, width, height, title);
+    axes(&s, &f, "x (m)", "y (m)", 0);
+    double min_px = nc > 2000 ? 0.6 : 0.3;
+    sb_puts(&s, "<g class=\"cells\" stroke=\"#333333\" stroke-width=\"0.5\" fill-opacity=\"0.55\">\n");
+    json_array_foreach(cells, i, c) {
+        double a = jnum(json_object_get(c, "area"), amin);
+        char col[16];
+        ramp(amax > amin ? (a - amin) / (amax - amin) : 0.5, col, sizeof col);
+        json_array_foreach(json_object_get(c, "polygons"), j, poly) {
+            sb_printf(&s, "<polygon fill=\"%s\" points=\"", col);
+            ring_points(&s, &f, poly, min_px);
+            sb_puts(&s, "\"/>\n");
+        }
+    }
+    sb_puts(&s, "</g>\n<g class=\"seeds\" fill=\"#d62728\">\n");
+    double r = nc > 2000 ? 0.8 : nc > 200 ? 1.5 : 2.5;
+    json_array_foreach(cells, i, c) {
+        const json_t *sd = json_object_get(c, "seed");
+        double x = jnum(json_array_get(sd, 0), NAN), y = jnum(json_array_get(sd, 1), NAN);
+        if (!isfinite(x) || !isfinite(y)) continue;
+        sb_printf(&s, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"%.1f\"/>\n", fx(&f, x), fy(&f, y), r);
+    }
+    sb_puts(&s, "</g>\n");
+    container_outline(&s, &f, json_object_get(res, "container"));
+    colorbar(&s, f.x0 + f.w + 30, f.y0 + 24, fmin(f.h - 30, 300), amin, amax, 0, 0, "cell area (m²)");
+    doc_end(&s);
+    return finish(&s, len, status, eb, el);
+}
+
+/* a histogram read from JSON or computed from values */
+typedef struct hist {
+    size_t k;
+    double *edges, *target, *achieved, *achieved2;
+    double mean;
+    int has_mean;
+} hist;
+
+static void hist_free(hist *h)
+{
+    free(h->edges);
+    free(h->target);
+    free(h->achieved);
+    free(h->achieved2);
+    memset(h, 0, sizeof *h);
+}
+
+/* reads {"edges", "target", "achieved"|"counts", "mean"}; 0 ok */
+static int hist_read(const json_t *o, hist *h)
+{
+    memset(h, 0, sizeof *h);
+    if (!json_is_object(o)) return -1;
+    size_t ne, nt, na;
+    h->edges = jarray(json_object_get(o, "edges"), &ne);
+    const json_t *a = json_object_get(o, "achieved");
+    if (!a) a = json_object_get(o, "counts");
+    h->achieved = jarray(a, &na);
+    h->target = jarray(json_object_get(o, "target"), &nt);
+    if (!h->edges || !h->achieved || ne != na + 1 || ne < 2) {
+        hist_free(h);
+        return -1;
+    }
+    if (h->target && nt != na) {
+        free(h->target);
+        h->target = NULL;
+    }
+    /* counts -> fractions */
+    if (!json_object_get(o, "achieved")) {
+        double sum = 0;
+        for (size_t i = 0; i < na; i++) sum += h->achieved[i];
+        if (sum > 0) for (size_t i = 0; i < na; i++) h->achieved[i] /= sum;
+    }
+    h->k = na;
+    const json_t *m = json_object_get(o, "mean");
+    if (json_is_number(m)) h->mean = json_number_value(m), h->has_mean = 1;
+    return 0;
+}
+
+/* k equal classes over [lo, hi] of values; fractions */
+static int hist_from_values(const double *v, size_t n, size_t k, double lo, double hi, hist *h)
+{
+    memset(h, 0, sizeof *h);
+    if (!n) return -1;
+    if (!(hi > lo)) { lo -= 0.5; hi += 0.5; }
+    h->edges = malloc((k + 1) * sizeof *h->edges);
+    h->achieved = calloc(k, sizeof *h->achieved);
+    if (!h->edges || !h->achieved) {
+        hist_free(h);
+        return -1;
+    }
+    for (size_t i = 0; i <= k; i++) h->edges[i] = lo + (hi - lo) * i / k;
+    double sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!isfinite(v[i])) continue;
+        long c = (long)floor((v[i] - lo) / (hi - lo) * k);
+        if (c < 0) c = 0;
+        if (c >= (long)k) c = (long)k - 1;
+        h->achieved[c] += 1;
+        sum += v[i];
+    }
+    for (size_t i = 0; i < k; i++) h->achieved[i] /= n;
+    h->k = k;
+    h->mean = sum / n;
+    h->has_mean = 1;
+    return 0;
+}
+
+/* values of a numeric member of each element of arr (key2 for a nested object); NULL if none */
+static double *collect(const json_t *arr, const char *key, const char *key2, size_t *n)
+{
+    *n = 0;
+    size_t m = json_array_size(arr);
+    if (!m) return NULL;
+    double *v = malloc(m * sizeof *v);
+    if (!v) return NULL;
+    size_t i;
+    const json_t *e;
+    json_array_foreach(arr, i, e) {
+        const json_t *x = json_object_get(e, key);
+        if (key2) x = json_object_get(x, key2);
+        if (json_is_number(x)) v[(*n)++] = json_number_value(x);
+    }
+    if (!*n) {
+        free(v);
+        return NULL;
+    }
+    return v;
+}
+
+static void minmax(const double *v, size_t n, double *lo, double *hi)
+{
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (size_t i = 0; i < n; i++)
+        if (isfinite(v[i])) *lo = fmin(*lo, v[i]), *hi = fmax(*hi, v[i]);
+}
+
+/* bars of h->achieved (and h->achieved2 as outlines) and h->target as a line with markers */
+static void draw_hist(sb *s, const frame *f, const hist *h, const char *bar_color)
+{
+    sb_printf(s, "<g class=\"bars\" fill=\"%s\" fill-opacity=\"0.7\" stroke=\"%s\">\n", bar_color, bar_color);
+    for (size_t i = 0; i < h->k; i++) {
+        double x0 = fx(f, h->edges[i]), x1 = fx(f, h->edges[i + 1]);
+        double y = fy(f, fmax(f->ymin, fmin(f->ymax, h->achieved[i]))), y0 = fy(f, f->ymin);
+        if (!isfinite(y)) continue;
+        sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n", x0 + 0.5, y,
+                  fmax(0, x1 - x0 - 1), fmax(0, y0 - y));
+    }
+    sb_puts(s, "</g>\n");
+    if (h->achieved2) {
+        sb_puts(s, "<path class=\"achieved2\" fill=\"none\" stroke=\"#ff7f0e\" stroke-width=\"2\" d=\"");
+        for (size_t i = 0; i < h->k; i++) {
+            double x0 = fx(f, h->edges[i]), x1 = fx(f, h->edges[i + 1]);
+            double y = fy(f, fmax(f->ymin, fmin(f->ymax, h->achieved2[i])));
+            sb_printf(s, "%s%.1f %.1fH%.1f", i ? "L" : "M", x0, y, x1);
+        }
+        sb_puts(s, "\"/>\n");
+    }
+    if (h->target) {
+        sb_puts(s, "<path class=\"target\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\" d=\"");
+        for (size_t i = 0; i < h->k; i++) {
+            double xc = fx(f, 0.5 * (h->edges[i] + h->edges[i + 1]));
+            sb_printf(s, "%s%.1f %.1f", i ? "L" : "M", xc, fy(f, fmin(f->ymax, h->target[i])));
+        }
+        sb_puts(s, "\"/>\n");
+        for (size_t i = 0; i < h->k; i++)
+            marker(s, fx(f, 0.5 * (h->edges[i] + h->edges[i + 1])), fy(f, fmin(f->ymax, h->target[i])),
+                   "#d62728");
+    }
+}
+
+static double hist_ymax(const hist *h)
+{
+    double m = 0;
+    for (size_t i = 0; i < h->k; i++) {
+        m = fmax(m, h->achieved[i]);
+        if (h->target) m = fmax(m, h->target[i]);
+        if (h->achieved2) m = fmax(m, h->achieved2[i]);
+    }
+    return m > 0 ? m * 1.1 : 1;
+}
+
+static frame hist_frame(double x0, double y0, double w, double h, const hist *hs)
+{
+    frame f = {x0, y0, w, h, hs->edges[0], hs->edges[hs->k], 0, hist_ymax(hs), 0};
+    if (!(f.xmax > f.xmin)) f.xmax = f.xmin + 1;
+    return f;
+}
+
+static char *view_size(const json_t *res, int width, size_t *len, int *status, char *eb, size_t el)
+{
+    const json_t *stats = json_object_get(res, "stats");
+    hist h;
+    const char *what = "cell area (m²)";
+    int have = hist_read(json_object_get(stats, "size_histogram"), &h) == 0;
+    if (have) {
+        hist g;
+        if (hist_read(json_object_get(stats, "grain_size_histogram"), &g) == 0) {
+            if (g.k == h.k) {
+                h.achieved2 = g.achieved;
+                g.achieved = NULL;
+            }
+            hist_free(&g);
+        }
+    } else {
+        size_t n;
+        double *v = collect(json_object_get(res, "cells"), "area", NULL, &n);
+        if (!v) {
+            v = collect(json_object_get(res, "grains"), "area", NULL, &n);
+            what = "grain area (m²)";
+        }
+        if (!v) {
+            seterr(eb, el, status, 409, "view \"size\" needs stats.size_histogram, cells or grains in the result");
+            return NULL;
+        }
+        double lo, hi;
+        minmax(v, n, &lo, &hi);
+        int ok = hist_from_values(v, n, n < 50 ? 8 : 20, lo, hi, &h) == 0;
+        free(v);
+        if (!ok) {
+            seterr(eb, el, status, 500, "out of memory");
+            return NULL;
+        }
+    }
+    int height = (int)lround(width * 0.62);
+    frame f = hist_frame(80, 40, width - 110, height - 110, &h);
+    sb s = {0};
+    doc_begin(&s, width, height, "Size distribution: target vs achieved");
+    axes(&s, &f, what, "fraction of cells", 1);
+    draw_hist(&s, &f, &h, "#1f77b4");
+    legend_item it[3];
+    int n = 0;
+    it[n++] = (legend_item){have ? "achieved (cells)" : "achieved", "bar", "#1f77b4"};
+    if (h.achieved2) it[n++] = (legend_item){"achieved (grains)", "line", "#ff7f0e"};
+    if (h.target) it[n++] = (legend_item){"target (lognormal)", "marker", "#d62728"};
+    legend(&s, f.x0 + f.w - 190, f.y0 + 8, it, n);
+    doc_end(&s);
+    hist_free(&h);
+    return finish(&s, len, status, eb, el);
+}
+
+static char *view_orientation(const json_t *res, int width, size_t *len, int *status, char *eb,
+                              size_t el)
+{
+    hist h;
+    int have = hist_read(json_object_get(json_object_get(res, "stats"), "orientation_histogram"), &h) == 0;
+    if (!have) {
+        size_t n;
+        double *v = collect(json_object_get(res, "grains"), "orientation_deg", NULL, &n);
+        if (!v) v = collect(json_object_get(res, "cells"), "orientation_deg", NULL, &n);
+        if (!v) {
+            seterr(eb, el, status, 409, "view \"orientation\" needs stats.orientation_histogram, grains or cells in the result");
+            return NULL;
+        }
+        int ok = hist_from_values(v, n, 18, -90, 90, &h) == 0;
+        free(v);
+        if (!ok) {
+            seterr(eb, el, status, 500, "out of memory");
+            return NULL;
+        }
+    }
+    int height = (int)lround(width * 0.75);
+    double cx = width / 2.0, cy = 40 + (height - 80) / 2.0, R = fmin(width / 2.0 - 60, (height - 100) / 2.0);
+    double m = 0;
+    for (size_t i = 0; i < h.k; i++) {
+        m = fmax(m, h.achieved[i]);
+        if (h.target) m = fmax(m, h.target[i]);
+    }
+    if (!(m > 0)) m = 1;
+    double st = nice_step(0, m, 4), rmax = ceil(m / st - 1e-9) * st;
+    sb s = {0};
+    doc_begin(&s, width, height, "Orientation rose: target vs achieved (axial, degrees)");
+    /* grid: rings and spokes */
+    sb_puts(&s, "<g class=\"grid\" fill=\"none\" stroke=\"#cccccc\">\n");
+    char lab[64];
+    for (double r = st; r <= rmax + st * 1e-9; r += st) {
+        double pr = R * r / rmax;
+        sb_printf(&s, "<path d=\"M%.1f %.1fa%.1f %.1f 0 1 0 %.1f 0a%.1f %.1f 0 1 0 %.1f 0z\"/>\n",
+                  cx - pr, cy, pr, pr, 2 * pr, pr, pr, -2 * pr);
+    }
+    for (int a = 0; a < 360; a += 30) {
+        double t = a * M_PI / 180;
+        sb_printf(&s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", cx, cy,
+                  cx + R * cos(t), cy - R * sin(t));
+    }
+    sb_puts(&s, "</g>\n");
+    for (double r = st; r <= rmax + st * 1e-9; r += st) {
+        fmt_label(lab, sizeof lab, r);
+        text_at(&s, cx + R * r / rmax * cos(M_PI / 12) + 2, cy - R * r / rmax * sin(M_PI / 12), "start",
+                "fill=\"#666666\" font-size=\"10\"", lab);
+    }
+    for (int a = -90; a <= 90; a += 30) {
+        double t = a * M_PI / 180;
+        snprintf(lab, sizeof lab, "%d°", a);
+        text_at(&s, cx + (R + 18) * cos(t), cy - (R + 18) * sin(t) + 4, "middle", NULL, lab);
+    }
+    /* achieved: wedges for each class and its mirror (axial data) */
+    sb_puts(&s, "<g class=\"achieved\" fill=\"#1f77b4\" fill-opacity=\"0.6\" stroke=\"#1f77b4\">\n");
+    for (size_t i = 0; i < h.k; i++) {
+        double pr = R * fmin(h.achieved[i], rmax) / rmax;
+        if (!(pr > 0)) continue;
+        for (int mirror = 0; mirror < 2; mirror++) {
+            double a0 = (h.edges[i] + 180 * mirror) * M_PI / 180, a1 = (h.edges[i + 1] + 180 * mirror) * M_PI / 180;
+            sb_printf(&s, "<path d=\"M%.1f %.1fL%.1f %.1fA%.1f %.1f 0 0 0 %.1f %.1fz\"/>\n", cx, cy,
+                      cx + pr * cos(a0), cy - pr * sin(a0), pr, pr, cx + pr * cos(a1), cy - pr * sin(a1));
+        }
+    }
+    sb_puts(&s, "</g>\n");
+    if (h.target) {
+        sb_puts(&s, "<path class=\"target\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\" d=\"");
+        for (int mirror = 0, first = 1; mirror < 2; mirror++)
+            for (size_t i = 0; i < h.k; i++) {
+                double a = (0.5 * (h.edges[i] + h.edges[i + 1]) + 180 * mirror) * M_PI / 180;
+                double pr = R * fmin(h.target[i], rmax) / rmax;
+                sb_printf(&s, "%s%.1f %.1f", first ? "M" : "L", cx + pr * cos(a), cy - pr * sin(a));
+                first = 0;
+            }
+        sb_puts(&s, "z\"/>\n");
+        for (int mirror = 0; mirror < 2; mirror++)
+            for (size_t i = 0; i < h.k; i++) {
+                double a = (0.5 * (h.edges[i] + h.edges[i + 1]) + 180 * mirror) * M_PI / 180;
+                double pr = R * fmin(h.target[i], rmax) / rmax;
+                marker(&s, cx + pr * cos(a), cy - pr * sin(a), "#d62728");
+            }
+    }
+    legend_item it[2] = {{"achieved (fraction per class)", "bar", "#1f77b4"},
+                         {"target", "marker", "#d62728"}};
+    legend(&s, 10, height - 56, it, h.target ? 2 : 1);
+    doc_end(&s);
+    hist_free(&h);
+    return finish(&s, len, status, eb, el);
+}
+
+static char *view_descriptors(const json_t *res, int width, size_t *len, int *status, char *eb,
+                              size_t el)
+{
+    static const char *names[4] = {"elongation", "roundness", "circularity", "regularity"};
+    const json_t *d = json_object_get(json_object_get(res, "stats"), "descriptors");
+    const json_t *grains = json_object_get(res, "grains");
+    hist h[4];
+    int ok = 1, any = 0;
+    for (int k = 0; k < 4; k++) {
+        if (hist_read(json_object_get(d, names[k]), &h[k]) == 0) {
+            any = 1;
+            continue;
+        }
+        size_t n;
+        double *v = collect(grains, "descriptors", names[k], &n);
+        if (v) {
+            double lo, hi;
+            minmax(v, n, &lo, &hi);
+            if (k != 3) lo = fmin(lo, 0), hi = fmax(hi, 1); /* ratios in [0, 1] */
+            if (hist_from_values(v, n, 20, lo, hi, &h[k]) == 0) any = 1;
+            else ok = 0;
+            free(v);
+        } else {
+            memset(&h[k], 0, sizeof h[k]);
+        }
+    }
+    if (!any || !ok) {
+        for (int k = 0; k < 4; k++) hist_free(&h[k]);
+        if (!ok) seterr(eb, el, status, 500, "out of memory");
+        else seterr(eb, el, status, 409, "view \"descriptors\" needs the descriptors: the spec did not ask for output \"descriptors\"");
+        return NULL;
+    }
+    int height = (int)lround(width * 0.75);
+    sb s = {0};
+    doc_begin(&s, width, height, "Shape descriptors of the grains");
+    double pw = (width - 40) / 2.0, ph = (height - 50) / 2.0;
+    for (int k = 0; k < 4; k++) {
+        double ox = 20 + (k % 2) * pw, oy = 40 + (k / 2) * ph;
+        if (!h[k].k) {
+            text_at(&s, ox + pw / 2, oy + ph / 2, "middle", NULL, "(not in the result)");
+            continue;
+        }
+        frame f = hist_frame(ox + 62, oy + 22, pw - 82, ph - 72, &h[k]);
+        axes(&s, &f, names[k], "fraction of grains", 0);
+        draw_hist(&s, &f, &h[k], "#2ca02c");
+        /* mean marker: a vertical dashed line with its value */
+        if (h[k].has_mean && h[k].mean >= f.xmin && h[k].mean <= f.xmax) {
+            double x = fx(&f, h[k].mean);
+            sb_printf(&s, "<line class=\"mean\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" "
+                          "stroke=\"#000000\" stroke-width=\"1.5\" stroke-dasharray=\"5 3\"/>\n",
+                      x, f.y0, x, f.y0 + f.h);
+            char lab[64];
+            snprintf(lab, sizeof lab, "mean %.3g", h[k].mean);
+            text_at(&s, x + 4, f.y0 + 10, "start", "font-size=\"11\"", lab);
+        }
+        char t[64];
+        snprintf(t, sizeof t, "%s", names[k]);
+        text_at(&s, f.x0 + f.w / 2, oy + 14, "middle", "font-weight=\"bold\"", t);
+    }
+    doc_end(&s);
+    for (int k = 0; k < 4; k++) hist_free(&h[k]);
+    return finish(&s, len, status, eb, el);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* 3D views */
+
+static char *view_section(const json_t *res, const gp_svg_options *opt, int width, size_t *len,
+                          int *status, char *eb, size_t el)
+{
+    const json_t *spheres = json_object_get(res, "spheres");
+    if (!json_is_array(spheres)) {
+        seterr(eb, el, status, 409, "view \"section\" needs the spheres: the spec did not ask for output \"spheres\"");
+        return NULL;
+    }
+    double box[3] = {NAN, NAN, NAN}, lo[3] = {0, 0, 0};
+    const json_t *jb = json_object_get(res, "box");
+    int have_box = json_is_array(jb) && json_array_size(jb) == 3;
+    double dmin = INFINITY, dmax = -INFINITY;
+    double bl[3] = {INFINITY, INFINITY, INFINITY}, bh[3] = {-INFINITY, -INFINITY, -INFINITY};
+    size_t i;
+    const json_t *sp;
+    json_array_foreach(spheres, i, sp) {
+        double r = jnum(json_array_get(sp, 3), NAN);
+        if (!(r > 0)) continue;
+        dmin = fmin(dmin, 2 * r);
+        dmax = fmax(dmax, 2 * r);
+        for (int a = 0; a < 3; a++) {
+            double c = jnum(json_array_get(sp, a), NAN);
+            bl[a] = fmin(bl[a], c - r);
+            bh[a] = fmax(bh[a], c + r);
+        }
+    }
+    for (int a = 0; a < 3; a++) {
+        if (have_box) box[a] = jnum(json_array_get(jb, a), NAN);
+        if (!(box[a] > 0)) {
+            have_box = 0;
+        }
+    }
+    if (!have_box) {
+        for (int a = 0; a < 3; a++) {
+            lo[a] = bh[a] >= bl[a] ? bl[a] : 0;
+            box[a] = bh[a] >= bl[a] ? bh[a] - bl[a] : 1;
+        }
+    }
+    double z = lo[2] + box[2] / 2;
+    if (opt && opt->has_z) {
+        z = opt->z;
+        if (!isfinite(z) || z < lo[2] || z > lo[2] + box[2]) {
+            seterr(eb, el, status, 400, "z = %g is outside the box (z from %g to %g m)", z, lo[2],
+                   lo[2] + box[2]);
+            return NULL;
+        }
+    }
+    if (!(dmax >= dmin)) dmin = dmax = 1;
+    bounds b = {lo[0], lo[0] + box[0], lo[1], lo[1] + box[1]};
+    int height;
+    frame f = map_frame(b, width, &height);
+    sb s = {0};
+    size_t ncut = 0;
+    json_array_foreach(spheres, i, sp) {
+        double r = jnum(json_array_get(sp, 3), NAN), dz = jnum(json_array_get(sp, 2), NAN) - z;
+        if (r > 0 && fabs(dz) < r) ncut++;
+    }
+    char title[200];
+    snprintf(title, sizeof title, "Section at z = %.4g m: %zu of %zu spheres cut", z, ncut,
+             json_array_size(spheres));
+    doc_begin(&s, width, height, title);
+    axes(&s, &f, "x (m)", "y (m)", 0);
+    sb_printf(&s, "<rect class=\"box\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#f4f4f4\" "
+                  "stroke=\"#000000\" stroke-width=\"1.5\"/>\n",
+              fx(&f, b.xmin), fy(&f, b.ymax), fx(&f, b.xmax) - fx(&f, b.xmin), fy(&f, b.ymin) - fy(&f, b.ymax));
+    int logscale = dmax > 4 * dmin;
+    sb_puts(&s, "<g class=\"spheres\" stroke=\"#222222\" stroke-width=\"0.4\">\n");
+    double scale = f.w / (f.xmax - f.xmin);
+    json_array_foreach(spheres, i, sp) {
+        double r = jnum(json_array_get(sp, 3), NAN), dz = jnum(json_array_get(sp, 2), NAN) - z;
+        if (!(r > 0) || !(fabs(dz) < r)) continue;
+        double rc = sqrt(r * r - dz * dz);
+        char c[16];
+        double t = dmax > dmin ? (logscale ? log(2 * r / dmin) / log(dmax / dmin) : (2 * r - dmin) / (dmax - dmin)) : 0.5;
+        ramp(t, c, sizeof c);
+        sb_printf(&s, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"%s\"/>\n",
+                  fx(&f, jnum(json_array_get(sp, 0), 0)), fy(&f, jnum(json_array_get(sp, 1), 0)),
+                  rc * scale, c);
+    }
+    sb_puts(&s, "</g>\n");
+    double k = dmax < 1 ? 1000 : 1;
+    colorbar(&s, f.x0 + f.w + 30, f.y0 + 24, fmin(f.h - 30, 300), dmin * k, dmax * k, 0, logscale,
+             k > 1 ? "diameter (mm)" : "diameter (m)");
+    doc_end(&s);
+    return finish(&s, len, status, eb, el);
+}
+
+static char *view_psd(const json_t *res, int width, size_t *len, int *status, char *eb, size_t el)
+{
+    const json_t *psd = json_object_get(json_object_get(res, "stats"), "psd");
+    static const char *keys[4] = {"target_weight", "achieved_weight", "target_number", "achieved_number"};
+    static const char *labels[4] = {"target, by weight", "achieved, by weight", "target, by number",
+                                    "achieved, by number"};
+    static const char *colors[4] = {"#1f77b4", "#1f77b4", "#d62728", "#d62728"};
+    size_t nd = 0, nc[4] = {0};
+    double *d = jarray(json_object_get(psd, "diameters"), &nd);
+    double *c[4] = {NULL};
+    for (int k = 0; k < 4; k++) {
+        c[k] = jarray(json_object_get(psd, keys[k]), &nc[k]);
+        if (c[k] && nc[k] != nd) {
+            free(c[k]);
+            c[k] = NULL;
+        }
+    }
+    int any = 0;
+    for (int k = 0; k < 4; k++) any |= c[k] != NULL;
+    if (!d || !any) {
+        free(d);
+        for (int k = 0; k < 4; k++) free(c[k]);
+        seterr(eb, el, status, 409, "view \"psd\" needs stats.psd (diameters with target/achieved curves) in the result");
+        return NULL;
+    }
+    double dmin = INFINITY, dmax = -INFINITY;
+    for (size_t i = 0; i < nd; i++)
+        if (d[i] > 0) dmin = fmin(dmin, d[i]), dmax = fmax(dmax, d[i]);
+    if (!(dmax >= dmin)) dmin = 1e-3, dmax = 1e-1;
+    double unit = dmax < 1 ? 1000 : 1;
+    double xlo = pow(10, floor(log10(dmin * unit) + 1e-9)), xhi = pow(10, ceil(log10(dmax * unit) - 1e-9));
+    if (!(xhi > xlo)) xhi = xlo * 10;
+    int height = (int)lround(width * 0.62);
+    frame f = {80, 40, width - 110.0, height - 110.0, xlo, xhi, 0, 100, 1};
+    sb s = {0};
+    doc_begin(&s, width, height, "Grain-size distribution: target vs achieved");
+    axes(&s, &f, unit > 1 ? "sieve diameter (mm, log scale)" : "sieve diameter (m, log scale)",
+         "percent passing (%)", 1);
+    for (int k = 0; k < 4; k++) {
+        if (!c[k]) continue;
+        int dashed = k % 2 == 0;
+        sb_printf(&s, "<path class=\"%s\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s d=\"", keys[k],
+                  colors[k], dashed ? " stroke-dasharray=\"6 4\"" : "");
+        int first = 1;
+        for (size_t i = 0; i < nd; i++) {
+            if (!(d[i] > 0) || !isfinite(c[k][i])) continue;
+            sb_printf(&s, "%s%.1f %.1f", first ? "M" : "L", fx(&f, d[i] * unit), fy(&f, fmax(0, fmin(100, c[k][i]))));
+            first = 0;
+        }
+        sb_puts(&s, "\"/>\n");
+        if (!dashed)
+            for (size_t i = 0; i < nd; i++)
+                if (d[i] > 0 && isfinite(c[k][i]))
+                    marker(&s, fx(&f, d[i] * unit), fy(&f, fmax(0, fmin(100, c[k][i]))), colors[k]);
+    }
+    legend_item it[4];
+    int n = 0;
+    for (int k = 0; k < 4; k++)
+        if (c[k]) it[n++] = (legend_item){labels[k], k % 2 == 0 ? "dash" : "marker", colors[k]};
+    legend(&s, f.x0 + 10, f.y0 + 8, it, n);
+    doc_end(&s);
+    free(d);
+    for (int k = 0; k < 4; k++) free(c[k]);
+    return finish(&s, len, status, eb, el);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+
+const char *gp_svg_views(const char *kind)
+{
+    if (!kind) return NULL;
+    if (!strcmp(kind, KIND_2D)) return VIEWS_2D;
+    if (!strcmp(kind, KIND_3D)) return VIEWS_3D;
+    return NULL;
+}
+
+char *gp_svg_render(const json_t *result, const char *kind, const char *view,
+                    const gp_svg_options *opt, size_t *len, int *status, char *errbuf,
+                    size_t errlen)
+{
+    if (len) *len = 0;
+    if (errbuf && errlen) errbuf[0] = 0;
+    if (!json_is_object(result)) {
+        seterr(errbuf, errlen, status, 500, "the result is not a JSON object");
+        return NULL;
+    }
+    if (!kind || !*kind) {
+        const char *k = json_string_value(json_object_get(result, "kind"));
+        if (k) kind = k;
+        else if (json_object_get(result, "spheres") || json_object_get(result, "box") ||
+                 json_object_get(json_object_get(result, "stats"), "psd"))
+            kind = KIND_3D;
+        else kind = KIND_2D;
+    }
+    const char *views = gp_svg_views(kind);
+    if (!views) {
+        seterr(errbuf, errlen, status, 400, "unknown kind \"%s\"", kind);
+        return NULL;
+    }
+    int width = opt && opt->width > 0 ? opt->width : 800;
+    if (width < 320) width = 320;
+    if (width > 4000) width = 4000;
+    if (!view || !*view) {
+        seterr(errbuf, errlen, status, 400, "missing view; valid views for %s: %s", kind, views);
+        return NULL;
+    }
+    if (!strcmp(kind, KIND_2D)) {
+        if (!strcmp(view, "packing")) return view_packing(result, opt, width, len, status, errbuf, errlen);
+        if (!strcmp(view, "cells")) return view_cells(result, width, len, status, errbuf, errlen);
+        if (!strcmp(view, "size")) return view_size(result, width, len, status, errbuf, errlen);
+        if (!strcmp(view, "orientation")) return view_orientation(result, width, len, status, errbuf, errlen);
+        if (!strcmp(view, "descriptors")) return view_descriptors(result, width, len, status, errbuf, errlen);
+    } else {
+        if (!strcmp(view, "section")) return view_section(result, opt, width, len, status, errbuf, errlen);
+        if (!strcmp(view, "psd")) return view_psd(result, width, len, status, errbuf, errlen);
+    }
+    char v[64];
+    snprintf(v, sizeof v, "%s", view);
+    seterr(errbuf, errlen, status, 400, "unknown view \"%s\"; valid views for %s: %s", v, kind, views);
+    return NULL;
+}
