@@ -534,7 +534,9 @@ static char *view_packing(const json_t *res, const gp_svg_options *opt, int widt
     sb s = {0};
     char title[160];
     const json_t *stats = json_object_get(res, "stats");
-    double sf = jnum(json_object_get(stats, "solid_fraction"), NAN);
+    const json_t *sfj = json_object_get(stats, "solid_fraction");
+    if (json_is_object(sfj)) sfj = json_object_get(sfj, "achieved"); /* {"target", "achieved"} */
+    double sf = jnum(sfj, NAN);
     if (isfinite(sf))
         snprintf(title, sizeof title, "Packing: %zu grains, solid fraction %.3f", ng, sf);
     else

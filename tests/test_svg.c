@@ -215,6 +215,31 @@ static void test_2d(void)
     CHECK(status == 409);
     json_decref(r);
 
+    /* the shapes server/result_json.c writes: stats as {"target", "achieved"}, null targets and
+     * histograms, descriptor stats with only a mean */
+    r = json_loads(RESULT_2D, 0, &e);
+    json_t *st = json_object_get(r, "stats");
+    json_object_set_new(st, "solid_fraction", json_pack("{s:f, s:f}", "target", 0.65, "achieved", 0.6));
+    json_object_set_new(json_object_get(st, "size_histogram"), "target", json_null());
+    json_object_set_new(st, "orientation_histogram", json_null());
+    json_object_set_new(json_object_get(st, "descriptors"), "elongation", json_pack("{s:f}", "mean", 0.7));
+    s = render(r, NULL, "packing", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && strstr(s, "solid fraction 0.600"));
+    free(s);
+    s = render(r, NULL, "size", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && !strstr(s, "class=\"target\""));
+    free(s);
+    s = render(r, NULL, "orientation", NULL, &len, &status, err);
+    check_common(s, len);
+    free(s);
+    s = render(r, NULL, "descriptors", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && count(s, "class=\"mean\"") == 4);
+    free(s);
+    json_decref(r);
+
     /* a circle container */
     r = json_loads("{\"grains\": [{\"contour\": [[0,0],[1,0],[0,1]], \"area\": 0.5}],"
                    " \"container\": {\"circle\": {\"center\": [0.3, 0.3], \"radius\": 2}}}", 0, &e);
