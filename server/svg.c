@@ -365,13 +365,13 @@ static frame map_frame(bounds b, int width, int *height)
     frame f;
     f.x0 = 80;
     f.y0 = 40;
-    f.w = width - 80 - 110; /* room for the colour bar on the right */
+    f.w = width - 80 - 130; /* room for the colour bar on the right */
     f.h = f.w * dy / dx;
     if (f.h > 2.0 * width) {
         f.h = 2.0 * width;
         f.w = f.h * dx / dy;
     }
-    if (f.h < 120) f.h = 120, f.w = fmin(width - 190.0, f.h * dx / dy);
+    if (f.h < 120) f.h = 120, f.w = fmin(width - 210.0, f.h * dx / dy);
     f.xmin = b.xmin;
     f.xmax = b.xmin + dx * 1.0;
     f.ymin = b.ymin;
@@ -483,7 +483,11 @@ static void colorbar(sb *s, double x, double y, double h, double lo, double hi, 
                   x + 16, yy, x + 20, yy);
         text_at(s, x + 23, yy + 4, "start", NULL, lab);
     }
-    text_at(s, x + 8, y - 8, "middle", NULL, label);
+    double lx = x + 82, ly = y + h / 2;
+    sb_printf(s, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" transform=\"rotate(-90 %.1f %.1f)\">",
+              lx, ly, lx, ly);
+    sb_text(s, label);
+    sb_puts(s, "</text>\n");
 }
 
 static char *finish(sb *s, size_t *len, int *status, char *errbuf, size_t errlen)
@@ -562,7 +566,7 @@ static char *view_packing(const json_t *res, const gp_svg_options *opt, int widt
     }
     sb_puts(&s, "</g>\n");
     container_outline(&s, &f, json_object_get(res, "container"));
-    double cbx = f.x0 + f.w + 30, cbh = fmin(f.h - 30, 300);
+    double cbx = f.x0 + f.w + 20, cbh = fmin(f.h - 30, 300);
     if (by_orient) colorbar(&s, cbx, f.y0 + 24, cbh, -90, 90, 1, 0, "orientation (deg)");
     else colorbar(&s, cbx, f.y0 + 24, cbh, amin, amax, 0, logscale, "area (m²)");
     doc_end(&s);
@@ -618,7 +622,7 @@ static char *view_cells(const json_t *res, int width, size_t *len, int *status, 
     }
     sb_puts(&s, "</g>\n");
     container_outline(&s, &f, json_object_get(res, "container"));
-    colorbar(&s, f.x0 + f.w + 30, f.y0 + 24, fmin(f.h - 30, 300), amin, amax, 0, 0, "cell area (m²)");
+    colorbar(&s, f.x0 + f.w + 20, f.y0 + 24, fmin(f.h - 30, 300), amin, amax, 0, 0, "cell area (m²)");
     doc_end(&s);
     return finish(&s, len, status, eb, el);
 }
@@ -1074,7 +1078,7 @@ static char *view_section(const json_t *res, const gp_svg_options *opt, int widt
     }
     sb_puts(&s, "</g>\n");
     double k = dmax < 1 ? 1000 : 1;
-    colorbar(&s, f.x0 + f.w + 30, f.y0 + 24, fmin(f.h - 30, 300), dmin * k, dmax * k, 0, logscale,
+    colorbar(&s, f.x0 + f.w + 20, f.y0 + 24, fmin(f.h - 30, 300), dmin * k, dmax * k, 0, logscale,
              k > 1 ? "diameter (mm)" : "diameter (m)");
     doc_end(&s);
     return finish(&s, len, status, eb, el);

@@ -13,7 +13,7 @@
  *   "container": {"polygon": [[x,y],...], "holes": [...]} | {"circle": {"center", "radius"}}
  *               (optional echo of the spec's container; drawn as the outline when present)
  *   "stats": {
- *     "imc_error", "imc_steps", "solid_fraction",                        (api.md)
+ *     "imc_error", "imc_steps", "solid_fraction" (a number or {"target", "achieved"}),
  *     "size_histogram":        {"edges": [k+1], "target": [k], "achieved": [k]},
  *                              cell areas (m^2), fractions of the number of cells (sum ~1)
  *     "grain_size_histogram":  same shape, grain areas (optional; drawn as a 2nd series)
@@ -24,7 +24,8 @@
  *   }
  *   (These mirror gp_hist in core/gp_specimen2d.h: "target" may be absent or null where there
  *   is no target; "counts" is accepted in place of "achieved".)
- *   Missing stats histograms are recomputed from grains[] / cells[] where possible.
+ *   Missing (absent or null) stats histograms are recomputed from grains[] / cells[] where
+ *   possible (descriptors from grains[].descriptors).
  *
  * 3D result
  *   "spheres": [[x,y,z,r],...] (m)                                        (api.md)
