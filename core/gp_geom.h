@@ -67,4 +67,18 @@ int gp_poly_inside_poly(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t nb
 /* 1 if the interiors of two simple polygons overlap (edge crossing or one inside the other). */
 int gp_poly_overlap(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t nb);
 
+/* --- additions (appended; the declarations above are pinned) --- */
+
+/* Axis-aligned bounding box of n >= 1 points. GP_ERR_INVALID for n == 0 or non-finite input. */
+gp_status gp_poly_bbox(const gp_vec2 *p, size_t n, gp_vec2 *lo, gp_vec2 *hi, gp_error *err);
+
+/* Exact orientation of (a, b, c): +1 counter-clockwise (c left of a->b), -1 clockwise, 0
+ * collinear. Adaptive: a floating-point filter, then exact expansion arithmetic, so the sign is
+ * exact for all finite input (|coordinates| below ~1e150). */
+int gp_orient2d(gp_vec2 a, gp_vec2 b, gp_vec2 c);
+
+/* 1 if the closed segments [a, b] and [c, d] share at least one point (exact); 0 otherwise or
+ * for non-finite input. */
+int gp_segments_intersect(gp_vec2 a, gp_vec2 b, gp_vec2 c, gp_vec2 d);
+
 #endif /* GP_GEOM_H */

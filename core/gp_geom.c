@@ -1,0 +1,1109 @@
+/* gp_geom.c -- see gp_geom.h.
+ *
+ * Precision strategy
+ *  - Metric quantities (area, centroid, distances, circles, calipers) are evaluated on
+ *    coordinates taken relative to a reference vertex, so that a small polygon far from the
+ *    origin (x = 1e6 + small) keeps its relative precision.
+ *  - Combinatorial decisions (hull turns, segment crossings, point classification used by
+ *    gp_poly_is_simple / gp_poly_inside_poly / gp_poly_overlap) use an exact orientation
+ *    predicate: Shewchuk's floating-point filter, and when the filter cannot decide, an exact
+ *    evaluation of the 2x2 determinant as a floating-point expansion (products split exactly
+ *    with fma, summed with error-free TwoSum). The sign is therefore exact for every finite
+ *    input (barring overflow / underflow of the products, i.e. |coordinates| < ~1e150 and
+ *    differences not below ~1e-150).
+ *
+ * Memory: gp_max_inscribed_circle and gp_min_caliper allocate a temporary buffer (freed before
+ * they return; GP_ERR_NOMEM if that fails). Everything else works in the caller's memory.
+ */
+#include "gp_geom.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GP_PI 3.14159265358979323846
+
+/* ------------------------------------------------------------------------------------------ */
+/* helpers                                                                                     */
+
+static inline int finite2(gp_vec2 v) { return isfinite(v.x) && isfinite(v.y); }
+
+static int all_finite(const gp_vec2 *p, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!finite2(p[i])) return 0;
+    return 1;
+}
+
+static inline int veq(gp_vec2 a, gp_vec2 b) { return a.x == b.x && a.y == b.y; }
+
+/* lexicographic (x, then y) */
+static inline int vlt(gp_vec2 a, gp_vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); }
+
+static void bbox_of(const gp_vec2 *p, size_t n, double *x0, double *y0, double *x1, double *y1)
+{
+    double a = p[0].x, b = p[0].y, c = p[0].x, d = p[0].y;
+    for (size_t i = 1; i < n; i++) {
+        if (p[i].x < a) a = p[i].x;
+        if (p[i].x > c) c = p[i].x;
+        if (p[i].y < b) b = p[i].y;
+        if (p[i].y > d) d = p[i].y;
+    }
+    *x0 = a;
+    *y0 = b;
+    *x1 = c;
+    *y1 = d;
+}
+
+gp_status gp_poly_bbox(const gp_vec2 *p, size_t n, gp_vec2 *lo, gp_vec2 *hi, gp_error *err)
+{
+    if (!p || n == 0) return gp_error_set(err, GP_ERR_INVALID, "bbox: need n >= 1 points");
+    if (!all_finite(p, n)) return gp_error_set(err, GP_ERR_INVALID, "bbox: non-finite vertex");
+    double x0, y0, x1, y1;
+    bbox_of(p, n, &x0, &y0, &x1, &y1);
+    if (lo) *lo = (gp_vec2){x0, y0};
+    if (hi) *hi = (gp_vec2){x1, y1};
+    return GP_OK;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* exact orientation                                                                           */
+
+static inline void two_sum(double a, double b, double *s, double *e)
+{
+    double x = a + b;
+    double bv = x - a;
+    double av = x - bv;
+    *e = (a - av) + (b - bv);
+    *s = x;
+}
+
+/* sign of ax*by - ax*cy - ay*bx + ay*cx + bx*cy - by*cx, computed exactly */
+static int orient_exact(gp_vec2 a, gp_vec2 b, gp_vec2 c)
+{
+    const double f[6][2] = {{a.x, b.y}, {-a.x, c.y}, {-a.y, b.x},
+                            {a.y, c.x}, {b.x, c.y}, {-b.y, c.x}};
+    double t[12];
+    for (int i = 0; i < 6; i++) {
+        double pr = f[i][0] * f[i][1];
+        t[2 * i] = pr;
+        t[2 * i + 1] = fma(f[i][0], f[i][1], -pr);
+    }
+    /* grow a non-overlapping expansion term by term (Shewchuk's Grow-Expansion with zero
+     * elimination); its sign is the sign of its largest (last) component */
+    double e[13];
+    int m = 0;
+    for (int k = 0; k < 12; k++) {
+        double q = t[k];
+        int len = 0;
+        for (int i = 0; i < m; i++) {
+            double s, h;
+            two_sum(q, e[i], &s, &h);
+            if (h != 0.0) e[len++] = h;
+            q = s;
+        }
+        if (q != 0.0) e[len++] = q;
+        m = len;
+    }
+    if (m == 0) return 0;
+    return e[m - 1] > 0.0 ? 1 : -1;
+}
+
+static inline int sgn(double v) { return (v > 0.0) - (v < 0.0); }
+
+/* +1 if a, b, c turn counter-clockwise, -1 clockwise, 0 collinear (exact). */
+static inline int orient(gp_vec2 a, gp_vec2 b, gp_vec2 c)
+{
+    const double errA = (3.0 + 16.0 * (DBL_EPSILON / 2)) * (DBL_EPSILON / 2);
+    double detl = (a.x - c.x) * (b.y - c.y);
+    double detr = (a.y - c.y) * (b.x - c.x);
+    double det = detl - detr, detsum;
+    if (detl > 0.0) {
+        if (detr <= 0.0) return sgn(det);
+        detsum = detl + detr;
+    } else if (detl < 0.0) {
+        if (detr >= 0.0) return sgn(det);
+        detsum = -detl - detr;
+    } else {
+        return sgn(det);
+    }
+    double bound = errA * detsum;
+    if (det >= bound || -det >= bound) return sgn(det);
+    return orient_exact(a, b, c);
+}
+
+int gp_orient2d(gp_vec2 a, gp_vec2 b, gp_vec2 c) { return orient(a, b, c); }
+
+/* closed segments [a,b] and [c,d] share a point (exact) */
+static int seg_intersect(gp_vec2 a, gp_vec2 b, gp_vec2 c, gp_vec2 d)
+{
+    if (fmax(a.x, b.x) < fmin(c.x, d.x) || fmax(c.x, d.x) < fmin(a.x, b.x) ||
+        fmax(a.y, b.y) < fmin(c.y, d.y) || fmax(c.y, d.y) < fmin(a.y, b.y))
+        return 0;
+    int o1 = orient(a, b, c), o2 = orient(a, b, d);
+    if (o1 * o2 > 0) return 0;
+    int o3 = orient(c, d, a), o4 = orient(c, d, b);
+    if (o3 * o4 > 0) return 0;
+    /* all collinear: the bounding boxes overlap, hence so do the segments */
+    return 1;
+}
+
+int gp_segments_intersect(gp_vec2 a, gp_vec2 b, gp_vec2 c, gp_vec2 d)
+{
+    if (!finite2(a) || !finite2(b) || !finite2(c) || !finite2(d)) return 0;
+    return seg_intersect(a, b, c, d);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* area, perimeter, centroid                                                                   */
+
+double gp_poly_signed_area(const gp_vec2 *p, size_t n)
+{
+    if (!p || n < 3) return 0.0;
+    const gp_vec2 o = p[0];
+    double s = 0.0;
+    double px = p[1].x - o.x, py = p[1].y - o.y;
+    for (size_t i = 2; i < n; i++) {
+        double qx = p[i].x - o.x, qy = p[i].y - o.y;
+        s += px * qy - py * qx;
+        px = qx;
+        py = qy;
+    }
+    return 0.5 * s;
+}
+
+double gp_poly_area(const gp_vec2 *p, size_t n) { return fabs(gp_poly_signed_area(p, n)); }
+
+double gp_poly_perimeter(const gp_vec2 *p, size_t n)
+{
+    if (!p || n < 2) return 0.0;
+    double s = 0.0;
+    for (size_t i = 0, j = n - 1; i < n; j = i++) s += hypot(p[i].x - p[j].x, p[i].y - p[j].y);
+    return s;
+}
+
+/* 1 if every vertex lies on one line (exact), including n < 3 and all-equal */
+static int all_collinear(const gp_vec2 *p, size_t n)
+{
+    size_t i = 1;
+    while (i < n && veq(p[i], p[0])) i++;
+    if (i >= n) return 1;
+    for (size_t k = i + 1; k < n; k++)
+        if (orient(p[0], p[i], p[k]) != 0) return 0;
+    return 1;
+}
+
+gp_status gp_poly_centroid(const gp_vec2 *p, size_t n, gp_vec2 *c, gp_error *err)
+{
+    if (!p || n == 0 || !c) return gp_error_set(err, GP_ERR_INVALID, "centroid: need n >= 1 points");
+    if (!all_finite(p, n)) return gp_error_set(err, GP_ERR_INVALID, "centroid: non-finite vertex");
+    const gp_vec2 o = p[0];
+    double a2 = 0.0, aabs = 0.0, sx = 0.0, sy = 0.0, mx = 0.0, my = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double xi = p[i].x - o.x, yi = p[i].y - o.y;
+        mx += xi;
+        my += yi;
+        if (i + 1 < n) {
+            double xj = p[i + 1].x - o.x, yj = p[i + 1].y - o.y;
+            double cr = xi * yj - xj * yi;
+            a2 += cr;
+            aabs += fabs(cr);
+            sx += (xi + xj) * cr;
+            sy += (yi + yj) * cr;
+        }
+    }
+    if (n < 3 || a2 == 0.0 || fabs(a2) <= 1e-13 * aabs || all_collinear(p, n)) {
+        c->x = o.x + mx / (double)n;
+        c->y = o.y + my / (double)n;
+        return gp_error_set(err, GP_ERR_DEGENERATE, "centroid: polygon has zero area");
+    }
+    c->x = o.x + sx / (3.0 * a2);
+    c->y = o.y + sy / (3.0 * a2);
+    return GP_OK;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* distances                                                                                   */
+
+static inline double seg_dist2(double qx, double qy, double ax, double ay, double bx, double by)
+{
+    double dx = bx - ax, dy = by - ay, wx = qx - ax, wy = qy - ay;
+    double l2 = dx * dx + dy * dy;
+    double t = wx * dx + wy * dy;
+    if (t <= 0.0 || l2 <= 0.0) return wx * wx + wy * wy;
+    if (t >= l2) {
+        double ux = qx - bx, uy = qy - by;
+        return ux * ux + uy * uy;
+    }
+    t /= l2;
+    double ex = wx - t * dx, ey = wy - t * dy;
+    return ex * ex + ey * ey;
+}
+
+double gp_segment_distance(gp_vec2 q, gp_vec2 a, gp_vec2 b)
+{
+    return sqrt(seg_dist2(q.x, q.y, a.x, a.y, b.x, b.y));
+}
+
+double gp_poly_boundary_distance(const gp_vec2 *p, size_t n, gp_vec2 q)
+{
+    if (!p || n == 0) return INFINITY;
+    if (n == 1) return hypot(q.x - p[0].x, q.y - p[0].y);
+    double m = INFINITY;
+    for (size_t i = 0, j = n - 1; i < n; j = i++) {
+        double d = seg_dist2(q.x, q.y, p[j].x, p[j].y, p[i].x, p[i].y);
+        if (d < m) m = d;
+    }
+    return sqrt(m);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* point in polygon                                                                            */
+
+/* Exact even-odd classification: 1 inside, 0 on the boundary, -1 outside. */
+static int point_class(const gp_vec2 *p, size_t n, gp_vec2 q)
+{
+    int c = 0;
+    for (size_t i = 0, j = n - 1; i < n; j = i++) {
+        gp_vec2 a = p[j], b = p[i];
+        if ((a.y > q.y) != (b.y > q.y)) {
+            int o = orient(a, b, q);
+            if (o == 0) return 0;
+            if ((o > 0) == (b.y > a.y)) c ^= 1;
+        } else if (a.y == q.y && b.y == q.y) {
+            if ((a.x <= q.x && q.x <= b.x) || (b.x <= q.x && q.x <= a.x)) return 0;
+        } else if (veq(a, q)) {
+            return 0;
+        }
+    }
+    return c ? 1 : -1;
+}
+
+int gp_poly_contains(const gp_vec2 *p, size_t n, gp_vec2 q)
+{
+    if (!p || n == 0 || !finite2(q)) return 0;
+    double x0, y0, x1, y1;
+    bbox_of(p, n, &x0, &y0, &x1, &y1);
+    double size = fmax(x1 - x0, y1 - y0);
+    if (!isfinite(size)) return 0;
+    double tol = 1e-12 * size;
+    if (q.x < x0 - tol || q.x > x1 + tol || q.y < y0 - tol || q.y > y1 + tol) return 0;
+    double tol2 = tol * tol;
+    int c = 0;
+    for (size_t i = 0, j = n - 1; i < n; j = i++) {
+        gp_vec2 a = p[j], b = p[i];
+        /* on (or within tol of) this edge: inside */
+        if (q.x >= fmin(a.x, b.x) - tol && q.x <= fmax(a.x, b.x) + tol &&
+            q.y >= fmin(a.y, b.y) - tol && q.y <= fmax(a.y, b.y) + tol &&
+            seg_dist2(q.x, q.y, a.x, a.y, b.x, b.y) <= tol2)
+            return 1;
+        if ((a.y > q.y) != (b.y > q.y)) {
+            int o = orient(a, b, q);
+            if (o == 0) return 1;
+            if ((o > 0) == (b.y > a.y)) c ^= 1;
+        }
+    }
+    return c;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* sorting (lexicographic), no allocation                                                      */
+
+static inline void vswap(gp_vec2 *a, gp_vec2 *b)
+{
+    gp_vec2 t = *a;
+    *a = *b;
+    *b = t;
+}
+
+static void sift_down(gp_vec2 *v, size_t root, size_t n)
+{
+    for (;;) {
+        size_t c = 2 * root + 1;
+        if (c >= n) return;
+        if (c + 1 < n && vlt(v[c], v[c + 1])) c++;
+        if (!vlt(v[root], v[c])) return;
+        vswap(&v[root], &v[c]);
+        root = c;
+    }
+}
+
+static void heap_sort(gp_vec2 *v, size_t n)
+{
+    if (n < 2) return;
+    for (size_t i = n / 2; i-- > 0;) sift_down(v, i, n);
+    for (size_t end = n - 1; end > 0; end--) {
+        vswap(&v[0], &v[end]);
+        sift_down(v, 0, end);
+    }
+}
+
+static void insertion_sort(gp_vec2 *v, size_t n)
+{
+    for (size_t i = 1; i < n; i++) {
+        gp_vec2 x = v[i];
+        size_t j = i;
+        while (j > 0 && vlt(x, v[j - 1])) {
+            v[j] = v[j - 1];
+            j--;
+        }
+        v[j] = x;
+    }
+}
+
+/* introsort: median-of-three quicksort, heap sort past a depth limit, insertion sort below 16 */
+static void sort_pts_rec(gp_vec2 *v, size_t n, int depth)
+{
+    while (n > 16) {
+        if (depth-- <= 0) {
+            heap_sort(v, n);
+            return;
+        }
+        size_t mid = n / 2;
+        if (vlt(v[mid], v[0])) vswap(&v[mid], &v[0]);
+        if (vlt(v[n - 1], v[0])) vswap(&v[n - 1], &v[0]);
+        if (vlt(v[n - 1], v[mid])) vswap(&v[n - 1], &v[mid]);
+        gp_vec2 piv = v[mid];
+        size_t i = 0, j = n - 1;
+        for (;;) {
+            while (vlt(v[i], piv)) i++;
+            while (vlt(piv, v[j])) j--;
+            if (i >= j) break;
+            vswap(&v[i], &v[j]);
+            i++;
+            j--;
+        }
+        /* [0, j] <= piv <= [j + 1, n) with 0 <= j < n - 1 */
+        size_t nl = j + 1, nr = n - nl;
+        if (nl < nr) {
+            sort_pts_rec(v, nl, depth);
+            v += nl;
+            n = nr;
+        } else {
+            sort_pts_rec(v + nl, nr, depth);
+            n = nl;
+        }
+    }
+    insertion_sort(v, n);
+}
+
+static void sort_pts(gp_vec2 *v, size_t n)
+{
+    int depth = 0;
+    for (size_t m = n; m > 1; m >>= 1) depth += 2;
+    sort_pts_rec(v, n, depth);
+}
+
+static void reverse_pts(gp_vec2 *v, size_t n)
+{
+    for (size_t i = 0, j = n; i + 1 < j; i++, j--) vswap(&v[i], &v[j - 1]);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* convex hull                                                                                 */
+
+/* Andrew's monotone chain, done in place in h: the points are split by the line A-B (A the
+ * lexicographically smallest, B the largest) into the lower set (on or below A-B, sorted
+ * ascending) followed by the upper set (strictly above, sorted descending); one scan of that
+ * sequence never writes past the point it reads, so h needs only n slots. Non-finite points
+ * are ignored. */
+size_t gp_convex_hull(const gp_vec2 *p, size_t n, gp_vec2 *h)
+{
+    if (!p || !h || n == 0) return 0;
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++)
+        if (finite2(p[i])) h[m++] = p[i];
+    if (m == 0) return 0;
+    size_t ia = 0, ib = 0;
+    for (size_t i = 1; i < m; i++) {
+        if (vlt(h[i], h[ia])) ia = i;
+        if (vlt(h[ib], h[i])) ib = i;
+    }
+    const gp_vec2 A = h[ia], B = h[ib];
+    if (veq(A, B)) {
+        h[0] = A;
+        return 1;
+    }
+    size_t nl = 0;
+    for (size_t i = 0; i < m; i++)
+        if (orient(A, B, h[i]) <= 0) vswap(&h[nl++], &h[i]);
+    sort_pts(h, nl);
+    sort_pts(h + nl, m - nl);
+    reverse_pts(h + nl, m - nl);
+
+    size_t k = 0;
+    for (size_t i = 0; i < nl; i++) {
+        gp_vec2 q = h[i];
+        while (k >= 2 && orient(h[k - 2], h[k - 1], q) <= 0) k--;
+        h[k++] = q;
+    }
+    const size_t t = k + 1;
+    for (size_t i = nl; i < m; i++) {
+        gp_vec2 q = h[i];
+        while (k >= t && orient(h[k - 2], h[k - 1], q) <= 0) k--;
+        h[k++] = q;
+    }
+    while (k >= t && orient(h[k - 2], h[k - 1], A) <= 0) k--;
+
+    /* start at the lowest, then leftmost vertex */
+    size_t s = 0;
+    for (size_t i = 1; i < k; i++)
+        if (h[i].y < h[s].y || (h[i].y == h[s].y && h[i].x < h[s].x)) s = i;
+    if (s) {
+        reverse_pts(h, s);
+        reverse_pts(h + s, k - s);
+        reverse_pts(h, k);
+    }
+    return k;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* minimum enclosing circle                                                                    */
+
+typedef struct {
+    double x, y, r2;
+} circ;
+
+static inline int circ_outside(const circ *c, double x, double y)
+{
+    double dx = x - c->x, dy = y - c->y;
+    return dx * dx + dy * dy > c->r2 * (1.0 + 1e-12);
+}
+
+static circ circ2(double ax, double ay, double bx, double by)
+{
+    circ c;
+    c.x = 0.5 * (ax + bx);
+    c.y = 0.5 * (ay + by);
+    double dx = bx - ax, dy = by - ay;
+    c.r2 = 0.25 * (dx * dx + dy * dy);
+    return c;
+}
+
+static circ circ3(double ax, double ay, double bx, double by, double cx, double cy)
+{
+    double ux = bx - ax, uy = by - ay, vx = cx - ax, vy = cy - ay;
+    double d = 2.0 * (ux * vy - uy * vx);
+    double U = ux * ux + uy * uy, V = vx * vx + vy * vy;
+    if (fabs(d) <= 1e-14 * 2.0 * sqrt(U * V)) {
+        /* (numerically) collinear: the diametral circle of the farthest pair */
+        double wx = cx - bx, wy = cy - by, W = wx * wx + wy * wy;
+        if (U >= V && U >= W) return circ2(ax, ay, bx, by);
+        if (V >= W) return circ2(ax, ay, cx, cy);
+        return circ2(bx, by, cx, cy);
+    }
+    double ox = (vy * U - uy * V) / d, oy = (ux * V - vx * U) / d;
+    circ c = {ax + ox, ay + oy, ox * ox + oy * oy};
+    return c;
+}
+
+static size_t gcd_sz(size_t a, size_t b)
+{
+    while (b) {
+        size_t t = a % b;
+        a = b;
+        b = t;
+    }
+    return a;
+}
+
+/* Welzl's incremental algorithm (three nested loops). The points are visited in a fixed
+ * pseudo-random order -- index k -> (k * s) mod n with s ~ n / golden ratio and gcd(s, n) = 1 --
+ * which spreads contour points like a shuffle without RNG, state or memory; expected O(n). */
+gp_status gp_min_enclosing_circle(const gp_vec2 *p, size_t n, gp_vec2 *center, double *radius,
+                                  gp_error *err)
+{
+    if (!p || n == 0 || !center || !radius)
+        return gp_error_set(err, GP_ERR_INVALID, "min_enclosing_circle: need n >= 1 points");
+    if (!all_finite(p, n))
+        return gp_error_set(err, GP_ERR_INVALID, "min_enclosing_circle: non-finite point");
+    const gp_vec2 o = p[0];
+    size_t s = 1;
+    if (n > 2) {
+        s = (size_t)((double)n * 0.6180339887498949);
+        if (s < 1) s = 1;
+        while (gcd_sz(s, n) != 1) s++;
+    }
+#define PX(idx) (p[idx].x - o.x)
+#define PY(idx) (p[idx].y - o.y)
+    circ c = {0.0, 0.0, 0.0};
+    size_t pi = 0;
+    for (size_t i = 1; i < n; i++) {
+        pi += s;
+        if (pi >= n) pi -= n;
+        if (!circ_outside(&c, PX(pi), PY(pi))) continue;
+        c.x = PX(pi);
+        c.y = PY(pi);
+        c.r2 = 0.0;
+        size_t pj = 0;
+        for (size_t j = 0; j < i; j++, pj = (pj + s >= n ? pj + s - n : pj + s)) {
+            if (!circ_outside(&c, PX(pj), PY(pj))) continue;
+            c = circ2(PX(pi), PY(pi), PX(pj), PY(pj));
+            size_t pk = 0;
+            for (size_t k = 0; k < j; k++, pk = (pk + s >= n ? pk + s - n : pk + s)) {
+                if (!circ_outside(&c, PX(pk), PY(pk))) continue;
+                c = circ3(PX(pi), PY(pi), PX(pj), PY(pj), PX(pk), PY(pk));
+            }
+        }
+    }
+#undef PX
+#undef PY
+    center->x = o.x + c.x;
+    center->y = o.y + c.y;
+    *radius = sqrt(c.r2);
+    return GP_OK;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* maximum inscribed circle (pole of inaccessibility)                                          */
+
+typedef struct {
+    double x, y, h, d, max;
+    size_t e1; /* nearest edge of the centre: where the children start their scan */
+} mic_cell;
+
+/* The polygon relative to the reference vertex, stored twice over (2n edges) so that a scan of
+ * all n edges can start anywhere without wrapping. */
+typedef struct {
+    size_t n;
+    const double *x, *y;        /* 2n + 1 */
+    const double *dx, *dy, *il; /* 2n */
+} mic_poly;
+
+enum { MIC_BLOCK = 16, MIC_K = 4 };
+#define MIC_SQRT2 1.4142135623730951
+
+/* Signed distance from (px, py) to the boundary (> 0 inside), scanning the edges from s;
+ * near[0..MIC_K-1]: the nearest edges, nearest first. Gives up early, returning -INFINITY, as
+ * soon as some edge is within sqrt(thr2) (thr2 < 0: never). */
+static double mic_sdist(const mic_poly *P, double px, double py, size_t s, double thr2,
+                        size_t near[MIC_K])
+{
+    const size_t n = P->n;
+    const double *X = P->x + s, *Y = P->y + s, *DX = P->dx + s, *DY = P->dy + s, *IL = P->il + s;
+    int inside = 0;
+    double mk[MIC_K];
+    size_t ik[MIC_K];
+    for (int k = 0; k < MIC_K; k++) {
+        mk[k] = INFINITY;
+        ik[k] = 0;
+    }
+    for (size_t b = 0; b < n; b += MIC_BLOCK) {
+        size_t end = n - b < MIC_BLOCK ? n : b + MIC_BLOCK;
+        for (size_t i = b; i < end; i++) {
+            double ax = X[i], ay = Y[i], by = Y[i + 1], ddx = DX[i], ddy = DY[i];
+            if ((ay > py) != (by > py) && px < ax + ddx * (py - ay) / ddy) inside ^= 1;
+            double wx = px - ax, wy = py - ay;
+            double t = (wx * ddx + wy * ddy) * IL[i];
+            t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+            double ex = wx - t * ddx, ey = wy - t * ddy;
+            double d2 = ex * ex + ey * ey;
+            if (d2 < mk[MIC_K - 1]) {
+                int k = MIC_K - 1;
+                for (; k > 0 && d2 < mk[k - 1]; k--) {
+                    mk[k] = mk[k - 1];
+                    ik[k] = ik[k - 1];
+                }
+                mk[k] = d2;
+                ik[k] = i;
+            }
+        }
+        if (mk[0] <= thr2) return -INFINITY;
+    }
+    for (int k = 0; k < MIC_K; k++) near[k] = mk[k] < INFINITY ? (ik[k] + s) % n : (size_t)-1;
+    double d = sqrt(mk[0]);
+    return inside ? d : -d;
+}
+
+/* If, over the whole cell (centre x, y, half-side h), the distance to segment e equals the
+ * distance to its line (every corner projects inside the segment, all on one side), writes
+ * that distance as the affine function f(x + u, y + v) = g . (u, v) + f0 and returns 1. */
+static int mic_affine(const mic_poly *P, size_t e, double x, double y, double h, double g[2],
+                      double *f0)
+{
+    double ax = P->x[e], ay = P->y[e], dx = P->dx[e], dy = P->dy[e], il = P->il[e];
+    if (il == 0.0) return 0;
+    double len = sqrt(dx * dx + dy * dy), nx = -dy / len, ny = dx / len;
+    double sd = nx * (x - ax) + ny * (y - ay), sigma = sd >= 0.0 ? 1.0 : -1.0;
+    for (int k = 0; k < 4; k++) {
+        double qx = x + ((k & 1) ? h : -h) - ax, qy = y + ((k & 2) ? h : -h) - ay;
+        double t = (qx * dx + qy * dy) * il;
+        if (t < 0.0 || t > 1.0 || sigma * (nx * qx + ny * qy) < 0.0) return 0;
+    }
+    g[0] = sigma * nx;
+    g[1] = sigma * ny;
+    *f0 = sigma * sd;
+    return 1;
+}
+
+typedef struct {
+    int k;
+    double g[MIC_K][2], f0[MIC_K];
+    double best, bu, bv;
+} mic_lp;
+
+static void mic_lp_try(mic_lp *L, double h, double u, double v)
+{
+    double lim = h * (1.0 + 1e-12);
+    if (!(fabs(u) <= lim && fabs(v) <= lim)) return;
+    double m = INFINITY;
+    for (int i = 0; i < L->k; i++) {
+        double f = L->f0[i] + L->g[i][0] * u + L->g[i][1] * v;
+        if (f < m) m = f;
+    }
+    if (m > L->best) {
+        L->best = m;
+        L->bu = u;
+        L->bv = v;
+    }
+}
+
+/* A tighter bound than d + h sqrt 2, and a probe point. d(q) <= dist(q, e) for every edge e, so
+ * over the cell d <= min over the nearest edges that are affine there (see mic_affine) of their
+ * distances: a small LP, max over the square of a minimum of affine functions, attained at a
+ * corner, where a crease f_i = f_j meets a side, or where three functions are equal. Returns
+ * the bound (INFINITY if no nearest edge is affine over the cell) and its argmax in (*px, *py).
+ * (This is what stops a ridge between parallel edges, e.g. the axis of a rectangle, from being
+ * refined to the tolerance, and what lets a cell that holds the pole find it in one probe.) */
+static double mic_lp_bound(const mic_poly *P, double x, double y, double h,
+                           const size_t near[MIC_K], double *px, double *py)
+{
+    mic_lp L;
+    L.k = 0;
+    for (int i = 0; i < MIC_K; i++)
+        if (near[i] != (size_t)-1 && mic_affine(P, near[i], x, y, h, L.g[L.k], &L.f0[L.k])) L.k++;
+    if (L.k == 0) return INFINITY;
+    L.best = -INFINITY;
+    L.bu = L.bv = 0.0;
+    for (int k = 0; k < 4; k++) mic_lp_try(&L, h, (k & 1) ? h : -h, (k & 2) ? h : -h);
+    for (int i = 0; i < L.k; i++)
+        for (int j = i + 1; j < L.k; j++) {
+            /* crease a u + b v + c = 0 */
+            double a = L.g[i][0] - L.g[j][0], b = L.g[i][1] - L.g[j][1], c = L.f0[i] - L.f0[j];
+            if (fabs(b) > 1e-12) {
+                mic_lp_try(&L, h, h, -(c + a * h) / b);
+                mic_lp_try(&L, h, -h, -(c - a * h) / b);
+            }
+            if (fabs(a) > 1e-12) {
+                mic_lp_try(&L, h, -(c + b * h) / a, h);
+                mic_lp_try(&L, h, -(c - b * h) / a, -h);
+            }
+            for (int k = j + 1; k < L.k; k++) {
+                double a2 = L.g[i][0] - L.g[k][0], b2 = L.g[i][1] - L.g[k][1];
+                double c2 = L.f0[i] - L.f0[k];
+                double det = a * b2 - a2 * b;
+                if (fabs(det) > 1e-12)
+                    mic_lp_try(&L, h, (b * c2 - b2 * c) / det, (a2 * c - a * c2) / det);
+            }
+        }
+    *px = x + L.bu;
+    *py = y + L.bv;
+    return L.best;
+}
+
+typedef struct {
+    mic_cell *a;
+    size_t n, cap;
+} mic_heap;
+
+static int heap_push(mic_heap *H, mic_cell c)
+{
+    if (H->n == H->cap) {
+        size_t nc = H->cap ? 2 * H->cap : 256;
+        mic_cell *na = realloc(H->a, nc * sizeof *na);
+        if (!na) return -1;
+        H->a = na;
+        H->cap = nc;
+    }
+    size_t i = H->n++;
+    while (i > 0) {
+        size_t par = (i - 1) / 2;
+        if (H->a[par].max >= c.max) break;
+        H->a[i] = H->a[par];
+        i = par;
+    }
+    H->a[i] = c;
+    return 0;
+}
+
+static mic_cell heap_pop(mic_heap *H)
+{
+    mic_cell top = H->a[0], last = H->a[--H->n];
+    size_t i = 0, n = H->n;
+    for (;;) {
+        size_t c = 2 * i + 1;
+        if (c >= n) break;
+        if (c + 1 < n && H->a[c + 1].max > H->a[c].max) c++;
+        if (H->a[c].max <= last.max) break;
+        H->a[i] = H->a[c];
+        i = c;
+    }
+    if (n) H->a[i] = last;
+    return top;
+}
+
+static size_t mic_start(const mic_poly *P, size_t e)
+{
+    if (P->n <= MIC_BLOCK) return 0;
+    return (e + P->n - MIC_BLOCK / 2) % P->n;
+}
+
+/* Evaluates the cell centred at (x, y) with half-side h, updating *best with its centre and
+ * with its LP probe point. Returns 1 when the cell must be kept (its bound exceeds best + tol);
+ * 0 when it provably cannot hold a point better than best + tol. */
+static int mic_make(const mic_poly *P, double x, double y, double h, size_t start, double tol,
+                    mic_cell *best, mic_cell *c)
+{
+    c->x = x;
+    c->y = y;
+    c->h = h;
+    double thr = fmin(best->d, best->d + tol - h * MIC_SQRT2);
+    size_t near[MIC_K];
+    c->d = mic_sdist(P, x, y, mic_start(P, start), thr > 0.0 ? thr * thr : -1.0, near);
+    if (c->d == -INFINITY) return 0;
+    c->e1 = near[0];
+    c->max = c->d + h * MIC_SQRT2;
+    if (c->d > best->d) *best = *c;
+    if (h <= 0.0 || c->max - best->d <= tol) return c->max - best->d > tol;
+    double qx, qy;
+    double u = mic_lp_bound(P, x, y, h, near, &qx, &qy);
+    if (u < c->max) c->max = u;
+    if (u < INFINITY && c->max - best->d > tol) {
+        /* probe the LP's argmax: when the model is right this is the pole of the cell */
+        mic_cell q;
+        size_t nq[MIC_K];
+        double thq = best->d;
+        q.x = qx;
+        q.y = qy;
+        q.h = 0.0;
+        q.d = mic_sdist(P, qx, qy, mic_start(P, near[0]), thq > 0.0 ? thq * thq : -1.0, nq);
+        if (q.d > best->d) {
+            q.e1 = nq[0];
+            q.max = q.d;
+            *best = q;
+        }
+    }
+    return c->max - best->d > tol;
+}
+
+/* Guarantee: with exact distances the returned radius r satisfies r <= r_true <= r + tol.
+ * The signed distance to the boundary is 1-Lipschitz, so a square cell of half-side h centred
+ * at c holds no point farther than d(c) + h sqrt 2 from the boundary (nor farther than the LP
+ * bound of mic_lp_bound); the grid over the bounding box is refined until no cell's bound
+ * exceeds the best distance found by more than tol. Rounding adds about 1e-15 of the polygon's
+ * size. The centre returned is strictly inside. */
+gp_status gp_max_inscribed_circle(const gp_vec2 *p, size_t n, double tol, gp_vec2 *center,
+                                  double *radius, gp_error *err)
+{
+    if (!p || n < 3 || !center || !radius)
+        return gp_error_set(err, GP_ERR_INVALID, "max_inscribed_circle: need n >= 3 vertices");
+    if (!all_finite(p, n) || isnan(tol))
+        return gp_error_set(err, GP_ERR_INVALID, "max_inscribed_circle: non-finite input");
+    if (all_collinear(p, n))
+        return gp_error_set(err, GP_ERR_DEGENERATE, "max_inscribed_circle: polygon has no area");
+
+    const gp_vec2 o = p[0];
+    const size_t n2 = 2 * n;
+    double *buf = malloc((5 * n2 + 2) * sizeof *buf);
+    if (!buf) return gp_error_set(err, GP_ERR_NOMEM, "max_inscribed_circle: out of memory");
+    double *X = buf, *Y = X + n2 + 1, *DX = Y + n2 + 1, *DY = DX + n2, *IL = DY + n2;
+    for (size_t i = 0; i < n; i++) {
+        X[i] = X[i + n] = p[i].x - o.x;
+        Y[i] = Y[i + n] = p[i].y - o.y;
+    }
+    X[n2] = X[0];
+    Y[n2] = Y[0];
+    double x0 = X[0], x1 = X[0], y0 = Y[0], y1 = Y[0];
+    for (size_t i = 0; i < n; i++) {
+        DX[i] = DX[i + n] = X[i + 1] - X[i];
+        DY[i] = DY[i + n] = Y[i + 1] - Y[i];
+        double l2 = DX[i] * DX[i] + DY[i] * DY[i];
+        IL[i] = IL[i + n] = l2 > 0.0 ? 1.0 / l2 : 0.0;
+        x0 = fmin(x0, X[i]);
+        x1 = fmax(x1, X[i]);
+        y0 = fmin(y0, Y[i]);
+        y1 = fmax(y1, Y[i]);
+    }
+    mic_poly P = {n, X, Y, DX, DY, IL};
+    double w = x1 - x0, hgt = y1 - y0, size = fmax(w, hgt);
+    if (tol <= 0.0) tol = 1e-6 * size;
+    if (tol < 1e-13 * size) tol = 1e-13 * size;
+
+    /* initial grid: square cells of side min(w, h), but at most ~64 along the long side */
+    double cell = fmax(fmin(w, hgt), size / 64.0);
+    size_t nx = (size_t)ceil(w / cell), ny = (size_t)ceil(hgt / cell);
+    if (nx < 1) nx = 1;
+    if (ny < 1) ny = 1;
+    double hh = 0.5 * cell;
+
+    /* first guesses: the bounding-box centre and the area centroid */
+    mic_cell best, c;
+    best.d = -INFINITY;
+    best.x = best.y = 0.0;
+    best.e1 = 0;
+    mic_make(&P, 0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0, 0, tol, &best, &c);
+    gp_vec2 cen;
+    if (gp_poly_centroid(p, n, &cen, NULL) == GP_OK)
+        mic_make(&P, cen.x - o.x, cen.y - o.y, 0.0, best.e1, tol, &best, &c);
+
+    gp_status st = GP_OK;
+    mic_heap H = {NULL, 0, 0};
+    for (size_t ix = 0; ix < nx && st == GP_OK; ix++)
+        for (size_t iy = 0; iy < ny && st == GP_OK; iy++)
+            if (mic_make(&P, x0 + ((double)ix + 0.5) * cell, y0 + ((double)iy + 0.5) * cell, hh,
+                         best.e1, tol, &best, &c) &&
+                heap_push(&H, c))
+                st = GP_ERR_NOMEM;
+    size_t evals = 0;
+    const size_t max_evals = 4000000;
+    while (st == GP_OK && H.n > 0) {
+        mic_cell pc = heap_pop(&H);
+        if (pc.max - best.d <= tol) break; /* max-heap: no remaining cell can do better */
+        double h2 = 0.5 * pc.h;
+        for (int k = 0; k < 4 && st == GP_OK; k++)
+            if (mic_make(&P, pc.x + ((k & 1) ? h2 : -h2), pc.y + ((k & 2) ? h2 : -h2), h2, pc.e1,
+                         tol, &best, &c) &&
+                heap_push(&H, c))
+                st = GP_ERR_NOMEM;
+        if ((evals += 4) > max_evals) st = GP_ERR_NOT_CONVERGED;
+    }
+    free(H.a);
+    free(buf);
+    center->x = o.x + best.x;
+    center->y = o.y + best.y;
+    *radius = best.d;
+    if (st == GP_ERR_NOMEM) return gp_error_set(err, st, "max_inscribed_circle: out of memory");
+    if (st == GP_ERR_NOT_CONVERGED)
+        return gp_error_set(err, st, "max_inscribed_circle: cell budget exhausted before tol %g", tol);
+    if (!(best.d > 0.0))
+        return gp_error_set(err, GP_ERR_DEGENERATE, "max_inscribed_circle: no interior point found");
+    return GP_OK;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* minimum caliper width                                                                       */
+
+gp_status gp_min_caliper(const gp_vec2 *p, size_t n, double *width, double *angle_rad,
+                         double *length, gp_error *err)
+{
+    if (!p || n == 0) return gp_error_set(err, GP_ERR_INVALID, "min_caliper: need n >= 1 points");
+    if (!all_finite(p, n)) return gp_error_set(err, GP_ERR_INVALID, "min_caliper: non-finite vertex");
+    gp_vec2 *h = malloc(n * sizeof *h);
+    if (!h) return gp_error_set(err, GP_ERR_NOMEM, "min_caliper: out of memory");
+    size_t m = gp_convex_hull(p, n, h);
+    if (m < 3) {
+        free(h);
+        return gp_error_set(err, GP_ERR_DEGENERATE, "min_caliper: points are collinear");
+    }
+    const gp_vec2 o = h[0];
+    for (size_t i = 0; i < m; i++) {
+        h[i].x -= o.x;
+        h[i].y -= o.y;
+    }
+    /* rotating calipers: for edge i, the antipodal vertex j maximises cross(e_i, h[j] - h[i]) */
+    size_t j = 1, best_i = 0;
+    double best_w = INFINITY;
+    for (size_t i = 0; i < m; i++) {
+        size_t i1 = i + 1 == m ? 0 : i + 1;
+        double ex = h[i1].x - h[i].x, ey = h[i1].y - h[i].y;
+        double len = hypot(ex, ey);
+        double cur = ex * (h[j].y - h[i].y) - ey * (h[j].x - h[i].x);
+        for (size_t step = 0; step < m; step++) {
+            size_t j1 = j + 1 == m ? 0 : j + 1;
+            double nxt = ex * (h[j1].y - h[i].y) - ey * (h[j1].x - h[i].x);
+            if (nxt < cur) break;
+            cur = nxt;
+            j = j1;
+        }
+        double wd = cur / len;
+        if (wd < best_w) {
+            best_w = wd;
+            best_i = i;
+        }
+    }
+    /* re-measure the chosen edge in full, independently of the caliper bookkeeping */
+    size_t i1 = best_i + 1 == m ? 0 : best_i + 1;
+    double ex = h[i1].x - h[best_i].x, ey = h[i1].y - h[best_i].y;
+    double len = hypot(ex, ey), ux = ex / len, uy = ey / len;
+    double wmax = 0.0, lmin = INFINITY, lmax = -INFINITY;
+    for (size_t k = 0; k < m; k++) {
+        double rx = h[k].x - h[best_i].x, ry = h[k].y - h[best_i].y;
+        double cr = ux * ry - uy * rx, dt = ux * rx + uy * ry;
+        if (cr > wmax) wmax = cr;
+        if (dt < lmin) lmin = dt;
+        if (dt > lmax) lmax = dt;
+    }
+    free(h);
+    double ang = atan2(ey, ex);
+    if (ang <= -GP_PI / 2) ang += GP_PI;
+    else if (ang > GP_PI / 2) ang -= GP_PI;
+    if (ang <= -GP_PI / 2) ang = GP_PI / 2; /* guard rounding at the boundary */
+    if (width) *width = wmax;
+    if (angle_rad) *angle_rad = ang;
+    if (length) *length = lmax - lmin;
+    return GP_OK;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* simplicity, containment, overlap (exact predicates)                                        */
+
+/* index of the next edge after i (cyclically) that has non-zero length */
+static size_t next_edge(const gp_vec2 *p, size_t n, size_t i)
+{
+    for (size_t k = 1; k <= n; k++) {
+        size_t e = (i + k) % n;
+        if (!veq(p[e], p[(e + 1) % n])) return e;
+    }
+    return i;
+}
+
+static size_t prev_edge(const gp_vec2 *p, size_t n, size_t i)
+{
+    for (size_t k = 1; k <= n; k++) {
+        size_t e = (i + n - k) % n;
+        if (!veq(p[e], p[(e + 1) % n])) return e;
+    }
+    return i;
+}
+
+int gp_poly_is_simple(const gp_vec2 *p, size_t n)
+{
+    if (!p || n < 3 || !all_finite(p, n)) return 0;
+    size_t ne = 0;
+    for (size_t i = 0; i < n; i++)
+        if (!veq(p[i], p[(i + 1) % n])) ne++;
+    if (ne < 3) return 0;
+    for (size_t i = 0; i < n; i++) {
+        gp_vec2 a = p[i], b = p[(i + 1) % n];
+        if (veq(a, b)) continue;
+        size_t ni = next_edge(p, n, i), pi = prev_edge(p, n, i);
+        gp_vec2 c = p[(ni + 1) % n];
+        /* the next edge folds back onto this one */
+        if (orient(a, b, c) == 0 && (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y) < 0.0)
+            return 0;
+        for (size_t j = i + 1; j < n; j++) {
+            gp_vec2 d0 = p[j], d1 = p[(j + 1) % n];
+            if (veq(d0, d1) || j == ni || j == pi) continue;
+            if (seg_intersect(a, b, d0, d1)) return 0;
+        }
+    }
+    return 1;
+}
+
+enum { BF_CROSS = 1, BF_IN = 2, BF_OUT = 4 };
+
+static inline double seg_param(gp_vec2 u, gp_vec2 v, gp_vec2 q)
+{
+    double dx = v.x - u.x, dy = v.y - u.y;
+    double t = ((q.x - u.x) * dx + (q.y - u.y) * dy) / (dx * dx + dy * dy);
+    return t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+}
+
+/* Segment u->v (non-degenerate) against the boundary of b. Returns 1 on a proper crossing.
+ * Otherwise sets *touch if the boundary meets the closed segment anywhere, and *tnext to the
+ * smallest contact parameter (in (t0, 1)) of a contact point or of an end of a collinear
+ * overlap, or 1 if none. If covered is non-NULL, sets it when a collinear edge of b covers the
+ * parameter tm. */
+static int seg_events(gp_vec2 u, gp_vec2 v, const gp_vec2 *b, size_t nb, double t0, double tm,
+                      int *touch, double *tnext, int *covered)
+{
+    double xlo = fmin(u.x, v.x), xhi = fmax(u.x, v.x), ylo = fmin(u.y, v.y), yhi = fmax(u.y, v.y);
+    double tn = 1.0;
+    for (size_t i = 0, j = nb - 1; i < nb; j = i++) {
+        gp_vec2 c = b[j], d = b[i];
+        if (veq(c, d)) continue;
+        if (fmax(c.x, d.x) < xlo || fmin(c.x, d.x) > xhi || fmax(c.y, d.y) < ylo ||
+            fmin(c.y, d.y) > yhi)
+            continue;
+        int o1 = orient(u, v, c), o2 = orient(u, v, d);
+        if (o1 * o2 > 0) continue;
+        int o3 = orient(c, d, u), o4 = orient(c, d, v);
+        if (o3 * o4 > 0) continue;
+        if (o1 && o2 && o3 && o4) return 1;
+        *touch = 1;
+        double ev[4];
+        int ne = 0;
+        if (o1 == 0 && o2 == 0) {
+            double tc = seg_param(u, v, c), td = seg_param(u, v, d);
+            double lo = fmin(tc, td), hi = fmax(tc, td);
+            ev[ne++] = lo;
+            ev[ne++] = hi;
+            if (covered && lo <= tm && tm <= hi && lo < hi) *covered = 1;
+        } else {
+            if (o1 == 0) ev[ne++] = seg_param(u, v, c);
+            if (o2 == 0) ev[ne++] = seg_param(u, v, d);
+        }
+        for (int k = 0; k < ne; k++)
+            if (ev[k] > t0 && ev[k] < tn) tn = ev[k];
+    }
+    *tnext = tn;
+    return 0;
+}
+
+/* Where the boundary of a lies relative to b: BF_CROSS (proper crossing), BF_IN (some point of
+ * it strictly inside b), BF_OUT (some point strictly outside b). Stops as soon as a flag in
+ * stop is set. */
+static int boundary_flags(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t nb, int stop)
+{
+    int f = 0;
+    for (size_t i = 0; i < na; i++) {
+        int c = point_class(b, nb, a[i]);
+        f |= c > 0 ? BF_IN : (c < 0 ? BF_OUT : 0);
+        if (f & stop) return f;
+    }
+    for (size_t i = 0; i < na; i++) {
+        gp_vec2 u = a[i], v = a[(i + 1) % na];
+        if (veq(u, v)) continue;
+        int touch = 0, cov = 0;
+        double tn;
+        if (seg_events(u, v, b, nb, 0.0, -1.0, &touch, &tn, NULL)) return f | BF_CROSS;
+        if (!touch) continue; /* no contact: the edge is on the side of its end points */
+        double t0 = 0.0;
+        for (;;) {
+            double tm = 0.5 * (t0 + tn);
+            cov = 0;
+            double dummy;
+            int tch = 0;
+            seg_events(u, v, b, nb, t0, tm, &tch, &dummy, &cov);
+            if (!cov) {
+                gp_vec2 q = {u.x + tm * (v.x - u.x), u.y + tm * (v.y - u.y)};
+                int c = point_class(b, nb, q);
+                f |= c > 0 ? BF_IN : (c < 0 ? BF_OUT : 0);
+                if (f & stop) return f;
+            }
+            if (tn >= 1.0) break;
+            t0 = tn;
+            seg_events(u, v, b, nb, t0, -1.0, &tch, &tn, NULL);
+        }
+    }
+    return f;
+}
+
+int gp_poly_inside_poly(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t nb)
+{
+    if (!a || !b || na == 0 || nb < 3 || !all_finite(a, na) || !all_finite(b, nb)) return 0;
+    double ax0, ay0, ax1, ay1, bx0, by0, bx1, by1;
+    bbox_of(a, na, &ax0, &ay0, &ax1, &ay1);
+    bbox_of(b, nb, &bx0, &by0, &bx1, &by1);
+    if (ax0 < bx0 || ay0 < by0 || ax1 > bx1 || ay1 > by1) return 0;
+    int f = boundary_flags(a, na, b, nb, BF_CROSS | BF_OUT);
+    return (f & (BF_CROSS | BF_OUT)) ? 0 : 1;
+}
+
+int gp_poly_overlap(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t nb)
+{
+    if (!a || !b || na < 3 || nb < 3 || !all_finite(a, na) || !all_finite(b, nb)) return 0;
+    double ax0, ay0, ax1, ay1, bx0, by0, bx1, by1;
+    bbox_of(a, na, &ax0, &ay0, &ax1, &ay1);
+    bbox_of(b, nb, &bx0, &by0, &bx1, &by1);
+    if (ax1 <= bx0 || bx1 <= ax0 || ay1 <= by0 || by1 <= ay0) return 0;
+    if (all_collinear(a, na) || all_collinear(b, nb)) return 0; /* no interior */
+    int fa = boundary_flags(a, na, b, nb, BF_CROSS | BF_IN);
+    if (fa & (BF_CROSS | BF_IN)) return 1;
+    int fb = boundary_flags(b, nb, a, na, BF_IN);
+    if (fb & BF_IN) return 1;
+    /* the boundary of a lies on the boundary of b: the same region */
+    return (fa & BF_OUT) ? 0 : 1;
+}
