@@ -108,9 +108,23 @@ static pthread_key_t conn_key;
 static int closed = 0; /* guarded by path_mu */
 static pthread_mutex_t path_mu = PTHREAD_MUTEX_INITIALIZER;
 
+/* A thread's connection and its prepared statements, cached by SQL text address (every SQL
+ * string here is a literal), so that a status poll costs one sqlite3_step. */
+#define STMT_CACHE 24
+typedef struct conn_t {
+    sqlite3 *db;
+    int n;
+    const char *sql[STMT_CACHE];
+    sqlite3_stmt *st[STMT_CACHE];
+} conn_t;
+
 static void conn_destroy(void *p)
 {
-    if (p) sqlite3_close_v2((sqlite3 *)p);
+    conn_t *c = p;
+    if (!c) return;
+    for (int i = 0; i < c->n; i++) sqlite3_finalize(c->st[i]);
+    sqlite3_close_v2(c->db);
+    free(c);
 }
 
 static const char *SCHEMA_SQL =
@@ -161,13 +175,26 @@ static sqlite3 *conn_open(void)
     return db;
 }
 
+static conn_t *conn_t_get(void)
+{
+    conn_t *c = pthread_getspecific(conn_key);
+    if (c) return c;
+    sqlite3 *db = conn_open();
+    if (!db) return NULL;
+    c = calloc(1, sizeof *c);
+    if (!c) {
+        sqlite3_close_v2(db);
+        return NULL;
+    }
+    c->db = db;
+    pthread_setspecific(conn_key, c);
+    return c;
+}
+
 static sqlite3 *conn(void)
 {
-    sqlite3 *db = pthread_getspecific(conn_key);
-    if (db) return db;
-    db = conn_open();
-    if (db) pthread_setspecific(conn_key, db);
-    return db;
+    conn_t *c = conn_t_get();
+    return c ? c->db : NULL;
 }
 
 int store_open(const char *path)
@@ -198,9 +225,9 @@ int store_open(const char *path)
 
 void store_thread_done(void)
 {
-    sqlite3 *db = pthread_getspecific(conn_key);
-    if (db) {
-        sqlite3_close_v2(db);
+    conn_t *c = pthread_getspecific(conn_key);
+    if (c) {
+        conn_destroy(c);
         pthread_setspecific(conn_key, NULL);
     }
 }
@@ -217,14 +244,39 @@ void store_close(void)
 
 /* ------------------------------------------------------------------ helpers */
 
+/* A prepared statement for sql (a string literal) on this thread's connection db; give it
+ * back with done(). */
 static sqlite3_stmt *prep(sqlite3 *db, const char *sql)
 {
+    conn_t *c = pthread_getspecific(conn_key);
+    if (c && c->db == db)
+        for (int i = 0; i < c->n; i++)
+            if (c->sql[i] == sql) return c->st[i];
     sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK) {
+    if (sqlite3_prepare_v3(db, sql, -1, SQLITE_PREPARE_PERSISTENT, &st, NULL) != SQLITE_OK) {
         gpd_log(GPD_LOG_ERROR, "sqlite prepare: %s (%s)", sqlite3_errmsg(db), sql);
         return NULL;
     }
+    if (c && c->db == db && c->n < STMT_CACHE) {
+        c->sql[c->n] = sql;
+        c->st[c->n++] = st;
+    }
     return st;
+}
+
+/* Resets a statement from prep() (finalizes it when it is not cached). */
+static void done(sqlite3_stmt *st)
+{
+    if (!st) return;
+    conn_t *c = pthread_getspecific(conn_key);
+    if (c)
+        for (int i = 0; i < c->n; i++)
+            if (c->st[i] == st) {
+                sqlite3_reset(st);
+                sqlite3_clear_bindings(st);
+                return;
+            }
+    sqlite3_finalize(st);
 }
 
 static void bind_text(sqlite3_stmt *st, int i, const char *s)
@@ -313,8 +365,8 @@ int store_recover(int *requeued, int *failed)
             }
         }
     }
-    sqlite3_finalize(a);
-    sqlite3_finalize(b);
+    done(a);
+    done(b);
     sqlite3_exec(db, rc == 0 ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL);
     return rc;
 }
@@ -334,7 +386,7 @@ store_rc store_insert(const char *kind, const char *spec_json, char id_out[33])
     bind_text(st, 3, spec_json);
     bind_text(st, 4, now);
     int rc = step_done(db, st);
-    sqlite3_finalize(st);
+    done(st);
     return rc == 0 ? STORE_OK : STORE_ERROR;
 }
 
@@ -356,7 +408,7 @@ json_t *store_get_job(const char *id, store_rc *rc)
     } else {
         gpd_log(GPD_LOG_ERROR, "sqlite get: %s", sqlite3_errmsg(db));
     }
-    sqlite3_finalize(st);
+    done(st);
     return j;
 }
 
@@ -393,7 +445,7 @@ store_rc store_get_text(const char *id, const char *column, char **text, char st
     } else {
         gpd_log(GPD_LOG_ERROR, "sqlite get %s: %s", column, sqlite3_errmsg(db));
     }
-    sqlite3_finalize(st);
+    done(st);
     return rc;
 }
 
@@ -409,7 +461,7 @@ json_t *store_list(const char *status, int limit, const char *after, store_rc *r
         bind_text(q, 1, after);
         int s = sqlite3_step(q);
         if (s == SQLITE_ROW) after_seq = sqlite3_column_int64(q, 0);
-        sqlite3_finalize(q);
+        done(q);
         if (s == SQLITE_DONE) {
             *rc = STORE_NOT_FOUND;
             return NULL;
@@ -437,7 +489,7 @@ json_t *store_list(const char *status, int limit, const char *after, store_rc *r
         json_array_append_new(jobs, job_from_row(st));
         n++;
     }
-    sqlite3_finalize(st);
+    done(st);
     if (s != SQLITE_ROW && s != SQLITE_DONE) {
         gpd_log(GPD_LOG_ERROR, "sqlite list: %s", sqlite3_errmsg(db));
         json_decref(jobs);
@@ -467,7 +519,7 @@ store_rc store_counts(long *queued, long *running, long *succeeded, long *failed
         else if (!strcmp(k, "failed")) f = n;
         else if (!strcmp(k, "cancelled")) c = n;
     }
-    sqlite3_finalize(st);
+    done(st);
     if (s != SQLITE_DONE) return STORE_ERROR;
     if (queued) *queued = q;
     if (running) *running = r;
@@ -512,7 +564,7 @@ store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts)
         rc = STORE_NOT_FOUND;
     }
     if (rc == STORE_ERROR) gpd_log(GPD_LOG_ERROR, "sqlite claim: %s", sqlite3_errmsg(db));
-    sqlite3_finalize(st);
+    done(st);
     return rc;
 }
 
@@ -529,7 +581,7 @@ static store_rc update_running(const char *sql, const char *id, const char *a, c
     if (np >= 3) bind_text(st, 3, b);
     if (np >= 4) bind_text(st, 4, c);
     int rc = step_done(db, st);
-    sqlite3_finalize(st);
+    done(st);
     if (rc) return STORE_ERROR;
     return sqlite3_changes(db) > 0 ? STORE_OK : STORE_CONFLICT;
 }
@@ -607,8 +659,8 @@ store_rc store_cancel(const char *id, int *was_running, char status_out[16])
             }
         }
     }
-    sqlite3_finalize(q);
-    sqlite3_finalize(u);
+    done(q);
+    done(u);
     if (sqlite3_exec(db, rc == STORE_OK ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK &&
         rc == STORE_OK) {
         gpd_log(GPD_LOG_ERROR, "sqlite cancel commit: %s", sqlite3_errmsg(db));
