@@ -37,6 +37,7 @@
 
 static struct MHD_Daemon *daemon_ = NULL;
 static size_t max_body = 1 << 20;
+static double max_result_mb = 1024;
 static double started_at = 0;
 
 /* ------------------------------------------------------------------ per-request state */
@@ -282,6 +283,34 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
                           "/kind: \"spheres-3d\" is not available in this build yet");
     }
 #endif
+    if (!strcmp(kind, "fourier-voronoi-2d")) {
+        /* bound the memory of one job: estimate the result's size from the spec */
+        double n = (double)json_integer_value(json_object_get(eff, "particles"));
+        double np = (double)json_integer_value(json_object_get(eff, "contour_points"));
+        if (np <= 0) np = 128;
+        double per = 400; /* stats, ids, areas, descriptors */
+        json_t *outs = json_object_get(eff, "outputs");
+        size_t k;
+        json_t *o;
+        json_array_foreach(outs, k, o)
+        {
+            const char *w = json_string_value(o);
+            if (!w) continue;
+            if (!strcmp(w, "grains")) per += 40 * np;
+            else if (!strcmp(w, "odec")) per += 40 * np + 60 * 16;
+            else if (!strcmp(w, "descriptors")) per += 40 * np + 120;
+            else if (!strcmp(w, "cells")) per += 40 * 12 + 100;
+        }
+        double mb = n * per / 1e6;
+        if (mb > max_result_mb) {
+            json_decref(eff);
+            return send_error(c, r, 422, "too_large", "/particles",
+                              "/particles: the result would be about %.0f MB, over this "
+                              "server's limit of %.0f MB (--max-result-mb); ask for fewer "
+                              "particles, contour_points or outputs",
+                              mb, max_result_mb);
+        }
+    }
     char *text = json_dumps(eff, JSON_COMPACT);
     char id[33];
     store_rc rc = text ? store_insert(kind, text, id) : STORE_ERROR;
@@ -745,6 +774,7 @@ bad:
 int gpd_http_start(const gpd_http_config *cfg)
 {
     max_body = cfg->max_body;
+    if (cfg->max_result_mb > 0) max_result_mb = cfg->max_result_mb;
     started_at = gpd_monotonic_s();
     unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_ERROR_LOG | MHD_USE_AUTO | MHD_USE_ITC;
     daemon_ = MHD_start_daemon(

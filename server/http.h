@@ -27,6 +27,7 @@ typedef struct gpd_http_config {
     unsigned max_connections;    /* connection limit */
     unsigned timeout_s;          /* idle timeout per connection */
     size_t max_body;             /* request body limit in bytes (413 above) */
+    double max_result_mb;        /* specs whose estimated result is larger get 422 too_large */
 } gpd_http_config;
 
 /* Parses "HOST:PORT" ("[v6]:PORT", ":PORT" = 127.0.0.1), binds and listens. Returns the fd

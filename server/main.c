@@ -61,6 +61,9 @@ static void usage(FILE *f)
             "                         (default 30)\n"
             "  --max-body BYTES       request body limit, 413 above [GRAINPACK_MAX_BODY]\n"
             "                         (default 1048576)\n"
+            "  --max-result-mb MB     refuse (422 too_large) a spec whose result would be\n"
+            "                         larger, which bounds one job's memory\n"
+            "                         [GRAINPACK_MAX_RESULT_MB] (default 1024)\n"
             "  --version              print the version and exit\n"
             "  --help                 this text\n"
             "\n"
@@ -105,16 +108,18 @@ int main(int argc, char **argv)
     const char *maxconn_s = env_or("GRAINPACK_MAX_CONNECTIONS", "1024");
     const char *timeout_s = env_or("GRAINPACK_TIMEOUT", "30");
     const char *maxbody_s = env_or("GRAINPACK_MAX_BODY", "1048576");
+    const char *maxres_s = env_or("GRAINPACK_MAX_RESULT_MB", "1024");
 
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},       {"db", required_argument, 0, 'd'},
         {"workers", required_argument, 0, 'w'},      {"log-level", required_argument, 0, 'L'},
         {"http-threads", required_argument, 0, 't'}, {"max-connections", required_argument, 0, 'c'},
         {"timeout", required_argument, 0, 'T'},      {"max-body", required_argument, 0, 'b'},
+        {"max-result-mb", required_argument, 0, 'R'},
         {"help", no_argument, 0, 'h'},               {"version", no_argument, 0, 'V'},
         {0, 0, 0, 0}};
     int ch;
-    while ((ch = getopt_long(argc, argv, "l:d:w:L:t:c:T:b:hV", opts, NULL)) != -1) {
+    while ((ch = getopt_long(argc, argv, "l:d:w:L:t:c:T:b:R:hV", opts, NULL)) != -1) {
         switch (ch) {
         case 'l': listen_s = optarg; break;
         case 'd': db = optarg; break;
@@ -124,6 +129,7 @@ int main(int argc, char **argv)
         case 'c': maxconn_s = optarg; break;
         case 'T': timeout_s = optarg; break;
         case 'b': maxbody_s = optarg; break;
+        case 'R': maxres_s = optarg; break;
         case 'h': usage(stdout); return 0;
         case 'V': printf("grainpackd %s\n", GPD_VERSION); return 0;
         default: usage(stderr); return 2;
@@ -134,12 +140,13 @@ int main(int argc, char **argv)
         usage(stderr);
         return 2;
     }
-    long nworkers, nthreads, maxconn, timeout, maxbody;
+    long nworkers, nthreads, maxconn, timeout, maxbody, maxres;
     if (parse_long("--workers", workers_s, 1, 1024, &nworkers) ||
         parse_long("--http-threads", threads_s, 1, 256, &nthreads) ||
         parse_long("--max-connections", maxconn_s, 1, 1000000, &maxconn) ||
         parse_long("--timeout", timeout_s, 1, 86400, &timeout) ||
-        parse_long("--max-body", maxbody_s, 1024, 1L << 30, &maxbody))
+        parse_long("--max-body", maxbody_s, 1024, 1L << 30, &maxbody) ||
+        parse_long("--max-result-mb", maxres_s, 1, 1L << 20, &maxres))
         return 2;
     int level = gpd_log_parse_level(level_s);
     if (level < 0) {
@@ -189,7 +196,8 @@ int main(int argc, char **argv)
                            .threads = (unsigned)nthreads,
                            .max_connections = (unsigned)maxconn,
                            .timeout_s = (unsigned)timeout,
-                           .max_body = (size_t)maxbody};
+                           .max_body = (size_t)maxbody,
+                           .max_result_mb = (double)maxres};
     if (gpd_http_start(&cfg) != 0) {
         close(fd);
         workers_stop();

@@ -35,6 +35,8 @@ def test_spec_errors(env):
         ("unknown nested field", dict(base, imc={"error": "E3", "speed": 2}), 422,
          "invalid_spec", "/imc/speed"),
         ("bad enum", dict(base, imc={"error": "E9"}), 422, "invalid_spec", "/imc/error"),
+        ("result too large", dict(base, particles=1000000, contour_points=512), 422,
+         "too_large", "/particles"),
     ]
     for name, body, status, code, pointer in cases:
         raw = body if isinstance(body, bytes) else json.dumps(body).encode()
