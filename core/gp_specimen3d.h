@@ -99,7 +99,8 @@ typedef struct gp_stats3d {
     double coordination_number;  /* mean contacts per sphere, wall contacts counted (a wall
                                     contact becomes a sphere contact when flipped) */
     double coordination_spheres; /* the same counting sphere-sphere contacts only */
-    double fabric[3][3];         /* Eq. 14 over all contacts (walls included); GP_OUT3_FABRIC */
+    double fabric[3][3];         /* Eq. 14 over the spheres' contacts (a pair counted by both
+                                    spheres, a wall contact by one: flip-invariant); GP_OUT3_FABRIC */
     double stress[3][3];         /* Eq. 15, Pa, compression positive, V = the box; GP_OUT3_STRESS */
     gp_psd3d psd;
     size_t particles;            /* spheres in the final packing */

@@ -1,0 +1,794 @@
+/* gp_dem3d.c -- see gp_dem3d.h. */
+#include "gp_dem3d.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+#define BLK 64          /* spheres per reduction block (fixed: results do not depend on threads) */
+#define SERVO_GAIN 0.25 /* fraction of Eq. 10's displacement applied per step */
+
+typedef struct blk_acc {
+    double sum_f, sum_fn, ke, vmax2, disp2;
+    double wf[6], wk[6];
+    size_t wn;
+    size_t nc;
+    int bad;
+} blk_acc;
+
+struct gp_dem3d;
+typedef void (*job_fn)(struct gp_dem3d *d, int tid, int nt);
+
+typedef struct pool {
+    int nt;
+    pthread_t *th;
+    pthread_mutex_t mu;
+    pthread_cond_t cv_start, cv_done;
+    unsigned gen;
+    int pending, quit, started;
+    job_fn fn;
+    struct gp_dem3d *d;
+} pool;
+
+typedef struct worker_arg {
+    pool *p;
+    int tid;
+} worker_arg;
+
+struct gp_dem3d {
+    size_t n;
+    double *x, *v, *w;         /* 3n */
+    double *r0, *r;            /* full and current radii */
+    double *m, *minv, *iinv;   /* true mass; inverse inertial mass and moment */
+    double *xref;              /* positions at the last rebuild */
+    double rscale, rscale_ref, r0max, r0min;
+    double E, ks_kn, tanphi, damping, g[3], dt, skin;
+    double wall[6];            /* positions: lo x, hi x, lo y, hi y, lo z, hi z */
+    double servo_f[6], servo_v[6], servo_lim[6];
+    double wall_f[6], wall_k[6];
+    size_t wall_n;
+    /* candidate pairs (i < j), sorted */
+    size_t np, pcap;
+    uint32_t *pi, *pj;
+    double *pfs, *pF, *pc, *pfn; /* shear spring (3), force on i (3), n x fs (3), f_n */
+    /* per-sphere pair lists: entries (pair << 1) | (sphere is j) */
+    size_t *off;
+    size_t *adj;
+    /* cells */
+    size_t ncell_cap;
+    size_t *cstart, *cell_of, *clist;
+    /* blocks */
+    size_t nblk;
+    blk_acc *blk;
+    /* status */
+    long steps, rebuilds;
+    double time, stability, kinetic, vmax;
+    size_t ncontacts;
+    int need_rebuild;
+    pool pool;
+    worker_arg *wargs;
+};
+
+/* ------------------------------------------------------------------ thread pool */
+
+static void *worker_main(void *arg)
+{
+    worker_arg *wa = arg;
+    pool *p = wa->p;
+    unsigned seen = 0;
+    for (;;) {
+        pthread_mutex_lock(&p->mu);
+        while (p->gen == seen && !p->quit)
+            pthread_cond_wait(&p->cv_start, &p->mu);
+        if (p->quit) {
+            pthread_mutex_unlock(&p->mu);
+            return NULL;
+        }
+        seen = p->gen;
+        job_fn fn = p->fn;
+        struct gp_dem3d *d = p->d;
+        pthread_mutex_unlock(&p->mu);
+        fn(d, wa->tid, p->nt);
+        pthread_mutex_lock(&p->mu);
+        if (--p->pending == 0)
+            pthread_cond_signal(&p->cv_done);
+        pthread_mutex_unlock(&p->mu);
+    }
+}
+
+static void run_job(gp_dem3d *d, job_fn fn)
+{
+    pool *p = &d->pool;
+    if (p->nt <= 1 || !p->started) {
+        fn(d, 0, 1);
+        return;
+    }
+    pthread_mutex_lock(&p->mu);
+    p->fn = fn;
+    p->d = d;
+    p->pending = p->nt - 1;
+    p->gen++;
+    pthread_cond_broadcast(&p->cv_start);
+    pthread_mutex_unlock(&p->mu);
+    fn(d, 0, p->nt);
+    pthread_mutex_lock(&p->mu);
+    while (p->pending > 0)
+        pthread_cond_wait(&p->cv_done, &p->mu);
+    pthread_mutex_unlock(&p->mu);
+}
+
+static int pool_start(gp_dem3d *d, int nt)
+{
+    pool *p = &d->pool;
+    p->nt = nt < 1 ? 1 : nt;
+    if (p->nt == 1)
+        return 0;
+    pthread_mutex_init(&p->mu, NULL);
+    pthread_cond_init(&p->cv_start, NULL);
+    pthread_cond_init(&p->cv_done, NULL);
+    p->th = calloc((size_t)p->nt, sizeof *p->th);
+    d->wargs = calloc((size_t)p->nt, sizeof *d->wargs);
+    if (!p->th || !d->wargs)
+        return -1;
+    p->started = 1;
+    for (int t = 1; t < p->nt; t++) {
+        d->wargs[t].p = p;
+        d->wargs[t].tid = t;
+        if (pthread_create(&p->th[t], NULL, worker_main, &d->wargs[t]) != 0) {
+            p->nt = t; /* run with the threads we have */
+            break;
+        }
+    }
+    return 0;
+}
+
+static void pool_stop(gp_dem3d *d)
+{
+    pool *p = &d->pool;
+    if (!p->started)
+        return;
+    pthread_mutex_lock(&p->mu);
+    p->quit = 1;
+    pthread_cond_broadcast(&p->cv_start);
+    pthread_mutex_unlock(&p->mu);
+    for (int t = 1; t < p->nt; t++)
+        pthread_join(p->th[t], NULL);
+    pthread_mutex_destroy(&p->mu);
+    pthread_cond_destroy(&p->cv_start);
+    pthread_cond_destroy(&p->cv_done);
+    free(p->th);
+    free(d->wargs);
+    p->started = 0;
+}
+
+/* ------------------------------------------------------------------ create / destroy */
+
+void gp_dem3d_params_defaults(gp_dem3d_params *p)
+{
+    memset(p, 0, sizeof *p);
+    p->density = 2600;
+    p->young = 15e6;
+    p->ks_kn = 0.5;
+    p->friction_deg = 18;
+    p->damping = 0.2;
+    p->gravity[2] = -9.81;
+    p->dt_safety = 0.2;
+    p->threads = 1;
+}
+
+void gp_dem3d_destroy(gp_dem3d *d)
+{
+    if (!d)
+        return;
+    pool_stop(d);
+    free(d->x); free(d->v); free(d->w); free(d->r0); free(d->r);
+    free(d->m); free(d->minv); free(d->iinv); free(d->xref);
+    free(d->pi); free(d->pj); free(d->pfs); free(d->pF); free(d->pc); free(d->pfn);
+    free(d->off); free(d->adj);
+    free(d->cstart); free(d->cell_of); free(d->clist);
+    free(d->blk);
+    free(d);
+}
+
+gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n,
+                          const double lo[3], const double hi[3], gp_dem3d **out, gp_error *err)
+{
+    *out = NULL;
+    if (!p || !xyzr || !lo || !hi)
+        return gp_error_set(err, GP_ERR_INVALID, "dem3d: NULL argument");
+    if (n == 0 || n > UINT32_MAX / 2)
+        return gp_error_set(err, GP_ERR_INVALID, "dem3d: sphere count %zu out of range", n);
+    if (!(p->density > 0) || !(p->young > 0) || !(p->ks_kn >= 0) || !(p->friction_deg >= 0)
+        || !(p->friction_deg < 90) || !(p->damping >= 0) || !(p->damping < 1))
+        return gp_error_set(err, GP_ERR_INVALID, "dem3d: material out of range");
+    for (int a = 0; a < 3; a++)
+        if (!isfinite(lo[a]) || !isfinite(hi[a]) || !(hi[a] > lo[a]) || !isfinite(p->gravity[a]))
+            return gp_error_set(err, GP_ERR_INVALID, "dem3d: box axis %d is empty", a);
+    gp_dem3d *d = calloc(1, sizeof *d);
+    if (!d)
+        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory");
+    d->n = n;
+    d->x = malloc(3 * n * sizeof *d->x);
+    d->v = calloc(3 * n, sizeof *d->v);
+    d->w = calloc(3 * n, sizeof *d->w);
+    d->xref = malloc(3 * n * sizeof *d->xref);
+    d->r0 = malloc(n * sizeof *d->r0);
+    d->r = malloc(n * sizeof *d->r);
+    d->m = malloc(n * sizeof *d->m);
+    d->minv = malloc(n * sizeof *d->minv);
+    d->iinv = malloc(n * sizeof *d->iinv);
+    d->off = calloc(n + 1, sizeof *d->off);
+    d->cell_of = malloc(n * sizeof *d->cell_of);
+    d->clist = malloc(n * sizeof *d->clist);
+    d->nblk = (n + BLK - 1) / BLK;
+    d->blk = calloc(d->nblk, sizeof *d->blk);
+    if (!d->x || !d->v || !d->w || !d->xref || !d->r0 || !d->r || !d->m || !d->minv || !d->iinv
+        || !d->off || !d->cell_of || !d->clist || !d->blk) {
+        gp_dem3d_destroy(d);
+        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (%zu spheres)", n);
+    }
+    d->r0min = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        const double *s = xyzr + 4 * i;
+        if (!isfinite(s[0]) || !isfinite(s[1]) || !isfinite(s[2]) || !(s[3] > 0) || !isfinite(s[3])) {
+            gp_dem3d_destroy(d);
+            return gp_error_set(err, GP_ERR_INVALID, "dem3d: sphere %zu is not finite or has r <= 0", i);
+        }
+        for (int a = 0; a < 3; a++)
+            d->x[3 * i + a] = s[a];
+        d->r0[i] = d->r[i] = s[3];
+        if (s[3] > d->r0max) d->r0max = s[3];
+        if (s[3] < d->r0min) d->r0min = s[3];
+    }
+    d->E = p->young;
+    d->ks_kn = p->ks_kn;
+    d->tanphi = tan(p->friction_deg * M_PI / 180);
+    d->damping = p->damping;
+    memcpy(d->g, p->gravity, sizeof d->g);
+    d->rscale = d->rscale_ref = 1;
+    d->skin = p->skin > 0 ? p->skin : 0.2 * d->r0min;
+    for (int a = 0; a < 3; a++) {
+        d->wall[2 * a] = lo[a];
+        d->wall[2 * a + 1] = hi[a];
+    }
+    /* masses and the time step (density scaling, see the header) */
+    double safety = p->dt_safety > 0 ? p->dt_safety : 0.2;
+    double rs = p->scaled_radius > 0 ? p->scaled_radius : 0;
+    double tmin = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        double r = d->r0[i];
+        double m = 4.0 / 3.0 * M_PI * r * r * r * p->density;
+        double mi = m;
+        if (rs > r) {
+            double ms = 4.0 / 3.0 * M_PI * rs * rs * rs * p->density;
+            mi = ms * r / rs; /* sqrt(mi / (2 E r)) = sqrt(ms / (2 E rs)) */
+        }
+        d->m[i] = m;
+        d->minv[i] = 1.0 / mi;
+        d->iinv[i] = 1.0 / (0.4 * mi * r * r);
+        double t = sqrt(mi / (2 * d->E * r));
+        if (t < tmin) tmin = t;
+    }
+    d->dt = safety * tmin;
+    for (int w = 0; w < 6; w++)
+        d->servo_lim[w] = NAN;
+    d->need_rebuild = 1;
+    d->stability = HUGE_VAL;
+    if (pool_start(d, p->threads) != 0) {
+        gp_dem3d_destroy(d);
+        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: cannot start threads");
+    }
+    *out = d;
+    return GP_OK;
+}
+
+size_t gp_dem3d_count(const gp_dem3d *d) { return d->n; }
+double gp_dem3d_dt(const gp_dem3d *d) { return d->dt; }
+void gp_dem3d_set_friction(gp_dem3d *d, double deg) { d->tanphi = tan(deg * M_PI / 180); }
+void gp_dem3d_set_damping(gp_dem3d *d, double c) { d->damping = c; }
+double gp_dem3d_wall(const gp_dem3d *d, int w) { return d->wall[w]; }
+
+void gp_dem3d_set_radius_scale(gp_dem3d *d, double s)
+{
+    d->rscale = s;
+    for (size_t i = 0; i < d->n; i++)
+        d->r[i] = d->r0[i] * s;
+    if (s < d->rscale_ref) /* shrinking never misses a contact, but keep the reference honest */
+        d->rscale_ref = s;
+}
+
+void gp_dem3d_set_wall(gp_dem3d *d, int w, double pos)
+{
+    d->wall[w] = pos;
+    d->servo_f[w] = 0;
+}
+
+void gp_dem3d_set_servo(gp_dem3d *d, int w, double force, double vmax)
+{
+    d->servo_f[w] = force > 0 ? force : 0;
+    d->servo_v[w] = vmax;
+}
+
+void gp_dem3d_set_servo_limit(gp_dem3d *d, int w, double pos)
+{
+    d->servo_lim[w] = pos;
+}
+
+void gp_dem3d_zero_velocities(gp_dem3d *d)
+{
+    memset(d->v, 0, 3 * d->n * sizeof *d->v);
+    memset(d->w, 0, 3 * d->n * sizeof *d->w);
+}
+
+/* ------------------------------------------------------------------ neighbour list */
+
+typedef struct nbr {
+    uint32_t j;
+} nbr;
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static gp_status rebuild(gp_dem3d *d, gp_error *err)
+{
+    size_t n = d->n;
+    double cs = 2 * d->r0max * d->rscale + d->skin;
+    double lo[3], ext[3];
+    size_t g[3];
+    for (int a = 0; a < 3; a++) {
+        /* spheres may sit slightly outside a wall: the grid covers the spheres' extent */
+        double mn = d->wall[2 * a], mx = d->wall[2 * a + 1];
+        for (size_t i = 0; i < n; i++) {
+            double c = d->x[3 * i + a];
+            if (c < mn) mn = c;
+            if (c > mx) mx = c;
+        }
+        lo[a] = mn;
+        ext[a] = mx - mn;
+        double ga = floor(ext[a] / cs);
+        if (ga < 1) ga = 1;
+        if (ga > 1024) ga = 1024;
+        g[a] = (size_t)ga;
+    }
+    /* keep the grid at most ~2 n cells */
+    while (g[0] * g[1] * g[2] > 2 * n + 64) {
+        int a = g[0] >= g[1] && g[0] >= g[2] ? 0 : (g[1] >= g[2] ? 1 : 2);
+        g[a] = (g[a] + 1) / 2;
+    }
+    double inv[3];
+    for (int a = 0; a < 3; a++)
+        inv[a] = (double)g[a] / (ext[a] > 0 ? ext[a] : 1);
+    size_t nc = g[0] * g[1] * g[2];
+    if (nc + 1 > d->ncell_cap) {
+        free(d->cstart);
+        d->cstart = malloc((nc + 1) * sizeof *d->cstart);
+        if (!d->cstart)
+            return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (cells)");
+        d->ncell_cap = nc + 1;
+    }
+    memset(d->cstart, 0, (nc + 1) * sizeof *d->cstart);
+    for (size_t i = 0; i < n; i++) {
+        size_t c[3];
+        for (int a = 0; a < 3; a++) {
+            double f = (d->x[3 * i + a] - lo[a]) * inv[a];
+            long k = (long)f;
+            if (k < 0) k = 0;
+            if (k >= (long)g[a]) k = (long)g[a] - 1;
+            c[a] = (size_t)k;
+        }
+        d->cell_of[i] = (c[2] * g[1] + c[1]) * g[0] + c[0];
+        d->cstart[d->cell_of[i] + 1]++;
+    }
+    for (size_t c = 0; c < nc; c++)
+        d->cstart[c + 1] += d->cstart[c];
+    {
+        size_t *fill = malloc(nc * sizeof *fill);
+        if (!fill)
+            return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (cells)");
+        memcpy(fill, d->cstart, nc * sizeof *fill);
+        for (size_t i = 0; i < n; i++)
+            d->clist[fill[d->cell_of[i]]++] = i;
+        free(fill);
+    }
+    /* new pair list */
+    size_t cap = d->np > 0 ? d->np + d->np / 4 + 64 : 8 * n + 64;
+    uint32_t *ni = malloc(cap * sizeof *ni), *nj = malloc(cap * sizeof *nj);
+    uint32_t *tmp = NULL;
+    size_t tcap = 0;
+    if (!ni || !nj) {
+        free(ni); free(nj);
+        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
+    }
+    size_t np = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t ci = d->cell_of[i];
+        size_t cx = ci % g[0], cy = (ci / g[0]) % g[1], cz = ci / (g[0] * g[1]);
+        size_t nt = 0;
+        double xi = d->x[3 * i], yi = d->x[3 * i + 1], zi = d->x[3 * i + 2], ri = d->r[i];
+        for (long dz = -1; dz <= 1; dz++) {
+            long z = (long)cz + dz;
+            if (z < 0 || z >= (long)g[2]) continue;
+            for (long dy = -1; dy <= 1; dy++) {
+                long y = (long)cy + dy;
+                if (y < 0 || y >= (long)g[1]) continue;
+                for (long dx = -1; dx <= 1; dx++) {
+                    long xx = (long)cx + dx;
+                    if (xx < 0 || xx >= (long)g[0]) continue;
+                    size_t c = ((size_t)z * g[1] + (size_t)y) * g[0] + (size_t)xx;
+                    for (size_t k = d->cstart[c]; k < d->cstart[c + 1]; k++) {
+                        size_t j = d->clist[k];
+                        if (j <= i) continue;
+                        double ex = d->x[3 * j] - xi, ey = d->x[3 * j + 1] - yi, ez = d->x[3 * j + 2] - zi;
+                        double rr = ri + d->r[j] + d->skin;
+                        if (ex * ex + ey * ey + ez * ez < rr * rr) {
+                            if (nt == tcap) {
+                                tcap = tcap ? 2 * tcap : 64;
+                                uint32_t *t2 = realloc(tmp, tcap * sizeof *t2);
+                                if (!t2) {
+                                    free(tmp); free(ni); free(nj);
+                                    return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory");
+                                }
+                                tmp = t2;
+                            }
+                            tmp[nt++] = (uint32_t)j;
+                        }
+                    }
+                }
+            }
+        }
+        if (nt > 1)
+            qsort(tmp, nt, sizeof *tmp, cmp_u32);
+        if (np + nt > cap) {
+            while (np + nt > cap) cap *= 2;
+            uint32_t *a2 = realloc(ni, cap * sizeof *a2);
+            if (a2) ni = a2;
+            uint32_t *b2 = realloc(nj, cap * sizeof *b2);
+            if (b2) nj = b2;
+            if (!a2 || !b2) {
+                free(tmp); free(ni); free(nj);
+                return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
+            }
+        }
+        for (size_t k = 0; k < nt; k++) {
+            ni[np] = (uint32_t)i;
+            nj[np] = tmp[k];
+            np++;
+        }
+    }
+    free(tmp);
+    /* carry the shear springs over (both lists sorted by (i, j)) */
+    size_t alloc = np ? np : 1;
+    double *fs = calloc(3 * alloc, sizeof *fs);
+    double *F = calloc(3 * alloc, sizeof *F);
+    double *pc = calloc(3 * alloc, sizeof *pc);
+    double *fn = calloc(alloc, sizeof *fn);
+    size_t *adj = malloc(2 * alloc * sizeof *adj);
+    if (!fs || !F || !pc || !fn || !adj) {
+        free(fs); free(F); free(pc); free(fn); free(adj); free(ni); free(nj);
+        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
+    }
+    size_t o = 0;
+    for (size_t k = 0; k < np && o < d->np; k++) {
+        while (o < d->np && (d->pi[o] < ni[k] || (d->pi[o] == ni[k] && d->pj[o] < nj[k])))
+            o++;
+        if (o < d->np && d->pi[o] == ni[k] && d->pj[o] == nj[k])
+            memcpy(fs + 3 * k, d->pfs + 3 * o, 3 * sizeof *fs);
+    }
+    free(d->pi); free(d->pj); free(d->pfs); free(d->pF); free(d->pc); free(d->pfn); free(d->adj);
+    d->pi = ni; d->pj = nj; d->pfs = fs; d->pF = F; d->pc = pc; d->pfn = fn; d->adj = adj;
+    d->np = np;
+    d->pcap = cap;
+    /* per-sphere lists in pair order */
+    memset(d->off, 0, (n + 1) * sizeof *d->off);
+    for (size_t k = 0; k < np; k++) {
+        d->off[ni[k] + 1]++;
+        d->off[nj[k] + 1]++;
+    }
+    for (size_t i = 0; i < n; i++)
+        d->off[i + 1] += d->off[i];
+    size_t *fill = malloc((n ? n : 1) * sizeof *fill);
+    if (!fill)
+        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory");
+    memcpy(fill, d->off, n * sizeof *fill);
+    for (size_t k = 0; k < np; k++) {
+        d->adj[fill[ni[k]]++] = k << 1;
+        d->adj[fill[nj[k]]++] = (k << 1) | 1;
+    }
+    free(fill);
+    memcpy(d->xref, d->x, 3 * n * sizeof *d->x);
+    d->rscale_ref = d->rscale;
+    d->need_rebuild = 0;
+    d->rebuilds++;
+    return GP_OK;
+}
+
+/* ------------------------------------------------------------------ one step */
+
+static void job_pairs(gp_dem3d *d, int tid, int nt)
+{
+    size_t np = d->np;
+    size_t k0 = np * (size_t)tid / (size_t)nt, k1 = np * (size_t)(tid + 1) / (size_t)nt;
+    const double *x = d->x, *v = d->v, *w = d->w, *r = d->r;
+    const double E2 = 2 * d->E, ksr = d->ks_kn, mu = d->tanphi, dt = d->dt;
+    for (size_t k = k0; k < k1; k++) {
+        size_t i = d->pi[k], j = d->pj[k];
+        double dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
+        double ri = r[i], rj = r[j], R = ri + rj;
+        double d2 = dx * dx + dy * dy + dz * dz;
+        double *fs = d->pfs + 3 * k, *F = d->pF + 3 * k, *c = d->pc + 3 * k;
+        if (d2 >= R * R || d2 == 0) {
+            fs[0] = fs[1] = fs[2] = 0;
+            F[0] = F[1] = F[2] = 0;
+            c[0] = c[1] = c[2] = 0;
+            d->pfn[k] = 0;
+            continue;
+        }
+        double dist = sqrt(d2), id = 1.0 / dist;
+        double nx = dx * id, ny = dy * id, nz = dz * id;
+        double ov = R - dist;
+        double kn = E2 * ri * rj / R;
+        double fn = kn * ov;
+        /* contact-point velocities: i at +ri n, j at -rj n */
+        const double *vi = v + 3 * i, *vj = v + 3 * j, *wi = w + 3 * i, *wj = w + 3 * j;
+        double vrx = vi[0] - vj[0] + ri * (wi[1] * nz - wi[2] * ny) + rj * (wj[1] * nz - wj[2] * ny);
+        double vry = vi[1] - vj[1] + ri * (wi[2] * nx - wi[0] * nz) + rj * (wj[2] * nx - wj[0] * nz);
+        double vrz = vi[2] - vj[2] + ri * (wi[0] * ny - wi[1] * nx) + rj * (wj[0] * ny - wj[1] * nx);
+        double vn = vrx * nx + vry * ny + vrz * nz;
+        double vtx = vrx - vn * nx, vty = vry - vn * ny, vtz = vrz - vn * nz;
+        /* keep the spring tangent (rotate with the contact, same magnitude) */
+        double sx = fs[0], sy = fs[1], sz = fs[2];
+        double s2 = sx * sx + sy * sy + sz * sz;
+        if (s2 > 0) {
+            double sn = sx * nx + sy * ny + sz * nz;
+            sx -= sn * nx; sy -= sn * ny; sz -= sn * nz;
+            double t2 = sx * sx + sy * sy + sz * sz;
+            if (t2 > 0) {
+                double f = sqrt(s2 / t2);
+                sx *= f; sy *= f; sz *= f;
+            }
+        }
+        double ks = ksr * kn;
+        sx -= ks * vtx * dt; sy -= ks * vty * dt; sz -= ks * vtz * dt;
+        double smax = mu * fn;
+        double ss = sx * sx + sy * sy + sz * sz;
+        if (ss > smax * smax) {
+            double f = ss > 0 ? smax / sqrt(ss) : 0;
+            sx *= f; sy *= f; sz *= f;
+        }
+        fs[0] = sx; fs[1] = sy; fs[2] = sz;
+        F[0] = -fn * nx + sx;
+        F[1] = -fn * ny + sy;
+        F[2] = -fn * nz + sz;
+        c[0] = ny * sz - nz * sy;
+        c[1] = nz * sx - nx * sz;
+        c[2] = nx * sy - ny * sx;
+        d->pfn[k] = fn;
+    }
+}
+
+static inline double sgn_damp(double f, double v, double c)
+{
+    double p = f * v;
+    return p > 0 ? f * (1 - c) : (p < 0 ? f * (1 + c) : f);
+}
+
+static void job_spheres(gp_dem3d *d, int tid, int nt)
+{
+    const double E2 = 2 * d->E, dt = d->dt, c = d->damping;
+    for (size_t b = (size_t)tid; b < d->nblk; b += (size_t)nt) {
+        blk_acc *acc = d->blk + b;
+        memset(acc, 0, sizeof *acc);
+        size_t i0 = b * BLK, i1 = i0 + BLK < d->n ? i0 + BLK : d->n;
+        for (size_t i = i0; i < i1; i++) {
+            double *x = d->x + 3 * i, *v = d->v + 3 * i, *w = d->w + 3 * i;
+            double ri = d->r[i], m = d->m[i];
+            double F[3] = {m * d->g[0], m * d->g[1], m * d->g[2]}, T[3] = {0, 0, 0};
+            double sfn = 0;
+            for (size_t e = d->off[i]; e < d->off[i + 1]; e++) {
+                size_t k = d->adj[e] >> 1;
+                double fn = d->pfn[k];
+                if (fn == 0) /* not touching (an overlap always has f_n > 0) */
+                    continue;
+                const double *Fk = d->pF + 3 * k, *ck = d->pc + 3 * k;
+                if (d->adj[e] & 1) {
+                    F[0] -= Fk[0]; F[1] -= Fk[1]; F[2] -= Fk[2];
+                } else {
+                    F[0] += Fk[0]; F[1] += Fk[1]; F[2] += Fk[2];
+                    acc->nc++;
+                }
+                T[0] += ri * ck[0]; T[1] += ri * ck[1]; T[2] += ri * ck[2];
+                sfn += fn;
+            }
+            for (int a = 0; a < 3; a++) {
+                double dl = x[a] - d->wall[2 * a];
+                if (dl < ri) {
+                    double f = E2 * ri * (ri - dl);
+                    F[a] += f;
+                    acc->wf[2 * a] += f;
+                    acc->wk[2 * a] += E2 * ri;
+                    acc->wn++;
+                    sfn += f;
+                }
+                double dh = d->wall[2 * a + 1] - x[a];
+                if (dh < ri) {
+                    double f = E2 * ri * (ri - dh);
+                    F[a] -= f;
+                    acc->wf[2 * a + 1] += f;
+                    acc->wk[2 * a + 1] += E2 * ri;
+                    acc->wn++;
+                    sfn += f;
+                }
+            }
+            acc->sum_f += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
+            acc->sum_fn += sfn;
+            double mi = d->minv[i] * dt, ii = d->iinv[i] * dt;
+            double v2 = 0, d2 = 0;
+            for (int a = 0; a < 3; a++) {
+                v[a] += sgn_damp(F[a], v[a], c) * mi;
+                w[a] += sgn_damp(T[a], w[a], c) * ii;
+                x[a] += v[a] * dt;
+                v2 += v[a] * v[a];
+                double e = x[a] - d->xref[3 * i + a];
+                d2 += e * e;
+            }
+            acc->ke += 0.5 * m * v2;
+            if (v2 > acc->vmax2) acc->vmax2 = v2;
+            if (d2 > acc->disp2) acc->disp2 = d2;
+            if (!(v2 < INFINITY)) acc->bad = 1;
+            for (int a = 0; a < 3; a++)
+                if (!(x[a] > d->wall[2 * a] - ri && x[a] < d->wall[2 * a + 1] + ri))
+                    acc->bad = 1;
+        }
+    }
+}
+
+gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err)
+{
+    for (long s = 0; s < nsteps; s++) {
+        if (d->need_rebuild) {
+            gp_status st = rebuild(d, err);
+            if (st)
+                return st;
+        }
+        run_job(d, job_pairs);
+        run_job(d, job_spheres);
+        double sf = 0, sfn = 0, ke = 0, vm = 0, dm = 0;
+        size_t nc = 0, wn = 0;
+        double wf[6] = {0}, wk[6] = {0};
+        int bad = 0;
+        for (size_t b = 0; b < d->nblk; b++) {
+            const blk_acc *a = d->blk + b;
+            sf += a->sum_f; sfn += a->sum_fn; ke += a->ke;
+            if (a->vmax2 > vm) vm = a->vmax2;
+            if (a->disp2 > dm) dm = a->disp2;
+            nc += a->nc; wn += a->wn; bad |= a->bad;
+            for (int w = 0; w < 6; w++) {
+                wf[w] += a->wf[w];
+                wk[w] += a->wk[w];
+            }
+        }
+        d->stability = sfn > 0 ? sf / sfn : HUGE_VAL;
+        d->kinetic = ke;
+        d->vmax = sqrt(vm);
+        d->ncontacts = nc;
+        d->wall_n = wn;
+        memcpy(d->wall_f, wf, sizeof wf);
+        memcpy(d->wall_k, wk, sizeof wk);
+        d->steps++;
+        d->time += d->dt;
+        if (bad)
+            return gp_error_set(err, GP_ERR_DEGENERATE,
+                                "dem3d: a sphere left the box or diverged at step %ld (time step too "
+                                "large for the loading?)", d->steps);
+        /* servo walls (Eq. 10) */
+        for (int w = 0; w < 6; w++) {
+            if (d->servo_f[w] <= 0)
+                continue;
+            double lim = d->servo_v[w] * d->dt;
+            double mv = wk[w] > 0 ? SERVO_GAIN * (d->servo_f[w] - wf[w]) / wk[w] : lim;
+            if (mv > lim) mv = lim;
+            if (mv < -lim) mv = -lim;
+            d->wall[w] += (w & 1) ? -mv : mv;
+            if (!isnan(d->servo_lim[w])) {
+                if ((w & 1) && d->wall[w] < d->servo_lim[w])
+                    d->wall[w] = d->servo_lim[w];
+                if (!(w & 1) && d->wall[w] > d->servo_lim[w])
+                    d->wall[w] = d->servo_lim[w];
+            }
+        }
+        double grow = (d->rscale - d->rscale_ref) * d->r0max;
+        if (2 * sqrt(dm) + 2 * (grow > 0 ? grow : 0) > d->skin)
+            d->need_rebuild = 1;
+    }
+    return GP_OK;
+}
+
+void gp_dem3d_get_state(const gp_dem3d *d, gp_dem3d_state *s)
+{
+    memset(s, 0, sizeof *s);
+    s->steps = d->steps;
+    s->time = d->time;
+    s->stability = d->stability;
+    s->kinetic = d->kinetic;
+    s->vmax = d->vmax;
+    memcpy(s->wall_force, d->wall_f, sizeof s->wall_force);
+    s->contacts = d->ncontacts;
+    s->wall_contacts = d->wall_n;
+    s->rebuilds = d->rebuilds;
+}
+
+void gp_dem3d_spheres(const gp_dem3d *d, double *xyzr)
+{
+    for (size_t i = 0; i < d->n; i++) {
+        xyzr[4 * i] = d->x[3 * i];
+        xyzr[4 * i + 1] = d->x[3 * i + 1];
+        xyzr[4 * i + 2] = d->x[3 * i + 2];
+        xyzr[4 * i + 3] = d->r[i];
+    }
+}
+
+gp_status gp_dem3d_contacts(const gp_dem3d *d, gp_dem3d_contact **out, size_t *nout, gp_error *err)
+{
+    *out = NULL;
+    *nout = 0;
+    size_t cnt = 0;
+    for (size_t k = 0; k < d->np; k++)
+        cnt += d->pfn[k] > 0;
+    for (size_t i = 0; i < d->n; i++)
+        for (int a = 0; a < 3; a++) {
+            cnt += d->x[3 * i + a] - d->wall[2 * a] < d->r[i];
+            cnt += d->wall[2 * a + 1] - d->x[3 * i + a] < d->r[i];
+        }
+    gp_dem3d_contact *c = malloc((cnt ? cnt : 1) * sizeof *c);
+    if (!c)
+        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (contacts)");
+    size_t m = 0;
+    for (size_t k = 0; k < d->np; k++) {
+        if (!(d->pfn[k] > 0))
+            continue;
+        size_t i = d->pi[k], j = d->pj[k];
+        double e[3], l2 = 0;
+        for (int a = 0; a < 3; a++) {
+            e[a] = d->x[3 * j + a] - d->x[3 * i + a];
+            l2 += e[a] * e[a];
+        }
+        double l = sqrt(l2);
+        c[m].i = i;
+        c[m].j = (long)j;
+        for (int a = 0; a < 3; a++) {
+            c[m].normal[a] = e[a] / l;
+            c[m].force[a] = d->pF[3 * k + a];
+        }
+        c[m].overlap = d->r[i] + d->r[j] - l;
+        m++;
+    }
+    for (size_t i = 0; i < d->n; i++)
+        for (int w = 0; w < 6; w++) {
+            int a = w / 2;
+            double dist = (w & 1) ? d->wall[w] - d->x[3 * i + a] : d->x[3 * i + a] - d->wall[w];
+            double ri = d->r[i];
+            if (!(dist < ri))
+                continue;
+            double f = 2 * d->E * ri * (ri - dist);
+            c[m].i = i;
+            c[m].j = -1 - w;
+            memset(c[m].normal, 0, sizeof c[m].normal);
+            memset(c[m].force, 0, sizeof c[m].force);
+            c[m].normal[a] = (w & 1) ? 1 : -1;
+            c[m].force[a] = (w & 1) ? -f : f;
+            c[m].overlap = ri - dist;
+            m++;
+        }
+    *out = c;
+    *nout = m;
+    return GP_OK;
+}

@@ -1,0 +1,132 @@
+/* gp_dem3d.h -- a small sphere DEM for building specimens (Dang & Meguid 2010, Eqs 1-3, 7, 10).
+ *
+ * Models only what a packing needs:
+ *   - normal force f_n = k_n * delta, delta = R_i + R_j - |O_i O_j| (full overlap),
+ *     k_n = 2 E R_i R_j / (R_i + R_j) (YADE's FrictPhys; E R for equal spheres);
+ *   - incremental shear spring dF_s = -k_s du_t (Eq. 2), k_s = ks_kn * k_n, kept tangent to the
+ *     contact as it rotates, truncated at tan(phi) f_n (Eq. 3); spheres rotate (the shear force
+ *     needs the contact-point velocity, omega x r) but carry no orientation;
+ *   - six rigid, frictionless box walls (Table 1: box friction 0). A wall acts as the mirror
+ *     image of the sphere: f = E R * 2 (R - d), d = distance from the centre to the wall. This is
+ *     exactly the force the sphere gets from its flipped copy (Eq. 13), so flipping keeps the
+ *     wall forces; any wall may be a servo wall (Eq. 10);
+ *   - gravity and local (non-viscous, Cundall) damping of forces and moments;
+ *   - density scaling for quasi-static runs (YADE's NewtonIntegrator.densityScaling idea): the
+ *     inertia of a sphere smaller than scaled_radius is raised to that of a sphere whose critical
+ *     time step is the one of scaled_radius. Gravity uses the true mass, so the static state
+ *     (what a specimen is) does not change; only how fast it is reached.
+ *   - time step dt = dt_safety * min_i sqrt(m_i / (2 E R_i)) (2 E R_i is the stiffest contact a
+ *     sphere of radius R_i can have: with a wall or a much larger sphere);
+ *   - contact detection with a linked-cell grid and a Verlet skin (pairs closer than the skin
+ *     are listed; rebuilt when a sphere has moved more than skin / 2); shear springs persist
+ *     across rebuilds by (i, j).
+ *   - threads: per-pair forces, then per-sphere sums in a fixed order; every reduction is done
+ *     over fixed blocks of spheres, so results are bit for bit the same for any thread count.
+ * Units SI. Walls 0..5: x-, x+, y-, y+, z-, z+.
+ */
+#ifndef GP_DEM3D_H
+#define GP_DEM3D_H
+
+#include <stddef.h>
+
+#include "gp_error.h"
+
+typedef struct gp_dem3d gp_dem3d;
+
+typedef struct gp_dem3d_params {
+    double density;      /* kg/m^3 */
+    double young;        /* Pa, for k_n */
+    double ks_kn;        /* k_s / k_n */
+    double friction_deg; /* sphere-sphere friction */
+    double damping;      /* local damping coefficient in [0, 1) */
+    double gravity[3];   /* m/s^2 */
+    double dt_safety;    /* fraction of the critical time step; 0 = 0.2 */
+    double scaled_radius;/* density scaling radius (m); 0 = none */
+    double skin;         /* Verlet skin (m); 0 = 0.2 * smallest radius */
+    int threads;         /* 0 = 1 */
+} gp_dem3d_params;
+
+/* Sensible defaults: Table 1 material, gravity -9.81 along z, safety 0.2, no scaling. */
+void gp_dem3d_params_defaults(gp_dem3d_params *p);
+
+/* n spheres xyzr[4n] (radii are the full radii; see set_radius_scale) in the box [lo, hi]. */
+gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n,
+                          const double lo[3], const double hi[3], gp_dem3d **out, gp_error *err);
+void gp_dem3d_destroy(gp_dem3d *d);
+
+size_t gp_dem3d_count(const gp_dem3d *d);
+double gp_dem3d_dt(const gp_dem3d *d);
+void gp_dem3d_set_friction(gp_dem3d *d, double friction_deg);
+void gp_dem3d_set_damping(gp_dem3d *d, double damping);
+/* Current radii are the full radii times s (in (0, 1]); masses stay those of the full radii. */
+void gp_dem3d_set_radius_scale(gp_dem3d *d, double s);
+/* Moves wall w to a fixed position (stops any servo). */
+void gp_dem3d_set_wall(gp_dem3d *d, int w, double position);
+double gp_dem3d_wall(const gp_dem3d *d, int w);
+/* Servo wall (Eq. 10): each step the wall moves inward by gain * (F - F_c) / k_wall, F_c and
+ * k_wall the sum of the forces and normal stiffnesses of its contacts, at most vmax * dt (and
+ * by vmax * dt when it has no contact). force <= 0 turns the servo off (the wall stays). */
+void gp_dem3d_set_servo(gp_dem3d *d, int w, double force, double vmax);
+/* The servo never moves wall w inward past position (NAN = no limit). */
+void gp_dem3d_set_servo_limit(gp_dem3d *d, int w, double position);
+/* Zeroes all velocities (translation and rotation). */
+void gp_dem3d_zero_velocities(gp_dem3d *d);
+
+/* Advances nsteps. Fails (GP_ERR_DEGENERATE) if a sphere leaves the box or a value is not
+ * finite. */
+gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err);
+
+typedef struct gp_dem3d_state {
+    long steps;
+    double time;
+    double stability;        /* S_c (Eq. 7) of the last step: sum |resultant| over spheres (gravity
+                                included) / sum over spheres of sum |f_n| of their contacts */
+    double kinetic;          /* translational kinetic energy, true masses, J */
+    double vmax;             /* largest sphere speed, m/s */
+    double wall_force[6];    /* normal force on each wall, N */
+    size_t contacts;         /* sphere-sphere contacts */
+    size_t wall_contacts;
+    long rebuilds;
+} gp_dem3d_state;
+
+void gp_dem3d_get_state(const gp_dem3d *d, gp_dem3d_state *s);
+/* Current x, y, z, r (current radii) into xyzr[4n]. */
+void gp_dem3d_spheres(const gp_dem3d *d, double *xyzr);
+
+/* A contact: j >= 0 sphere (i < j), j < 0 wall -1 - j. normal from i to j (or the wall);
+ * overlap: full sphere overlap, or R - d for a wall (Eq. 12); force on sphere i. */
+typedef struct gp_dem3d_contact {
+    size_t i;
+    long j;
+    double normal[3];
+    double overlap;
+    double force[3];
+} gp_dem3d_contact;
+
+/* The current contacts (sphere pairs in (i, j) order, then wall contacts by sphere), malloc'ed. */
+gp_status gp_dem3d_contacts(const gp_dem3d *d, gp_dem3d_contact **c, size_t *nc, gp_error *err);
+
+/* --- measures on a static list (gp_dem3d_measure.c) --- */
+
+/* All pairs i < j with |O_i O_j| < R_i + R_j + gap, by linked cells, sorted by (i, j):
+ * pairs[2k], pairs[2k+1]. O(n) for bounded size ratios. */
+gp_status gp_dem3d_find_pairs(const double *xyzr, size_t n, double gap, size_t **pairs,
+                              size_t *npairs, gp_error *err);
+
+/* Eq. 14: F = (1/N_c) sum n n^T, summed over the spheres' contacts: a sphere pair is seen by
+ * both spheres (weight 2), a wall contact by one (weight 1; the flip turns it into half of a
+ * pair with the sphere's image). With no wall contacts this is Eq. 14 exactly; with them it is
+ * invariant under flip tiling. */
+void gp_dem3d_fabric(const gp_dem3d_contact *c, size_t nc, double F[3][3]);
+
+/* Eq. 15 with compression positive: sigma = -(1/V) sum_c l_c (x) f_c, summed over both spheres of
+ * a pair (the branch vector O_i O_j times the force on i) and over the sphere of a wall contact
+ * (centre to contact point). xyzr: the spheres the contacts refer to. */
+void gp_dem3d_stress(const gp_dem3d_contact *c, size_t nc, const double *xyzr, double volume,
+                     double S[3][3]);
+
+/* Solid volume of the spheres inside the box [lo, hi] (each sphere clipped by the six planes;
+ * caps of one sphere at two walls are assumed disjoint). */
+double gp_dem3d_solid_volume(const double *xyzr, size_t n, const double lo[3], const double hi[3]);
+
+#endif /* GP_DEM3D_H */
