@@ -778,11 +778,12 @@ int gpd_http_start(const gpd_http_config *cfg)
     started_at = gpd_monotonic_s();
     unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_ERROR_LOG | MHD_USE_AUTO | MHD_USE_ITC;
     daemon_ = MHD_start_daemon(
-        flags, 0, NULL, NULL, &on_request, NULL, MHD_OPTION_LISTEN_SOCKET, cfg->listen_fd,
+        flags, 0, NULL, NULL, &on_request, NULL, MHD_OPTION_EXTERNAL_LOGGER, &mhd_log, NULL,
+        MHD_OPTION_LISTEN_SOCKET, cfg->listen_fd,
         MHD_OPTION_THREAD_POOL_SIZE, cfg->threads, MHD_OPTION_CONNECTION_LIMIT,
         cfg->max_connections, MHD_OPTION_CONNECTION_TIMEOUT, cfg->timeout_s,
         MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)64 * 1024, MHD_OPTION_NOTIFY_COMPLETED,
-        &on_completed, NULL, MHD_OPTION_EXTERNAL_LOGGER, &mhd_log, NULL, MHD_OPTION_END);
+        &on_completed, NULL, MHD_OPTION_END);
     if (!daemon_) {
         gpd_log(GPD_LOG_ERROR, "cannot start the HTTP server");
         return -1;

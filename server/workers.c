@@ -71,14 +71,10 @@ typedef struct run_ctx {
     double last_write;
 } run_ctx;
 
-__attribute__((unused)) static char *progress_text(const char *phase, double fraction, double eta, long steps,
-                           double error, int with_detail)
+/* detail: NULL = {} */
+static char *progress_text(const char *phase, double fraction, double eta, json_t *detail)
 {
-    json_t *detail = json_object();
-    if (with_detail) {
-        json_object_set_new(detail, "steps", json_integer(steps));
-        json_object_set_new(detail, "error", gpd_jreal(error));
-    }
+    if (!detail) detail = json_object();
     json_t *p = json_pack("{s:s, s:o, s:o, s:o}", "phase", phase ? phase : "", "fraction",
                           gpd_jreal(fraction), "eta_s", gpd_jreal(eta), "detail", detail);
     char *t = p ? json_dumps(p, JSON_COMPACT) : NULL;
@@ -87,8 +83,10 @@ __attribute__((unused)) static char *progress_text(const char *phase, double fra
 }
 
 /* Throttled progress write; returns non-zero when the job must stop. */
+/* 2D detail: {steps, error}; 3D detail: {steps, porosity, stability}. */
 __attribute__((unused)) static int report(run_ctx *c, const char *phase, double f, long steps,
-                                          double error)
+                                          double error, int is3d, double porosity,
+                                          double stability)
 {
     if (__atomic_load_n(&c->s->cancel, __ATOMIC_RELAXED)) return 1;
     double now = gpd_monotonic_s();
@@ -98,7 +96,11 @@ __attribute__((unused)) static int report(run_ctx *c, const char *phase, double 
     if (f > 1) f = 1;
     double elapsed = now - c->t0;
     double eta = (f >= 0.01 && f < 1) ? elapsed * (1 - f) / f : (f >= 1 ? 0 : NAN);
-    char *t = progress_text(phase, f, eta, steps, error, 1);
+    json_t *detail = is3d ? json_pack("{s:I, s:o, s:o}", "steps", (json_int_t)steps, "porosity",
+                                      gpd_jreal(porosity), "stability", gpd_jreal(stability))
+                          : json_pack("{s:I, s:o}", "steps", (json_int_t)steps, "error",
+                                      gpd_jreal(error));
+    char *t = progress_text(phase, f, eta, detail);
     if (t) {
         if (store_progress(c->id, t) == STORE_CONFLICT) /* no longer running: cancelled */
             __atomic_store_n(&c->s->cancel, 1, __ATOMIC_RELAXED);
@@ -110,15 +112,13 @@ __attribute__((unused)) static int report(run_ctx *c, const char *phase, double 
 #ifdef GPD_HAVE_SPECIMEN2D
 static int on_progress2d(void *user, const gp_progress *p)
 {
-    return report(user, p->phase, p->fraction, p->steps, p->error);
+    return report(user, p->phase, p->fraction, p->steps, p->error, 0, 0, 0);
 }
 #endif
 #ifdef GPD_HAVE_SPECIMEN3D
 static int on_progress3d(void *user, const gp_progress3d *p)
 {
-    /* detail.error carries the current porosity during deposition/compaction and S_c after */
-    double e = (p->stability > 0) ? p->stability : p->porosity;
-    return report(user, p->phase, p->fraction, p->steps, e);
+    return report(user, p->phase, p->fraction, p->steps, 0, 1, p->porosity, p->stability);
 }
 #endif
 
@@ -135,7 +135,7 @@ __attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r)
 {
     char *text = r ? json_dumps(r, JSON_COMPACT | JSON_REAL_PRECISION(15)) : NULL;
     json_decref(r);
-    char *prog = progress_text("done", 1.0, 0.0, 0, 0, 0);
+    char *prog = progress_text("done", 1.0, 0.0, NULL);
     if (!text || !prog) {
         finish_failed(ctx->id, "internal", "out of memory while serialising the result");
     } else {

@@ -38,6 +38,17 @@ LONG_2D = {
     "outputs": ["grains", "odec", "descriptors"],
 }
 
+# A small 3D packing: a 1 cm box of 1-2 mm spheres (a few hundred).
+SMALL_3D = {
+    "kind": "spheres-3d",
+    "seed": 7,
+    "box": [0.01, 0.01, 0.01],
+    "sieve": [[1, 0], [2, 100]],
+    "sieve_units": "mm",
+    "porosity": 0.42,
+    "outputs": ["spheres", "contacts", "fabric", "stress"],
+}
+
 VIEWS_2D = ["packing", "cells", "size", "orientation", "descriptors"]
 FINAL = ("succeeded", "failed", "cancelled")
 JOB_KEYS = {"id", "kind", "status", "created_at", "started_at", "finished_at", "progress", "error"}

@@ -136,6 +136,29 @@ def test_health_schema_dashboard(env):
     assert d.stop() == 0
 
 
+def test_spheres_3d(env):
+    d = env.daemon(workers=1)
+    st, _, j = d.json("POST", "/v1/jobs", gpd.SMALL_3D)
+    if st == 501:
+        print("    SKIP: spheres-3d is not in this build")
+        return
+    assert st == 201, (st, j)
+    job = d.wait(j["id"], timeout=150)
+    assert job["status"] == "succeeded", job
+    st, _, r = d.json("GET", "/v1/jobs/%s/result" % j["id"])
+    assert st == 200, st
+    for k in ("porosity", "coordination_number", "fabric", "psd", "particles"):
+        assert k in r["stats"], k
+    for k in ("deposition", "compaction", "tiling", "total"):
+        assert k in r["timings"], k
+    assert r["spheres"] and len(r["spheres"][0]) == 4
+    for view in ("section", "psd"):
+        st, h, body = d.request("GET", "/v1/jobs/%s/svg?view=%s" % (j["id"], view))
+        assert st == 200, (view, st, body[:300])
+        ET.fromstring(body)
+    assert d.stop() == 0, d.read_log()
+
+
 if __name__ == "__main__":
     gpd.main([test_submit_poll_result_svg, test_determinism, test_list_pagination,
-              test_health_schema_dashboard])
+              test_health_schema_dashboard, test_spheres_3d])
