@@ -115,7 +115,8 @@ typedef struct gp_specimen2d {
     double mean_orientation_gap_deg; /* mean |theta_grain - theta_cell| (pi-periodic) */
     gp_hist size_hist;          /* cell areas: target lognormal vs achieved (cells) */
     gp_hist grain_size_hist;    /* grain areas, same classes scaled by solid_fraction */
-    gp_hist orientation_hist;   /* degrees in [-90, 90) */
+    gp_hist orientation_hist;   /* cells: degrees in [-90, 90), target cosine law vs achieved */
+    gp_hist grain_orientation_hist; /* grains, same classes and target */
     gp_descriptors descriptor_mean; /* with GP_OUT_DESCRIPTORS */
     gp_hist descriptor_hist[4]; /* elongation, roundness, circularity, regularity */
     /* timings, seconds */
