@@ -38,14 +38,14 @@ LONG_2D = {
     "outputs": ["grains", "odec", "descriptors"],
 }
 
-# A small 3D packing: a 1 cm box of 1-2 mm spheres (a few hundred).
+# A small 3D packing: a 6 mm box of 1-2 mm spheres (a few dozen; ~1 s).
 SMALL_3D = {
     "kind": "spheres-3d",
     "seed": 7,
-    "box": [0.01, 0.01, 0.01],
+    "box": [0.006, 0.006, 0.006],
     "sieve": [[1, 0], [2, 100]],
     "sieve_units": "mm",
-    "porosity": 0.42,
+    "porosity": 0.5,
     "outputs": ["spheres", "contacts", "fabric", "stress"],
 }
 
