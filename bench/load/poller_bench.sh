@@ -39,8 +39,8 @@ submit() {
   curl -sf -X POST "$url/v1/jobs" -H 'Content-Type: application/json' -d "$1" |
     python3 -c 'import json,sys; print(json.load(sys.stdin)["id"])'
 }
-small='{"kind":"fourier-voronoi-2d","seed":1,"particles":60,"contour_points":32,"imc":{"threshold":0.01,"max_steps":20000}}'
-long='{"kind":"fourier-voronoi-2d","seed":2,"particles":20000,"contour_points":64,"imc":{"threshold":1e-9,"max_steps":1000000000}}'
+small='{"kind":"fourier-voronoi-2d","seed":1,"particles":60,"contour_points":32,"imc":{"threshold":0.05,"max_steps":20000}}'
+long='{"kind":"fourier-voronoi-2d","seed":2,"particles":40000,"contour_points":64,"imc":{"threshold":1e-9,"max_steps":1000000000}}'
 done_id="$(submit "$small")"
 for _ in $(seq 200); do
   st="$(curl -sf "$url/v1/jobs/$done_id" | python3 -c 'import json,sys; print(json.load(sys.stdin)["status"])')"
