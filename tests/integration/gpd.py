@@ -50,6 +50,10 @@ SMALL_3D = {
     "outputs": ["spheres", "contacts", "fabric", "stress"],
 }
 
+# Latency limits are multiplied by this (set GPD_TEST_TIME_SCALE=5 for a TSan build, which
+# runs the core several times slower).
+TIME_SCALE = float(os.environ.get("GPD_TEST_TIME_SCALE", "1"))
+
 VIEWS_2D = ["packing", "cells", "size", "orientation", "descriptors"]
 FINAL = ("succeeded", "failed", "cancelled")
 JOB_KEYS = {"id", "kind", "status", "created_at", "started_at", "finished_at", "progress", "error"}
