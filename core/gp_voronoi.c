@@ -8,7 +8,7 @@
  *
  * - Cell i is computed on its own, voro++-style: start from a box B slightly larger than the
  *   container's bounding box and clip it by the bisector half-planes of the seeds found in rings
- *   of bins around seed i (Chebyshev distance 0, 1, 2, ...). A bin is skipped when its nearest
+ *   of bins around seed i (Chebyshev distance 0-1, 2, 3, ...; nearest seeds first). A bin is skipped when its nearest
  *   point is at least 2 Rmax from the seed (Rmax = farthest vertex of the current polygon: no
  *   seed there can cut it), and the search stops when the next ring is that far. When the outer
  *   ring is convex its edges are clipped in the same loop (their half-planes contain the
@@ -135,6 +135,9 @@ struct gp_voronoi {
     int32_t hcap;
     int32_t *aff;
     int32_t affcap;
+    double *cand_d;
+    int32_t *cand_j;
+    int32_t candcap;
 };
 
 /* ------------------------------------------------------------------------------------------ */
@@ -313,9 +316,19 @@ static int scratch_reserve(gp_voronoi *v, int32_t need)
 static int32_t clip_hp(const gp_vec2 *sv, const int32_t *st, int32_t m, gp_vec2 o, gp_vec2 nrm,
                        double eps, int32_t newtag, gp_vec2 *dv, int32_t *dt, double *d)
 {
+    /* quick exit: no vertex beyond the line (the common case for far candidates) */
+    {
+        int any = 0;
+        for (int32_t k = 0; k < m; k++) {
+            double t = (sv[k].x - o.x) * nrm.x + (sv[k].y - o.y) * nrm.y;
+            d[k] = t;
+            any |= t > eps;
+        }
+        if (!any) return -1;
+    }
     double dmax = -INFINITY, dmin = INFINITY;
     for (int32_t k = 0; k < m; k++) {
-        double t = (sv[k].x - o.x) * nrm.x + (sv[k].y - o.y) * nrm.y;
+        double t = d[k];
         if (t <= eps && t >= -eps) t = 0.0;
         d[k] = t;
         if (t > dmax) dmax = t;
@@ -356,6 +369,7 @@ static double convex_orientation(const gp_vec2 *p, int32_t m, double eps2)
     for (int32_t k = 1; k < m; k++)
         if (p[k].y < p[s].y || (p[k].y == p[s].y && p[k].x < p[s].x)) s = k;
     double best = INFINITY, bx = 1.0, by = 0.0;
+    int32_t j = -1; /* antipodal vertex, advanced monotonically (rotating calipers) */
     for (int32_t c = 0; c < m; c++) {
         int32_t k = s + c;
         if (k >= m) k -= m;
@@ -363,10 +377,14 @@ static double convex_orientation(const gp_vec2 *p, int32_t m, double eps2)
         double ex = p[k1].x - p[k].x, ey = p[k1].y - p[k].y;
         double l2 = ex * ex + ey * ey;
         if (l2 <= eps2) continue;
-        double h = 0.0;
-        for (int32_t j = 0; j < m; j++) {
-            double cr = ex * (p[j].y - p[k].y) - ey * (p[j].x - p[k].x);
-            if (cr > h) h = cr;
+        if (j < 0) j = k1;
+        double h = ex * (p[j].y - p[k].y) - ey * (p[j].x - p[k].x);
+        for (int32_t t = 0; t < m; t++) {
+            int32_t j1 = j + 1 == m ? 0 : j + 1;
+            double nx = ex * (p[j1].y - p[k].y) - ey * (p[j1].x - p[k].x);
+            if (nx < h) break;
+            h = nx;
+            j = j1;
         }
         double w = h * h / l2;
         if (w < best) {
@@ -908,45 +926,76 @@ static gp_status compute_cell(gp_voronoi *v, uint32_t i, vcell *out)
     const int32_t bx = bin_x(v, s.x), by = bin_y(v, s.y);
     const double epsr = 1e-13 * v->L;
     const int conv = v->outer_convex;
+    /* rings 0 and 1 form the first batch, then one ring per batch; inside a batch the seeds are
+     * clipped nearest first (the near ones shrink the polygon, the far ones then fail the cheap
+     * distance test). The result does not depend on this order (canonical vertices). */
     for (int32_t r = 0;; r++) {
-        int32_t y0 = by - r, y1 = by + r;
-        for (int32_t yy = y0 < 0 ? 0 : y0; yy <= y1 && yy < v->nby; yy++) {
-            int edge_row = (yy == y0 || yy == y1);
-            int32_t step = edge_row ? 1 : 2 * r;
-            for (int32_t xx = bx - r; xx <= bx + r; xx += (step ? step : 1)) {
-                if (xx < 0 || xx >= v->nbx) continue;
-                double lx = xx * v->hx, ux = lx + v->hx, ly = yy * v->hy, uy = ly + v->hy;
-                double dx = s.x < lx ? lx - s.x : (s.x > ux ? s.x - ux : 0.0);
-                double dy = s.y < ly ? ly - s.y : (s.y > uy ? s.y - uy : 0.0);
-                double md2 = dx * dx + dy * dy;
-                if (md2 >= 4.0 * rmax2) continue;
-                int32_t b = yy * v->nbx + xx;
-                if (conv && md2 <= rmax2) {
-                    for (uint32_t q = v->ce_off[b]; q < v->ce_off[b + 1]; q++) {
-                        uint32_t e = v->ce[q];
-                        if (v->estamp[e] == es) continue;
-                        v->estamp[e] = es;
-                        gp_vec2 a = v->rv[e], c = v->rv[v->enext[e]];
-                        gp_vec2 nrm = {c.y - a.y, a.x - c.x};
-                        gp_status st = clip_step(v, &m, &ina, a, nrm, epsr * (fabs(nrm.x) + fabs(nrm.y)),
-                                                 -(int32_t)e - 2, s, &rmax2);
-                        if (st != GP_OK) return st;
+        int32_t rlo = r == 1 ? 1 : r, nc = 0;
+        if (r == 0) r = 1;
+        for (int32_t rr = r == 1 ? 0 : rlo; rr <= r; rr++) {
+            int32_t y0 = by - rr, y1 = by + rr;
+            for (int32_t yy = y0 < 0 ? 0 : y0; yy <= y1 && yy < v->nby; yy++) {
+                int edge_row = (yy == y0 || yy == y1);
+                int32_t step = edge_row ? 1 : 2 * rr;
+                for (int32_t xx = bx - rr; xx <= bx + rr; xx += (step ? step : 1)) {
+                    if (xx < 0 || xx >= v->nbx) continue;
+                    double lx = xx * v->hx, ux = lx + v->hx, ly = yy * v->hy, uy = ly + v->hy;
+                    double dx = s.x < lx ? lx - s.x : (s.x > ux ? s.x - ux : 0.0);
+                    double dy = s.y < ly ? ly - s.y : (s.y > uy ? s.y - uy : 0.0);
+                    double md2 = dx * dx + dy * dy;
+                    if (md2 >= 4.0 * rmax2) continue;
+                    int32_t b = yy * v->nbx + xx;
+                    if (conv && md2 <= rmax2) {
+                        for (uint32_t q = v->ce_off[b]; q < v->ce_off[b + 1]; q++) {
+                            uint32_t e = v->ce[q];
+                            if (v->estamp[e] == es) continue;
+                            v->estamp[e] = es;
+                            gp_vec2 a = v->rv[e], c = v->rv[v->enext[e]];
+                            gp_vec2 nrm = {c.y - a.y, a.x - c.x};
+                            gp_status st = clip_step(v, &m, &ina, a, nrm, epsr * (fabs(nrm.x) + fabs(nrm.y)),
+                                                     -(int32_t)e - 2, s, &rmax2);
+                            if (st != GP_OK) return st;
+                        }
+                    }
+                    vbin *bn = &v->bins[b];
+                    const int32_t *it = bin_items(bn);
+                    if (nc + bn->cnt > v->candcap) {
+                        int32_t c0 = v->candcap;
+                        if (grow((void **)&v->cand_d, &c0, nc + bn->cnt, sizeof(double))) return GP_ERR_NOMEM;
+                        c0 = v->candcap;
+                        if (grow((void **)&v->cand_j, &c0, nc + bn->cnt, sizeof(int32_t))) return GP_ERR_NOMEM;
+                        v->candcap = c0;
+                    }
+                    for (int32_t q = 0; q < bn->cnt; q++) {
+                        int32_t j = it[q];
+                        if ((uint32_t)j == i) continue;
+                        double nx = v->seed[j].x - s.x, ny = v->seed[j].y - s.y, d2 = nx * nx + ny * ny;
+                        if (d2 >= 4.0 * rmax2) continue;
+                        v->cand_d[nc] = d2;
+                        v->cand_j[nc++] = j;
                     }
                 }
-                vbin *bn = &v->bins[b];
-                const int32_t *it = bin_items(bn);
-                for (int32_t q = 0; q < bn->cnt; q++) {
-                    int32_t j = it[q];
-                    if ((uint32_t)j == i) continue;
-                    gp_vec2 p = v->seed[j];
-                    double nx = p.x - s.x, ny = p.y - s.y;
-                    if (nx * nx + ny * ny >= 4.0 * rmax2) continue;
-                    gp_vec2 mid = {s.x + 0.5 * nx, s.y + 0.5 * ny};
-                    gp_status st = clip_step(v, &m, &ina, mid, (gp_vec2){nx, ny},
-                                             epsr * (fabs(nx) + fabs(ny)), j, s, &rmax2);
-                    if (st != GP_OK) return st;
-                }
             }
+        }
+        for (int32_t q = 0; q < nc; q++) {
+            if (q < 8) { /* partial selection sort: the nearest few first */
+                int32_t b = q;
+                for (int32_t k = q + 1; k < nc; k++)
+                    if (v->cand_d[k] < v->cand_d[b]) b = k;
+                double td = v->cand_d[q];
+                int32_t tj = v->cand_j[q];
+                v->cand_d[q] = v->cand_d[b];
+                v->cand_j[q] = v->cand_j[b];
+                v->cand_d[b] = td;
+                v->cand_j[b] = tj;
+            }
+            if (v->cand_d[q] >= 4.0 * rmax2) continue;
+            int32_t j = v->cand_j[q];
+            double nx = v->seed[j].x - s.x, ny = v->seed[j].y - s.y;
+            gp_vec2 mid = {s.x + 0.5 * nx, s.y + 0.5 * ny};
+            gp_status st = clip_step(v, &m, &ina, mid, (gp_vec2){nx, ny}, epsr * (fabs(nx) + fabs(ny)), j,
+                                     s, &rmax2);
+            if (st != GP_OK) return st;
         }
         /* stop when every seed outside the block of rings 0..r is at least 2 Rmax away */
         double dmin = INFINITY;
@@ -1496,6 +1545,8 @@ void gp_voronoi_destroy(gp_voronoi *v)
     free(v->lpo);
     free(v->hv);
     free(v->aff);
+    free(v->cand_d);
+    free(v->cand_j);
     free(v);
 }
 
