@@ -66,6 +66,13 @@ static double now_s(void)
 
 static double rng_u01(void *state) { return gp_rng_uniform((gp_rng *)state); }
 
+/* The service raises the cancel flag from another thread with an atomic store; read it
+ * atomically too (a plain volatile read is a data race in C11 terms). */
+static int cancelled(const volatile int *cancel)
+{
+    return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
+}
+
 /* ---------------------------------------------------------------- histograms */
 
 static void hist_free(gp_hist *h)
@@ -383,7 +390,7 @@ static int imc_progress(void *user, long steps, double error)
     double threshold = r->threshold;
     if (r->error0 < 0.0)
         r->error0 = error;
-    if (r->cancel && *r->cancel)
+    if (cancelled(r->cancel))
         return 1;
     if (!r->fn)
         return 0;
@@ -497,7 +504,7 @@ gp_status gp_specimen2d_build(const gp_spec2d *spec, gp_progress_fn progress, vo
     /* ---- tessellation + IMC */
     if (progress) {
         gp_progress p = {"tessellation", 0.0, 0, 0.0};
-        if (progress(user, &p) || (cancel && *cancel)) {
+        if (progress(user, &p) || cancelled(cancel)) {
             st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
             goto fail;
         }
@@ -645,7 +652,7 @@ gp_status gp_specimen2d_build(const gp_spec2d *spec, gp_progress_fn progress, vo
         while (started > 0 && atomic_load(&job.done) < n && !atomic_load(&job.stop)) {
             struct timespec ts = {0, 50 * 1000 * 1000};
             nanosleep(&ts, NULL);
-            int stop = cancel && *cancel;
+            int stop = cancelled(cancel);
             if (!stop && progress) {
                 gp_progress p = {"fill", 0.65 + 0.35 * (double)atomic_load(&job.done) / (double)n,
                                  out->imc_steps, out->imc_error};

@@ -6,7 +6,7 @@ SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PKGS="build-essential cmake pkg-config \
   libmicrohttpd-dev libjansson-dev libsqlite3-dev libfftw3-dev libgsl-dev \
-  python3 curl"
+  python3 curl wrk"
 missing=""
 for p in $PKGS; do
   dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
