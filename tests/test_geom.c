@@ -45,6 +45,8 @@ static double now_s(void)
 /* one unit in the last place of |x| */
 static double ulp(double x) { return nextafter(fabs(x), INFINITY) - fabs(x); }
 
+static int naive_contains(const gp_vec2 *p, size_t n, gp_vec2 q);
+
 static const gp_vec2 SQ[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
 /* L-shape: [0,2]x[0,1] u [0,1]x[1,2]; area 3, centroid (5/6, 5/6) */
 static const gp_vec2 LSH[6] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
@@ -322,6 +324,61 @@ static void test_mec(void)
     CHECK(gp_min_enclosing_circle(NULL, 0, &c, &r, &e) == GP_ERR_INVALID);
 }
 
+/* reference pole of inaccessibility: textbook polylabel with the d + h sqrt 2 bound */
+static double ref_sdist(const gp_vec2 *p, size_t n, double x, double y)
+{
+    gp_vec2 q = {x, y};
+    double d = gp_poly_boundary_distance(p, n, q);
+    return naive_contains(p, n, q) ? d : -d;
+}
+
+static double ref_polylabel(const gp_vec2 *p, size_t n, double tol)
+{
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        x0 = fmin(x0, p[i].x);
+        x1 = fmax(x1, p[i].x);
+        y0 = fmin(y0, p[i].y);
+        y1 = fmax(y1, p[i].y);
+    }
+    size_t cap = 1 << 16, cnt = 0;
+    double(*cell)[4] = malloc(cap * sizeof *cell); /* x, y, h, d */
+    double h = 0.5 * fmax(x1 - x0, y1 - y0), best = -INFINITY;
+    cell[cnt][0] = 0.5 * (x0 + x1);
+    cell[cnt][1] = 0.5 * (y0 + y1);
+    cell[cnt][2] = h;
+    cell[cnt][3] = ref_sdist(p, n, cell[cnt][0], cell[cnt][1]);
+    cnt++;
+    while (cnt > 0) {
+        /* pop the cell with the largest bound (linear scan: simple and obviously right) */
+        size_t bi = 0;
+        for (size_t i = 1; i < cnt; i++)
+            if (cell[i][3] + cell[i][2] * sqrt(2.0) > cell[bi][3] + cell[bi][2] * sqrt(2.0)) bi = i;
+        double cx = cell[bi][0], cy = cell[bi][1], ch = cell[bi][2], cd = cell[bi][3];
+        cell[bi][0] = cell[cnt - 1][0];
+        cell[bi][1] = cell[cnt - 1][1];
+        cell[bi][2] = cell[cnt - 1][2];
+        cell[bi][3] = cell[cnt - 1][3];
+        cnt--;
+        if (cd > best) best = cd;
+        if (cd + ch * sqrt(2.0) - best <= tol) break;
+        for (int k = 0; k < 4 && cnt < cap; k++) {
+            double nx = cx + ((k & 1) ? 0.5 : -0.5) * ch, ny = cy + ((k & 2) ? 0.5 : -0.5) * ch;
+            double nd = ref_sdist(p, n, nx, ny);
+            if (nd > best) best = nd;
+            if (nd + 0.5 * ch * sqrt(2.0) - best > tol) {
+                cell[cnt][0] = nx;
+                cell[cnt][1] = ny;
+                cell[cnt][2] = 0.5 * ch;
+                cell[cnt][3] = nd;
+                cnt++;
+            }
+        }
+    }
+    free(cell);
+    return best;
+}
+
 /* checks a max inscribed circle against the truth r_true with the documented guarantee */
 static void check_mic(const gp_vec2 *p, size_t n, double tol, double r_true, double cx, double cy,
                       int check_center)
@@ -392,6 +449,33 @@ static void test_mic(void)
         }
     CHECK(r + 1e-6 >= rg);                   /* nothing on the grid beats it */
     CHECK(r <= rg + 3.0 / 400 * sqrt(0.5)); /* and the grid comes close to it */
+
+    /* random non-convex polygons (noisy stars, some very jagged) against a plain reference
+     * polylabel (Lipschitz bound only, best-first, no pruning tricks) at a tight tolerance */
+    int bad = 0;
+    for (int trial = 0; trial < 40; trial++) {
+        size_t m = 8 + (size_t)(urand() * 250);
+        gp_vec2 *poly = malloc(m * sizeof *poly);
+        double amp = trial % 4 == 0 ? 0.5 : 0.15, ph = urand() * 6;
+        for (size_t i = 0; i < m; i++) {
+            double t = 2 * PI * (double)i / (double)m;
+            double rr = 1.0 + 0.25 * cos(2 * t + ph) + 0.1 * cos(3 * t + 2 * ph) + amp * (urand() - 0.5) * 0.3;
+            poly[i] = (gp_vec2){5 + rr * cos(t), -2 + rr * sin(t)};
+        }
+        double rref = ref_polylabel(poly, m, 1e-7);
+        const double tols[3] = {1e-2, 1e-4, 1e-6};
+        for (int k = 0; k < 3; k++) {
+            if (gp_max_inscribed_circle(poly, m, tols[k], &c, &r, NULL) != GP_OK) {
+                bad++;
+                continue;
+            }
+            if (r > rref + 1e-7 + 1e-12 || rref - r > tols[k] + 1e-12) bad++;
+            if (fabs(gp_poly_boundary_distance(poly, m, c) - r) > 1e-12 || !gp_poly_contains(poly, m, c))
+                bad++;
+        }
+        free(poly);
+    }
+    CHECK(bad == 0);
 
     gp_error e;
     gp_vec2 line[3] = {{0, 0}, {1, 1}, {2, 2}};
