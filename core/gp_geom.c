@@ -40,6 +40,10 @@ static int all_finite(const gp_vec2 *p, size_t n)
     return 1;
 }
 
+/* inline min / max for finite values (fmin / fmax are library calls without -ffast-math) */
+static inline double dmin(double a, double b) { return a < b ? a : b; }
+static inline double dmax(double a, double b) { return a > b ? a : b; }
+
 static inline int veq(gp_vec2 a, gp_vec2 b) { return a.x == b.x && a.y == b.y; }
 
 /* lexicographic (x, then y) */
@@ -142,8 +146,8 @@ int gp_orient2d(gp_vec2 a, gp_vec2 b, gp_vec2 c) { return orient(a, b, c); }
 /* closed segments [a,b] and [c,d] share a point (exact) */
 static int seg_intersect(gp_vec2 a, gp_vec2 b, gp_vec2 c, gp_vec2 d)
 {
-    if (fmax(a.x, b.x) < fmin(c.x, d.x) || fmax(c.x, d.x) < fmin(a.x, b.x) ||
-        fmax(a.y, b.y) < fmin(c.y, d.y) || fmax(c.y, d.y) < fmin(a.y, b.y))
+    if (dmax(a.x, b.x) < dmin(c.x, d.x) || dmax(c.x, d.x) < dmin(a.x, b.x) ||
+        dmax(a.y, b.y) < dmin(c.y, d.y) || dmax(c.y, d.y) < dmin(a.y, b.y))
         return 0;
     int o1 = orient(a, b, c), o2 = orient(a, b, d);
     if (o1 * o2 > 0) return 0;
@@ -298,8 +302,8 @@ int gp_poly_contains(const gp_vec2 *p, size_t n, gp_vec2 q)
     for (size_t i = 0, j = n - 1; i < n; j = i++) {
         gp_vec2 a = p[j], b = p[i];
         /* on (or within tol of) this edge: inside */
-        if (q.x >= fmin(a.x, b.x) - tol && q.x <= fmax(a.x, b.x) + tol &&
-            q.y >= fmin(a.y, b.y) - tol && q.y <= fmax(a.y, b.y) + tol &&
+        if (q.x >= dmin(a.x, b.x) - tol && q.x <= dmax(a.x, b.x) + tol &&
+            q.y >= dmin(a.y, b.y) - tol && q.y <= dmax(a.y, b.y) + tol &&
             seg_dist2(q.x, q.y, a.x, a.y, b.x, b.y) <= tol2)
             return 1;
         if ((a.y > q.y) != (b.y > q.y)) {
@@ -823,7 +827,7 @@ static int mic_make(const mic_poly *P, double x, double y, double h, size_t star
     c->x = x;
     c->y = y;
     c->h = h;
-    double thr = fmin(best->d, best->d + tol - h * MIC_SQRT2);
+    double thr = dmin(best->d, best->d + tol - h * MIC_SQRT2);
     size_t near[MIC_K];
     c->d = mic_sdist(P, x, y, mic_start(P, start), thr > 0.0 ? thr * thr : -1.0, near);
     if (c->d == -INFINITY) return 0;
@@ -888,10 +892,10 @@ gp_status gp_max_inscribed_circle(const gp_vec2 *p, size_t n, double tol, gp_vec
         DY[i] = DY[i + n] = Y[i + 1] - Y[i];
         double l2 = DX[i] * DX[i] + DY[i] * DY[i];
         IL[i] = IL[i + n] = l2 > 0.0 ? 1.0 / l2 : 0.0;
-        x0 = fmin(x0, X[i]);
-        x1 = fmax(x1, X[i]);
-        y0 = fmin(y0, Y[i]);
-        y1 = fmax(y1, Y[i]);
+        x0 = dmin(x0, X[i]);
+        x1 = dmax(x1, X[i]);
+        y0 = dmin(y0, Y[i]);
+        y1 = dmax(y1, Y[i]);
     }
     mic_poly P = {n, X, Y, DX, DY, IL};
     double w = x1 - x0, hgt = y1 - y0, size = fmax(w, hgt);
@@ -1051,7 +1055,7 @@ int gp_poly_is_simple(const gp_vec2 *p, size_t n)
         if (orient(a, b, c) == 0 && (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y) < 0.0)
             return 0;
         for (size_t j = i + 1; j < n; j++) {
-            gp_vec2 d0 = p[j], d1 = p[(j + 1) % n];
+            gp_vec2 d0 = p[j], d1 = p[j + 1 == n ? 0 : j + 1];
             if (veq(d0, d1) || j == ni || j == pi) continue;
             if (seg_intersect(a, b, d0, d1)) return 0;
         }
@@ -1076,13 +1080,13 @@ static inline double seg_param(gp_vec2 u, gp_vec2 v, gp_vec2 q)
 static int seg_events(gp_vec2 u, gp_vec2 v, const gp_vec2 *b, size_t nb, double t0, double tm,
                       int *touch, double *tnext, int *covered)
 {
-    double xlo = fmin(u.x, v.x), xhi = fmax(u.x, v.x), ylo = fmin(u.y, v.y), yhi = fmax(u.y, v.y);
+    double xlo = dmin(u.x, v.x), xhi = dmax(u.x, v.x), ylo = dmin(u.y, v.y), yhi = dmax(u.y, v.y);
     double tn = 1.0;
     for (size_t i = 0, j = nb - 1; i < nb; j = i++) {
         gp_vec2 c = b[j], d = b[i];
         if (veq(c, d)) continue;
-        if (fmax(c.x, d.x) < xlo || fmin(c.x, d.x) > xhi || fmax(c.y, d.y) < ylo ||
-            fmin(c.y, d.y) > yhi)
+        if (dmax(c.x, d.x) < xlo || dmin(c.x, d.x) > xhi || dmax(c.y, d.y) < ylo ||
+            dmin(c.y, d.y) > yhi)
             continue;
         int o1 = orient(u, v, c), o2 = orient(u, v, d);
         if (o1 * o2 > 0) continue;
@@ -1094,7 +1098,7 @@ static int seg_events(gp_vec2 u, gp_vec2 v, const gp_vec2 *b, size_t nb, double 
         int ne = 0;
         if (o1 == 0 && o2 == 0) {
             double tc = seg_param(u, v, c), td = seg_param(u, v, d);
-            double lo = fmin(tc, td), hi = fmax(tc, td);
+            double lo = dmin(tc, td), hi = dmax(tc, td);
             ev[ne++] = lo;
             ev[ne++] = hi;
             if (covered && lo <= tm && tm <= hi && lo < hi) *covered = 1;
