@@ -53,6 +53,7 @@
 #define GP_VOR_SEEDS_PER_BIN 2.0
 #define GP_VOR_PI 3.14159265358979323846
 #define TAG_B INT32_MIN
+#define TAG_SMALL (INT32_MIN + 4) /* a side of the provisional small box: never in a result */
 
 typedef struct vcell {
     int32_t nv, cap;      /* vertices of all parts / capacity of v, tag */
@@ -313,49 +314,49 @@ static int scratch_reserve(gp_voronoi *v, int32_t need)
 /* Keeps the part of polygon (sv, st, m) where d(x) = (x - o) . nrm <= 0 (|d| <= eps counts as
  * 0), writes it to (dv, dt) with newtag on the new edge. Returns the new vertex count, -1 when
  * the half-plane does not cut (the caller keeps its polygon), 0 when nothing is left. */
-static int32_t clip_hp(const gp_vec2 *sv, const int32_t *st, int32_t m, gp_vec2 o, gp_vec2 nrm,
-                       double eps, int32_t newtag, gp_vec2 *dv, int32_t *dt, double *d)
+static inline __attribute__((always_inline)) int32_t
+clip_hp(const gp_vec2 *sv, const int32_t *st, int32_t m, gp_vec2 o, gp_vec2 nrm, double eps, int32_t newtag,
+        gp_vec2 *dv, int32_t *dt, double *d, gp_vec2 s, double *rmax2)
 {
-    /* quick exit: no vertex beyond the line (the common case for far candidates) */
-    {
-        int any = 0;
-        for (int32_t k = 0; k < m; k++) {
-            double t = (sv[k].x - o.x) * nrm.x + (sv[k].y - o.y) * nrm.y;
-            d[k] = t;
-            any |= t > eps;
-        }
-        if (!any) return -1;
-    }
-    double dmax = -INFINITY, dmin = INFINITY;
+    /* one pass: snapped signed distances; no vertex beyond the line is the common quick exit */
+    int any = 0, allout = 1;
     for (int32_t k = 0; k < m; k++) {
-        double t = d[k];
+        double t = (sv[k].x - o.x) * nrm.x + (sv[k].y - o.y) * nrm.y;
         if (t <= eps && t >= -eps) t = 0.0;
         d[k] = t;
-        if (t > dmax) dmax = t;
-        if (t < dmin) dmin = t;
+        any |= t > 0.0;
+        allout &= t > 0.0;
     }
-    if (dmax <= 0.0) return -1;
-    if (dmin > 0.0) return 0;
+    if (!any) return -1;
+    if (allout) return 0;
     int32_t w = 0;
+    double r2 = 0.0;
+#define GP_EMIT(P, T)                                                                  \
+    do {                                                                               \
+        gp_vec2 p_ = (P);                                                              \
+        double ex_ = p_.x - s.x, ey_ = p_.y - s.y, d2_ = ex_ * ex_ + ey_ * ey_;        \
+        if (d2_ > r2) r2 = d2_;                                                        \
+        dv[w] = p_;                                                                    \
+        dt[w++] = (T);                                                                 \
+    } while (0)
+    double dk = d[0];
     for (int32_t k = 0; k < m; k++) {
         int32_t j = k + 1 == m ? 0 : k + 1;
-        double dk = d[k], dj = d[j];
+        double dj = d[j];
         if (dk <= 0.0) {
-            dv[w] = sv[k];
-            dt[w++] = (dk == 0.0 && dj > 0.0) ? newtag : st[k];
+            GP_EMIT(sv[k], (dk == 0.0 && dj > 0.0) ? newtag : st[k]);
             if (dk < 0.0 && dj > 0.0) {
                 double t = dk / (dk - dj);
-                dv[w].x = sv[k].x + t * (sv[j].x - sv[k].x);
-                dv[w].y = sv[k].y + t * (sv[j].y - sv[k].y);
-                dt[w++] = newtag;
+                GP_EMIT(((gp_vec2){sv[k].x + t * (sv[j].x - sv[k].x), sv[k].y + t * (sv[j].y - sv[k].y)}), newtag);
             }
         } else if (dj < 0.0) {
             double t = dk / (dk - dj);
-            dv[w].x = sv[k].x + t * (sv[j].x - sv[k].x);
-            dv[w].y = sv[k].y + t * (sv[j].y - sv[k].y);
-            dt[w++] = st[k];
+            GP_EMIT(((gp_vec2){sv[k].x + t * (sv[j].x - sv[k].x), sv[k].y + t * (sv[j].y - sv[k].y)}), st[k]);
         }
+        dk = dj;
     }
+#undef GP_EMIT
+    *rmax2 = r2;
     return w;
 }
 
@@ -825,23 +826,18 @@ static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const 
 /* one cell                                                                                    */
 
 /* One half-plane clip of the current polygon (in sa/ta when *ina, else sb/tb). */
-static gp_status clip_step(gp_voronoi *v, int32_t *m, int *ina, gp_vec2 o, gp_vec2 nrm, double eps,
-                           int32_t tag, gp_vec2 s, double *rmax2)
+static inline __attribute__((always_inline)) gp_status
+clip_step(gp_voronoi *v, int32_t *m, int *ina, gp_vec2 o, gp_vec2 nrm, double eps, int32_t tag, gp_vec2 s,
+          double *rmax2)
 {
     if (*m + 2 > v->scap && scratch_reserve(v, *m + 2)) return GP_ERR_NOMEM;
     gp_vec2 *cv = *ina ? v->sa : v->sb, *nv = *ina ? v->sb : v->sa;
     int32_t *ct = *ina ? v->ta : v->tb, *nt = *ina ? v->tb : v->ta;
-    int32_t w = clip_hp(cv, ct, *m, o, nrm, eps, tag, nv, nt, v->sd);
+    int32_t w = clip_hp(cv, ct, *m, o, nrm, eps, tag, nv, nt, v->sd, s, rmax2);
     if (w == 0) return GP_ERR_INTERNAL;
     if (w < 0) return GP_OK;
     *ina = !*ina;
     *m = w;
-    double r2 = 0.0;
-    for (int32_t k = 0; k < w; k++) {
-        double ex = nv[k].x - s.x, ey = nv[k].y - s.y, d2 = ex * ex + ey * ey;
-        if (d2 > r2) r2 = d2;
-    }
-    *rmax2 = r2;
     return GP_OK;
 }
 
@@ -853,7 +849,7 @@ static void tag_line(const gp_voronoi *v, gp_vec2 s, int32_t t, gp_vec2 *n, doub
         n->x = q.x - s.x;
         n->y = q.y - s.y;
         *c = 0.5 * (n->x * n->x + n->y * n->y);
-    } else if (t <= TAG_B + 3) {
+    } else if (t <= TAG_B + 4) {
         switch (t - TAG_B) {
         case 0: *n = (gp_vec2){0, -1}; *c = s.y - v->bmin.y; break;
         case 1: *n = (gp_vec2){1, 0}; *c = v->bmax.x - s.x; break;
@@ -900,7 +896,18 @@ static void canonicalise(const gp_voronoi *v, gp_vec2 s, const gp_vec2 *cv, cons
     }
 }
 
+static gp_status compute_cell_box(gp_voronoi *v, uint32_t i, vcell *out, int full);
+
+/* Cell i: first from a box of half-size 2 bins around the seed (cheap: the polygon and Rmax are
+ * small from the start); if the box still bounds the result, again from the whole box B. */
 static gp_status compute_cell(gp_voronoi *v, uint32_t i, vcell *out)
+{
+    gp_status st = compute_cell_box(v, i, out, 0);
+    if (st == GP_ERR_NOT_CONVERGED) st = compute_cell_box(v, i, out, 1);
+    return st;
+}
+
+static gp_status compute_cell_box(gp_voronoi *v, uint32_t i, vcell *out, int full)
 {
     const gp_vec2 s = v->seed[i];
     if (scratch_reserve(v, 64)) return GP_ERR_NOMEM;
@@ -908,14 +915,24 @@ static gp_status compute_cell(gp_voronoi *v, uint32_t i, vcell *out)
     gp_vec2 *cv = v->sa;
     int32_t *ct = v->ta;
     int32_t m = 4;
-    cv[0] = v->bmin;
-    cv[1] = (gp_vec2){v->bmax.x, v->bmin.y};
-    cv[2] = v->bmax;
-    cv[3] = (gp_vec2){v->bmin.x, v->bmax.y};
-    ct[0] = TAG_B;
-    ct[1] = TAG_B + 1;
-    ct[2] = TAG_B + 2;
-    ct[3] = TAG_B + 3;
+    {
+        double r0 = 2.0 * fmax(v->hx, v->hy);
+        double x0 = v->bmin.x, y0 = v->bmin.y, x1 = v->bmax.x, y1 = v->bmax.y;
+        ct[0] = TAG_B;
+        ct[1] = TAG_B + 1;
+        ct[2] = TAG_B + 2;
+        ct[3] = TAG_B + 3;
+        if (!full) {
+            if (s.y - r0 > y0) { y0 = s.y - r0; ct[0] = TAG_SMALL; }
+            if (s.x + r0 < x1) { x1 = s.x + r0; ct[1] = TAG_SMALL; }
+            if (s.y + r0 < y1) { y1 = s.y + r0; ct[2] = TAG_SMALL; }
+            if (s.x - r0 > x0) { x0 = s.x - r0; ct[3] = TAG_SMALL; }
+        }
+        cv[0] = (gp_vec2){x0, y0};
+        cv[1] = (gp_vec2){x1, y0};
+        cv[2] = (gp_vec2){x1, y1};
+        cv[3] = (gp_vec2){x0, y1};
+    }
     double rmax2 = 0.0;
     for (int32_t k = 0; k < 4; k++) {
         double dx = cv[k].x - s.x, dy = cv[k].y - s.y, d2 = dx * dx + dy * dy;
@@ -978,7 +995,7 @@ static gp_status compute_cell(gp_voronoi *v, uint32_t i, vcell *out)
             }
         }
         for (int32_t q = 0; q < nc; q++) {
-            if (q < 8) { /* partial selection sort: the nearest few first */
+            if (r == 1 && q < 8) { /* partial selection sort: the nearest few first */
                 int32_t b = q;
                 for (int32_t k = q + 1; k < nc; k++)
                     if (v->cand_d[k] < v->cand_d[b]) b = k;
@@ -1006,6 +1023,8 @@ static gp_status compute_cell(gp_voronoi *v, uint32_t i, vcell *out)
         if (dmin == INFINITY) break;
         if (dmin > 0 && dmin * dmin >= 4.0 * rmax2) break;
     }
+    for (int32_t k = 0; k < m; k++)
+        if ((ina ? v->ta : v->tb)[k] == TAG_SMALL) return GP_ERR_NOT_CONVERGED; /* box too small */
     cv = ina ? v->sb : v->sa; /* canonical copy into the other buffer */
     ct = ina ? v->tb : v->ta;
     canonicalise(v, s, ina ? v->sa : v->sb, ina ? v->ta : v->tb, m, cv, ct);
