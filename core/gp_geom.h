@@ -69,6 +69,17 @@ int gp_poly_overlap(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t nb);
 
 /* --- additions (appended; the declarations above are pinned) --- */
 
+/* Notes on the functions above, as implemented:
+ * - gp_max_inscribed_circle and gp_min_caliper allocate a temporary buffer, freed before they
+ *   return (GP_ERR_NOMEM if unavailable); nothing else allocates.
+ * - gp_convex_hull skips non-finite points. The fallible functions return GP_ERR_INVALID on
+ *   non-finite input; gp_poly_is_simple / _inside_poly / _overlap return 0 for it.
+ * - gp_poly_is_simple, gp_poly_inside_poly, gp_poly_overlap and gp_convex_hull decide with an
+ *   exact orientation predicate (gp_orient2d), so touching and crossing are told apart exactly
+ *   on the given doubles. gp_poly_contains adds a boundary tolerance of 1e-12 of the size.
+ * - gp_max_inscribed_circle: r <= r_true <= r + tol (up to ~1e-15 of the size in rounding);
+ *   the centre is strictly inside. */
+
 /* Axis-aligned bounding box of n >= 1 points. GP_ERR_INVALID for n == 0 or non-finite input. */
 gp_status gp_poly_bbox(const gp_vec2 *p, size_t n, gp_vec2 *lo, gp_vec2 *hi, gp_error *err);
 
