@@ -61,8 +61,8 @@ struct gp_dem3d {
     size_t *off;
     size_t *adj;
     /* cells */
-    size_t ncell_cap;
-    size_t *cstart, *cell_of, *clist;
+    size_t *cell_of;
+    unsigned char *level;
     /* blocks */
     size_t nblk;
     blk_acc *blk;
@@ -191,7 +191,7 @@ void gp_dem3d_destroy(gp_dem3d *d)
     free(d->m); free(d->minv); free(d->iinv); free(d->xref);
     free(d->pi); free(d->pj); free(d->pfs); free(d->pF); free(d->pc); free(d->pfn);
     free(d->off); free(d->adj);
-    free(d->cstart); free(d->cell_of); free(d->clist);
+    free(d->cell_of); free(d->level);
     free(d->blk);
     free(d);
 }
@@ -225,11 +225,11 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
     d->iinv = malloc(n * sizeof *d->iinv);
     d->off = calloc(n + 1, sizeof *d->off);
     d->cell_of = malloc(n * sizeof *d->cell_of);
-    d->clist = malloc(n * sizeof *d->clist);
+    d->level = malloc(n * sizeof *d->level);
     d->nblk = (n + BLK - 1) / BLK;
     d->blk = calloc(d->nblk, sizeof *d->blk);
     if (!d->x || !d->v || !d->w || !d->xref || !d->r0 || !d->r || !d->m || !d->minv || !d->iinv
-        || !d->off || !d->cell_of || !d->clist || !d->blk) {
+        || !d->off || !d->cell_of || !d->level || !d->blk) {
         gp_dem3d_destroy(d);
         return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (%zu spheres)", n);
     }
@@ -328,9 +328,6 @@ void gp_dem3d_zero_velocities(gp_dem3d *d)
 
 /* ------------------------------------------------------------------ neighbour list */
 
-typedef struct nbr {
-    uint32_t j;
-} nbr;
 
 static int cmp_u32(const void *a, const void *b)
 {
@@ -338,12 +335,24 @@ static int cmp_u32(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+static gp_status finish_rebuild(gp_dem3d *d, uint32_t *ni, uint32_t *nj, size_t np, size_t cap,
+                                gp_error *err);
+
+/* One grid per size level (level L holds radii in (rmax / 2^(L+1), rmax / 2^L]); cells of
+ * level L are 2 rmax_L + skin wide, so a wide size range does not make the small spheres scan
+ * cells sized for the largest ones. */
+#define NLEVEL 8
+typedef struct level_grid {
+    size_t g[3], n;
+    double lo[3], inv[3], cs, rmax;
+    size_t *start, *list;
+} level_grid;
+
 static gp_status rebuild(gp_dem3d *d, gp_error *err)
 {
     size_t n = d->n;
-    double cs = 2 * d->r0max * d->rscale + d->skin;
-    double lo[3], ext[3];
-    size_t g[3];
+    double rmax = d->r0max * d->rscale;
+    double ext_lo[3], ext_hi[3];
     for (int a = 0; a < 3; a++) {
         /* spheres may sit slightly outside a wall: the grid covers the spheres' extent */
         double mn = d->wall[2 * a], mx = d->wall[2 * a + 1];
@@ -352,52 +361,88 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
             if (c < mn) mn = c;
             if (c > mx) mx = c;
         }
-        lo[a] = mn;
-        ext[a] = mx - mn;
-        double ga = floor(ext[a] / cs);
-        if (ga < 1) ga = 1;
-        if (ga > 1024) ga = 1024;
-        g[a] = (size_t)ga;
+        ext_lo[a] = mn;
+        ext_hi[a] = mx;
     }
-    /* keep the grid at most ~2 n cells */
-    while (g[0] * g[1] * g[2] > 2 * n + 64) {
-        int a = g[0] >= g[1] && g[0] >= g[2] ? 0 : (g[1] >= g[2] ? 1 : 2);
-        g[a] = (g[a] + 1) / 2;
-    }
-    double inv[3];
-    for (int a = 0; a < 3; a++)
-        inv[a] = (double)g[a] / (ext[a] > 0 ? ext[a] : 1);
-    size_t nc = g[0] * g[1] * g[2];
-    if (nc + 1 > d->ncell_cap) {
-        free(d->cstart);
-        d->cstart = malloc((nc + 1) * sizeof *d->cstart);
-        if (!d->cstart)
-            return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (cells)");
-        d->ncell_cap = nc + 1;
-    }
-    memset(d->cstart, 0, (nc + 1) * sizeof *d->cstart);
+    level_grid lv[NLEVEL];
+    memset(lv, 0, sizeof lv);
+    unsigned char *lev = d->level;
     for (size_t i = 0; i < n; i++) {
+        int L = 0;
+        double r = d->r[i];
+        while (L < NLEVEL - 1 && r <= 0.5 * rmax / (double)(1u << L))
+            L++;
+        lev[i] = (unsigned char)L;
+        lv[L].n++;
+        if (r > lv[L].rmax) lv[L].rmax = r;
+    }
+    gp_status st = GP_OK;
+    size_t *cellbuf = d->cell_of; /* cell index of each sphere in its level */
+    for (int L = 0; L < NLEVEL; L++) {
+        level_grid *G = lv + L;
+        if (!G->n)
+            continue;
+        G->cs = 2 * G->rmax + d->skin;
+        for (int a = 0; a < 3; a++) {
+            double e = ext_hi[a] - ext_lo[a];
+            double ga = floor(e / G->cs);
+            if (ga < 1) ga = 1;
+            if (ga > 2048) ga = 2048;
+            G->g[a] = (size_t)ga;
+        }
+        while (G->g[0] * G->g[1] * G->g[2] > 2 * G->n + 64) {
+            int a = G->g[0] >= G->g[1] && G->g[0] >= G->g[2] ? 0 : (G->g[1] >= G->g[2] ? 1 : 2);
+            G->g[a] = (G->g[a] + 1) / 2;
+        }
+        for (int a = 0; a < 3; a++) {
+            double e = ext_hi[a] - ext_lo[a];
+            G->lo[a] = ext_lo[a];
+            G->inv[a] = e > 0 ? (double)G->g[a] / e : 0;
+            /* a cell must stay at least cs wide */
+            if (e > 0 && e / (double)G->g[a] < G->cs) {
+                /* fewer cells than floor(e / cs) is never produced above; nothing to do */
+            }
+        }
+        size_t nc = G->g[0] * G->g[1] * G->g[2];
+        G->start = calloc(nc + 1, sizeof *G->start);
+        G->list = malloc(G->n * sizeof *G->list);
+        if (!G->start || !G->list) {
+            st = gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (cells)");
+            goto done;
+        }
+    }
+    for (size_t i = 0; i < n; i++) {
+        level_grid *G = lv + lev[i];
         size_t c[3];
         for (int a = 0; a < 3; a++) {
-            double f = (d->x[3 * i + a] - lo[a]) * inv[a];
-            long k = (long)f;
+            long k = (long)((d->x[3 * i + a] - G->lo[a]) * G->inv[a]);
             if (k < 0) k = 0;
-            if (k >= (long)g[a]) k = (long)g[a] - 1;
+            if (k >= (long)G->g[a]) k = (long)G->g[a] - 1;
             c[a] = (size_t)k;
         }
-        d->cell_of[i] = (c[2] * g[1] + c[1]) * g[0] + c[0];
-        d->cstart[d->cell_of[i] + 1]++;
+        cellbuf[i] = (c[2] * G->g[1] + c[1]) * G->g[0] + c[0];
+        G->start[cellbuf[i] + 1]++;
     }
-    for (size_t c = 0; c < nc; c++)
-        d->cstart[c + 1] += d->cstart[c];
-    {
-        size_t *fill = malloc(nc * sizeof *fill);
-        if (!fill)
-            return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (cells)");
-        memcpy(fill, d->cstart, nc * sizeof *fill);
-        for (size_t i = 0; i < n; i++)
-            d->clist[fill[d->cell_of[i]]++] = i;
-        free(fill);
+    for (int L = 0; L < NLEVEL; L++) {
+        level_grid *G = lv + L;
+        if (!G->n)
+            continue;
+        size_t nc = G->g[0] * G->g[1] * G->g[2];
+        for (size_t c = 0; c < nc; c++)
+            G->start[c + 1] += G->start[c];
+    }
+    for (size_t i = 0; i < n; i++) { /* fill, using clist as the per-level cursor store */
+        level_grid *G = lv + lev[i];
+        G->list[G->start[cellbuf[i]]++] = i;
+    }
+    for (int L = 0; L < NLEVEL; L++) { /* shift starts back */
+        level_grid *G = lv + L;
+        if (!G->n)
+            continue;
+        size_t nc = G->g[0] * G->g[1] * G->g[2];
+        for (size_t c = nc; c > 0; c--)
+            G->start[c] = G->start[c - 1];
+        G->start[0] = 0;
     }
     /* new pair list */
     size_t cap = d->np > 0 ? d->np + d->np / 4 + 64 : 8 * n + 64;
@@ -406,44 +451,49 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
     size_t tcap = 0;
     if (!ni || !nj) {
         free(ni); free(nj);
-        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
+        st = gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
+        goto done;
     }
     size_t np = 0;
     for (size_t i = 0; i < n; i++) {
-        size_t ci = d->cell_of[i];
-        size_t cx = ci % g[0], cy = (ci / g[0]) % g[1], cz = ci / (g[0] * g[1]);
         size_t nt = 0;
-        double xi = d->x[3 * i], yi = d->x[3 * i + 1], zi = d->x[3 * i + 2], ri = d->r[i];
-        for (long dz = -1; dz <= 1; dz++) {
-            long z = (long)cz + dz;
-            if (z < 0 || z >= (long)g[2]) continue;
-            for (long dy = -1; dy <= 1; dy++) {
-                long y = (long)cy + dy;
-                if (y < 0 || y >= (long)g[1]) continue;
-                for (long dx = -1; dx <= 1; dx++) {
-                    long xx = (long)cx + dx;
-                    if (xx < 0 || xx >= (long)g[0]) continue;
-                    size_t c = ((size_t)z * g[1] + (size_t)y) * g[0] + (size_t)xx;
-                    for (size_t k = d->cstart[c]; k < d->cstart[c + 1]; k++) {
-                        size_t j = d->clist[k];
-                        if (j <= i) continue;
-                        double ex = d->x[3 * j] - xi, ey = d->x[3 * j + 1] - yi, ez = d->x[3 * j + 2] - zi;
-                        double rr = ri + d->r[j] + d->skin;
-                        if (ex * ex + ey * ey + ez * ez < rr * rr) {
-                            if (nt == tcap) {
-                                tcap = tcap ? 2 * tcap : 64;
-                                uint32_t *t2 = realloc(tmp, tcap * sizeof *t2);
-                                if (!t2) {
-                                    free(tmp); free(ni); free(nj);
-                                    return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory");
+        double xi[3] = {d->x[3 * i], d->x[3 * i + 1], d->x[3 * i + 2]}, ri = d->r[i];
+        for (int L = 0; L < NLEVEL; L++) {
+            level_grid *G = lv + L;
+            if (!G->n)
+                continue;
+            double R = ri + G->rmax + d->skin;
+            long c0[3], c1[3];
+            for (int a = 0; a < 3; a++) {
+                c0[a] = (long)floor((xi[a] - R - G->lo[a]) * G->inv[a]);
+                c1[a] = (long)floor((xi[a] + R - G->lo[a]) * G->inv[a]);
+                if (c0[a] < 0) c0[a] = 0;
+                if (c1[a] >= (long)G->g[a]) c1[a] = (long)G->g[a] - 1;
+            }
+            for (long z = c0[2]; z <= c1[2]; z++)
+                for (long y = c0[1]; y <= c1[1]; y++)
+                    for (long xx = c0[0]; xx <= c1[0]; xx++) {
+                        size_t c = ((size_t)z * G->g[1] + (size_t)y) * G->g[0] + (size_t)xx;
+                        for (size_t k = G->start[c]; k < G->start[c + 1]; k++) {
+                            size_t j = G->list[k];
+                            if (j <= i) continue;
+                            double ex = d->x[3 * j] - xi[0], ey = d->x[3 * j + 1] - xi[1], ez = d->x[3 * j + 2] - xi[2];
+                            double rr = ri + d->r[j] + d->skin;
+                            if (ex * ex + ey * ey + ez * ez < rr * rr) {
+                                if (nt == tcap) {
+                                    tcap = tcap ? 2 * tcap : 64;
+                                    uint32_t *t2 = realloc(tmp, tcap * sizeof *t2);
+                                    if (!t2) {
+                                        free(tmp); free(ni); free(nj);
+                                        st = gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory");
+                                        goto done;
+                                    }
+                                    tmp = t2;
                                 }
-                                tmp = t2;
+                                tmp[nt++] = (uint32_t)j;
                             }
-                            tmp[nt++] = (uint32_t)j;
                         }
                     }
-                }
-            }
         }
         if (nt > 1)
             qsort(tmp, nt, sizeof *tmp, cmp_u32);
@@ -455,7 +505,8 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
             if (b2) nj = b2;
             if (!a2 || !b2) {
                 free(tmp); free(ni); free(nj);
-                return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
+                st = gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
+                goto done;
             }
         }
         for (size_t k = 0; k < nt; k++) {
@@ -465,6 +516,19 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
         }
     }
     free(tmp);
+    st = finish_rebuild(d, ni, nj, np, cap, err);
+done:
+    for (int L = 0; L < NLEVEL; L++) {
+        free(lv[L].start);
+        free(lv[L].list);
+    }
+    return st;
+}
+
+static gp_status finish_rebuild(gp_dem3d *d, uint32_t *ni, uint32_t *nj, size_t np, size_t cap,
+                                gp_error *err)
+{
+    size_t n = d->n;
     /* carry the shear springs over (both lists sorted by (i, j)) */
     size_t alloc = np ? np : 1;
     double *fs = calloc(3 * alloc, sizeof *fs);

@@ -1,0 +1,631 @@
+/* gp_specimen3d.c -- see gp_specimen3d.h.
+ *
+ * Protocol (what the paper does, and where this differs; see also gp_dem3d.h):
+ *  phase 0, deposition: the sieve is drawn by quota for V_s = (1 - p) b_x b_y b_z (NOTES.md,
+ *    Eq. 8), the spheres are placed at random without overlap (largest first) at a reduced
+ *    radius in a box of the sample's plan and a taller height, then grown to full size while they
+ *    settle under gravity (the "grow radii" variant of pouring: the same loose, gravity-made
+ *    structure without minutes of free fall), and left to settle.
+ *  phase 1, compaction: the top wall becomes a servo wall (Eq. 10) pressing with
+ *    COMPACTION_STRESS; instead of shaking the walls, the friction angle is halved whenever the
+ *    packing has come to rest above the target height (the YADE practice of compacting with a
+ *    reduced friction); the servo never goes below the target height b_z. When the top wall
+ *    reaches b_z the friction is restored, the wall is fixed there, and
+ *  relaxation runs until S_c <= 1e-4 (Eq. 7, NOTES.md). If the packing comes to rest above b_z
+ *    even without friction, the target is denser than this sieve can pack ("target_too_dense");
+ *    if the deposit settles below b_z at full friction, it is looser ("target_too_loose").
+ *  phase 2, tiling: gp_flip.
+ */
+#include "gp_specimen3d.h"
+
+#include "gp_dem3d.h"
+#include "gp_flip.h"
+#include "gp_rng.h"
+#include "gp_sieve.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+#define MAX_SAMPLE_SPHERES 400000
+#define MAX_TILED_SPHERES 20000000
+#define GRAVITY 9.81
+#define STABILITY 1e-4           /* Eq. 7: 0.01 % */
+#define GROW_FROM 0.6            /* initial radius scale of the placement */
+#define GROW_STEPS 1500
+#define SETTLE_SC 5e-2           /* deposition ends when S_c is below this ... */
+#define SETTLE_STEPS 1000        /* ... or after this many steps */
+#define CHUNK 100
+#define STALL_STEPS 3000
+#define STALL_FRACTION 0.1
+#define DT_SAFETY 0.3            /* of sqrt(m / 2 E R): omega dt <= 0.3 sqrt(12) ~ 1 < 2 even
+                                    with 12 contacts as stiff as a wall */
+#define COMPACTION_STRESS 1.0    /* top-wall stress, times the geostatic stress at the bottom */
+#define RELAX_DAMPING 0.7        /* local damping during relaxation (the static state does not
+                                    depend on it; Sc <= 1e-4 comes ~2x sooner than at 0.2) */
+
+static const gp_sieve_row TABLE2[5] = {
+    {0.010, 0}, {0.020, 2}, {0.050, 50}, {0.080, 95}, {0.100, 100}};
+
+void gp_spec3d_defaults(gp_spec3d *s)
+{
+    memset(s, 0, sizeof *s);
+    s->seed = 0;
+    s->box[0] = s->box[1] = s->box[2] = 0.5;
+    s->sieve = TABLE2;
+    s->nsieve = 5;
+    s->porosity = 0.38;
+    s->material.density = 2600;
+    s->material.young = 15e6;
+    s->material.poisson = 0.5;
+    s->material.friction_deg = 18;
+    s->material.damping = 0.2;
+    s->tiling[0] = s->tiling[1] = s->tiling[2] = 1;
+    s->outputs = GP_OUT3_SPHERES;
+    s->threads = 1;
+    s->max_steps = 0;
+    s->tile_relax_steps = 0;
+}
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+typedef struct run_ctx {
+    gp_progress3d_fn fn;
+    void *user;
+    const volatile int *cancel;
+    double last;
+} run_ctx;
+
+static int report(run_ctx *c, const char *phase, double fraction, long steps, double porosity,
+                  double sc, int force)
+{
+    if (c->cancel && *c->cancel)
+        return 1;
+    if (!c->fn)
+        return 0;
+    double t = now();
+    if (!force && t - c->last < 0.05)
+        return 0;
+    c->last = t;
+    gp_progress3d p = {phase, fraction < 0 ? 0 : (fraction > 1 ? 1 : fraction), steps,
+                       porosity, isfinite(sc) ? sc : 0};
+    return c->fn(c->user, &p) != 0;
+}
+
+void gp_specimen3d_destroy(gp_specimen3d *s)
+{
+    if (!s)
+        return;
+    free(s->spheres);
+    free(s->contacts);
+    free(s->stats.psd.diameter);
+    free(s->stats.psd.target_weight);
+    free(s->stats.psd.target_number);
+    free(s->stats.psd.target_number_midbin);
+    free(s->stats.psd.achieved_weight);
+    free(s->stats.psd.achieved_number);
+    free(s);
+}
+
+static int cmp_desc(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x > y ? -1 : x < y;
+}
+
+/* Random sequential placement of spheres (radii lam * d / 2, largest first) without overlap in
+ * [0, L]. Returns 0 on success. */
+static int place(const double *diam, size_t n, double lam, const double L[3], gp_rng *rng,
+                 double *xyzr)
+{
+    double rmax = 0.5 * lam * diam[0];
+    double cs = 2 * rmax;
+    size_t g[3];
+    for (int a = 0; a < 3; a++) {
+        double ga = floor(L[a] / cs);
+        g[a] = ga < 1 ? 1 : (ga > 512 ? 512 : (size_t)ga);
+    }
+    while (g[0] * g[1] * g[2] > 4 * n + 64) {
+        int a = g[0] >= g[1] && g[0] >= g[2] ? 0 : (g[1] >= g[2] ? 1 : 2);
+        g[a] = (g[a] + 1) / 2;
+    }
+    size_t nc = g[0] * g[1] * g[2];
+    long *head = malloc(nc * sizeof *head), *next = malloc(n * sizeof *next);
+    if (!head || !next) {
+        free(head); free(next);
+        return -1;
+    }
+    for (size_t c = 0; c < nc; c++)
+        head[c] = -1;
+    int ok = 1;
+    for (size_t i = 0; i < n && ok; i++) {
+        double r = 0.5 * lam * diam[i];
+        int placed = 0;
+        for (int t = 0; t < 4000 && !placed; t++) {
+            double p[3];
+            size_t c[3];
+            for (int a = 0; a < 3; a++) {
+                p[a] = r + gp_rng_uniform(rng) * (L[a] - 2 * r);
+                long k = (long)(p[a] / L[a] * (double)g[a]);
+                c[a] = k < 0 ? 0 : (k >= (long)g[a] ? g[a] - 1 : (size_t)k);
+            }
+            int clash = 0;
+            for (long z = (long)c[2] - 1; z <= (long)c[2] + 1 && !clash; z++) {
+                if (z < 0 || z >= (long)g[2]) continue;
+                for (long y = (long)c[1] - 1; y <= (long)c[1] + 1 && !clash; y++) {
+                    if (y < 0 || y >= (long)g[1]) continue;
+                    for (long x = (long)c[0] - 1; x <= (long)c[0] + 1 && !clash; x++) {
+                        if (x < 0 || x >= (long)g[0]) continue;
+                        for (long j = head[((size_t)z * g[1] + (size_t)y) * g[0] + (size_t)x]; j >= 0; j = next[j]) {
+                            const double *q = xyzr + 4 * j;
+                            double dx = q[0] - p[0], dy = q[1] - p[1], dz = q[2] - p[2], rr = q[3] + r;
+                            if (dx * dx + dy * dy + dz * dz < rr * rr) {
+                                clash = 1;
+                                break;
+                            }
+                        }
+                    }
+                }
+            }
+            if (!clash) {
+                for (int a = 0; a < 3; a++)
+                    xyzr[4 * i + a] = p[a];
+                xyzr[4 * i + 3] = r;
+                size_t cell = (c[2] * g[1] + c[1]) * g[0] + c[0];
+                next[i] = head[cell];
+                head[cell] = (long)i;
+                placed = 1;
+            }
+        }
+        ok = placed;
+    }
+    free(head);
+    free(next);
+    return ok ? 0 : 1;
+}
+
+/* statistics of a contact list over n spheres */
+static void contact_stats(const gp_dem3d_contact *c, size_t nc, size_t n, double *z, double *zs,
+                          size_t *npair, size_t *nwall)
+{
+    size_t p = 0, w = 0;
+    for (size_t k = 0; k < nc; k++) {
+        if (c[k].j >= 0) p++;
+        else w++;
+    }
+    *npair = p;
+    *nwall = w;
+    *z = n ? (2.0 * (double)p + (double)w) / (double)n : 0;
+    *zs = n ? 2.0 * (double)p / (double)n : 0;
+}
+
+static gp_status validate(const gp_spec3d *s, gp_error *err)
+{
+    for (int a = 0; a < 3; a++)
+        if (!isfinite(s->box[a]) || !(s->box[a] > 0))
+            return gp_error_set(err, GP_ERR_INVALID, "box[%d] must be > 0", a);
+    if (!(s->porosity > 0) || !(s->porosity < 1))
+        return gp_error_set(err, GP_ERR_INVALID, "porosity must be in (0, 1)");
+    const gp_material3d *m = &s->material;
+    if (!(m->density > 0) || !isfinite(m->density))
+        return gp_error_set(err, GP_ERR_INVALID, "material.density must be > 0");
+    if (!(m->young > 0) || !isfinite(m->young))
+        return gp_error_set(err, GP_ERR_INVALID, "material.young must be > 0");
+    if (!(m->poisson >= 0) || !(m->poisson <= 10))
+        return gp_error_set(err, GP_ERR_INVALID, "material.poisson (k_s/k_n) must be in [0, 10]");
+    if (!(m->friction_deg >= 0) || !(m->friction_deg < 90))
+        return gp_error_set(err, GP_ERR_INVALID, "material.friction_deg must be in [0, 90)");
+    if (!(m->damping >= 0) || !(m->damping < 1))
+        return gp_error_set(err, GP_ERR_INVALID, "material.damping must be in [0, 1)");
+    for (int a = 0; a < 3; a++)
+        if (s->tiling[a] < 1 || s->tiling[a] > 4096)
+            return gp_error_set(err, GP_ERR_INVALID, "tiling[%d] must be in [1, 4096]", a);
+    if (s->threads < 0 || s->threads > 256)
+        return gp_error_set(err, GP_ERR_INVALID, "threads must be in [0, 256]");
+    if (s->max_steps < 0 || s->tile_relax_steps < 0)
+        return gp_error_set(err, GP_ERR_INVALID, "max_steps and tile_relax_steps must be >= 0");
+    if (!s->sieve || s->nsieve < 2)
+        return gp_error_set(err, GP_ERR_INVALID, "sieve: need at least 2 rows");
+    return GP_OK;
+}
+
+gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, void *user,
+                              const volatile int *cancel, gp_specimen3d **out, gp_error *err)
+{
+    double t0 = now();
+    *out = NULL;
+    if (!spec)
+        return gp_error_set(err, GP_ERR_INVALID, "spec is NULL");
+    gp_status st = validate(spec, err);
+    if (st)
+        return st;
+    size_t ns = spec->nsieve;
+    double *sd = malloc(ns * sizeof *sd), *sw = malloc(ns * sizeof *sw);
+    if (!sd || !sw) {
+        free(sd); free(sw);
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    }
+    for (size_t k = 0; k < ns; k++) {
+        sd[k] = spec->sieve[k].diameter;
+        sw[k] = spec->sieve[k].passing;
+    }
+    st = gp_sieve_validate(sd, sw, ns, err);
+    if (st) {
+        free(sd); free(sw);
+        return st;
+    }
+    const double *B = spec->box;
+    double bmin = fmin(B[0], fmin(B[1], B[2]));
+    double dmax = sd[ns - 1];
+    if (dmax > bmin) {
+        free(sd); free(sw);
+        return gp_error_set(err, GP_ERR_INVALID,
+                            "box: its smallest side (%g m) is smaller than the largest grain "
+                            "(%g m, the last sieve)", bmin, dmax);
+    }
+    size_t ntile = (size_t)spec->tiling[0] * (size_t)spec->tiling[1] * (size_t)spec->tiling[2];
+    double p = spec->porosity;
+    double V = B[0] * B[1] * B[2];
+    double vs = (1 - p) * V; /* Eq. 8 corrected (NOTES.md) */
+
+    gp_specimen3d *res = calloc(1, sizeof *res);
+    gp_rng *rng = gp_rng_create(spec->seed, 0, err);
+    double *diam = NULL, *xyzr = NULL;
+    gp_dem3d *dem = NULL;
+    gp_dem3d_contact *con = NULL, *tcon = NULL;
+    double *tiled = NULL;
+    size_t n = 0, ncon = 0, ntcon = 0, ntiled = 0;
+    gp_status ret = GP_OK;
+    if (!res || !rng) {
+        ret = res ? (err ? err->code : GP_ERR_NOMEM) : gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+        if (ret == GP_OK) ret = GP_ERR_NOMEM;
+        goto fail;
+    }
+    st = gp_sieve_draw(sd, sw, ns, vs, MAX_SAMPLE_SPHERES, rng, &diam, &n, err);
+    if (st) {
+        ret = st;
+        goto fail;
+    }
+    if (n * ntile > MAX_TILED_SPHERES) {
+        ret = gp_error_set(err, GP_ERR_INVALID, "tiling: %zu tiles of %zu spheres exceed the limit "
+                           "of %d spheres", ntile, n, MAX_TILED_SPHERES);
+        goto fail;
+    }
+    /* PSD: targets and achieved (by the drawn sample) */
+    gp_psd3d *psd = &res->stats.psd;
+    psd->n = ns;
+    psd->diameter = malloc(ns * sizeof(double));
+    psd->target_weight = malloc(ns * sizeof(double));
+    psd->target_number = malloc(ns * sizeof(double));
+    psd->target_number_midbin = malloc(ns * sizeof(double));
+    psd->achieved_weight = malloc(ns * sizeof(double));
+    psd->achieved_number = malloc(ns * sizeof(double));
+    xyzr = malloc(4 * n * sizeof *xyzr);
+    if (!psd->diameter || !psd->target_weight || !psd->target_number || !psd->target_number_midbin
+        || !psd->achieved_weight || !psd->achieved_number || !xyzr) {
+        ret = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    memcpy(psd->diameter, sd, ns * sizeof *sd);
+    memcpy(psd->target_weight, sw, ns * sizeof *sw);
+    gp_sieve_weight_to_number(sd, sw, ns, GP_SIEVE_UNIFORM, psd->target_number, NULL);
+    gp_sieve_weight_to_number(sd, sw, ns, GP_SIEVE_MIDBIN, psd->target_number_midbin, NULL);
+    gp_sieve_passing(diam, n, sd, ns, psd->achieved_weight, psd->achieved_number);
+    qsort(diam, n, sizeof *diam, cmp_desc);
+
+    gp_stats3d *S = &res->stats;
+    S->porosity_target = p;
+    S->sample_particles = n;
+    res->sample_box[0] = B[0];
+    res->sample_box[1] = B[1];
+    res->sample_box[2] = B[2];
+    run_ctx rc = {progress, user, cancel, 0};
+    const char *reason = "stable";
+
+    /* ---- phase 0: placement and deposition ---- */
+    double H0 = fmax(1.15 * B[2], B[2] * (1 - p) / 0.5);
+    double L[3] = {B[0], B[1], H0};
+    double lam = GROW_FROM;
+    int tries = 0;
+    while (place(diam, n, lam, L, rng, xyzr) != 0) {
+        if (++tries > 12) {
+            ret = gp_error_set(err, GP_ERR_INTERNAL, "deposition: cannot place the spheres");
+            goto fail;
+        }
+        lam *= 0.85;
+    }
+    /* density scaling radius: the median radius by number (see gp_dem3d.h) */
+    gp_dem3d_params dp;
+    gp_dem3d_params_defaults(&dp);
+    dp.density = spec->material.density;
+    dp.young = spec->material.young;
+    dp.ks_kn = spec->material.poisson;
+    dp.friction_deg = spec->material.friction_deg;
+    dp.damping = spec->material.damping;
+    dp.gravity[2] = -GRAVITY;
+    dp.scaled_radius = 0.5 * diam[n / 2];
+    dp.skin = 0.5 * (0.5 * diam[n - 1]);   /* half the smallest radius */
+    dp.dt_safety = DT_SAFETY;
+    dp.threads = spec->threads > 0 ? spec->threads : 1;
+    for (size_t i = 0; i < n; i++)
+        xyzr[4 * i + 3] = 0.5 * diam[i]; /* full radii; the DEM scales them */
+    double lo[3] = {0, 0, 0};
+    st = gp_dem3d_create(&dp, xyzr, n, lo, L, &dem, err);
+    if (st) {
+        ret = st;
+        goto fail;
+    }
+    long max_steps = spec->max_steps > 0 ? spec->max_steps : 400000;
+    gp_dem3d_state ds;
+    double t_phase = now();
+    for (long s = 0; s < GROW_STEPS; s += 10) {
+        gp_dem3d_set_radius_scale(dem, lam + (1 - lam) * (double)(s + 10) / GROW_STEPS);
+        if ((st = gp_dem3d_run(dem, 10, err))) {
+            ret = st;
+            goto fail;
+        }
+        if (report(&rc, "deposition", 0.1 * s / GROW_STEPS, s, 0, 0, 0)) {
+            ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+            goto fail;
+        }
+    }
+    gp_dem3d_set_radius_scale(dem, 1.0);
+    for (long s = 0; s < SETTLE_STEPS; s += CHUNK) {
+        if ((st = gp_dem3d_run(dem, CHUNK, err))) {
+            ret = st;
+            goto fail;
+        }
+        gp_dem3d_get_state(dem, &ds);
+        if (report(&rc, "deposition", 0.1 + 0.1 * s / SETTLE_STEPS, ds.steps, 0, ds.stability, 0)) {
+            ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+            goto fail;
+        }
+        if (ds.stability < SETTLE_SC)
+            break;
+    }
+    res->t_deposition = now() - t_phase;
+
+    /* ---- phase 1: compaction with the servo top wall (Eq. 10) and reduced friction ---- */
+    t_phase = now();
+    double area = B[0] * B[1];
+    double sigma0 = COMPACTION_STRESS * (1 - p) * spec->material.density * GRAVITY * B[2];
+    gp_dem3d_set_servo(dem, 5, sigma0 * area, 1.0);
+    gp_dem3d_set_servo_limit(dem, 5, B[2]);
+    double phi = spec->material.friction_deg;
+    double h_touch = NAN;
+    int reached = 0, stall_chunks = 0;
+    double por_cp = 1;
+    while (!reached) {
+        if ((st = gp_dem3d_run(dem, CHUNK, err))) {
+            ret = st;
+            goto fail;
+        }
+        gp_dem3d_get_state(dem, &ds);
+        double h = gp_dem3d_wall(dem, 5);
+        double por = 1 - vs / (area * h);
+        if (report(&rc, "compaction", 0.2 + 0.4 * fmin(1, (H0 - h) / (H0 - B[2])), ds.steps, por,
+                   ds.stability, 0)) {
+            ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+            goto fail;
+        }
+        if (isnan(h_touch) && ds.wall_force[5] >= 0.5 * sigma0 * area) {
+            /* the top wall rests on the deposit (full friction): phase 0's porosity; from now
+             * on compact without friction */
+            h_touch = h;
+            phi = 0;
+            gp_dem3d_set_friction(dem, phi);
+        }
+        if (h <= B[2]) {
+            reached = 1;
+            break;
+        }
+        /* without friction, the approach has stalled: over the last STALL_STEPS the porosity
+         * fell by less than STALL_FRACTION of what remains to the target (or the wall is at
+         * rest): the target is denser than this sieve packs here */
+        
+        if (phi == 0) {
+            if (++stall_chunks * CHUNK >= STALL_STEPS) {
+                double gain = por_cp - por, left = por - p;
+                if (gain < STALL_FRACTION * left) {
+                    reason = "target_too_dense";
+                    ret = gp_error_set(err, GP_ERR_INFEASIBLE,
+                                       "porosity %g is denser than this sieve packs in this box "
+                                       "without friction (stalled at %.4f)", p, por);
+                    break;
+                }
+                por_cp = por;
+                stall_chunks = 0;
+            }
+        }
+
+        if (ds.steps > max_steps) {
+            reason = "max_steps";
+            ret = gp_error_set(err, GP_ERR_NOT_CONVERGED, "compaction: %ld steps without reaching "
+                               "porosity %g (at %.4f)", ds.steps, p, por);
+            break;
+        }
+    }
+    S->deposition_porosity = 1 - vs / (area * (isnan(h_touch) ? gp_dem3d_wall(dem, 5) : h_touch));
+    S->compaction_friction_deg = phi;
+    res->t_compaction = now() - t_phase;
+
+    /* ---- relaxation at the target height, friction restored ---- */
+    t_phase = now();
+    if (reached) {
+        gp_dem3d_set_friction(dem, spec->material.friction_deg);
+        gp_dem3d_set_wall(dem, 5, B[2]);
+        gp_dem3d_set_damping(dem, fmax(spec->material.damping, RELAX_DAMPING));
+        for (;;) {
+            if ((st = gp_dem3d_run(dem, CHUNK, err))) {
+                ret = st;
+                goto fail;
+            }
+            gp_dem3d_get_state(dem, &ds);
+            double sc = ds.stability;
+            double fr = log(fmax(sc, STABILITY) / 1.0) / log(STABILITY);
+            if (report(&rc, "relaxation", 0.6 + 0.3 * fmin(1, fmax(0, fr)), ds.steps, p, sc, 0)) {
+                ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+                goto fail;
+            }
+            if (sc <= STABILITY)
+                break;
+            if (ds.steps > max_steps) {
+                reason = "max_steps";
+                ret = gp_error_set(err, GP_ERR_NOT_CONVERGED,
+                                   "relaxation: S_c = %.3g after %ld steps (> 1e-4)", sc, ds.steps);
+                break;
+            }
+        }
+        if (ret == GP_OK && !(ds.wall_force[5] > 0)) {
+            reason = "target_too_loose";
+            ret = gp_error_set(err, GP_ERR_INFEASIBLE,
+                               "porosity %g is looser than the deposit of this sieve at friction "
+                               "%g deg: the packing settles below the top wall", p,
+                               spec->material.friction_deg);
+        }
+    }
+    res->t_relaxation = now() - t_phase;
+    gp_dem3d_get_state(dem, &ds);
+    S->stability = ds.stability;
+    S->steps = ds.steps;
+    S->dt = gp_dem3d_dt(dem);
+    S->stop_reason = reason;
+    gp_dem3d_spheres(dem, xyzr);
+    res->sample_box[2] = gp_dem3d_wall(dem, 5);
+    st = gp_dem3d_contacts(dem, &con, &ncon, err);
+    if (st) {
+        ret = st;
+        goto fail;
+    }
+    gp_dem3d_destroy(dem);
+    dem = NULL;
+    {
+        double hi[3] = {res->sample_box[0], res->sample_box[1], res->sample_box[2]};
+        double Vb = hi[0] * hi[1] * hi[2];
+        S->sample_porosity = 1 - gp_dem3d_solid_volume(xyzr, n, lo, hi) / Vb;
+    }
+
+    /* ---- phase 2: flip tiling ---- */
+    t_phase = now();
+    const gp_dem3d_contact *fc = con;
+    size_t nfc = ncon;
+    const double *fx = xyzr;
+    size_t nf = n;
+    for (int a = 0; a < 3; a++)
+        res->box[a] = res->sample_box[a];
+    int tile = ntile > 1 && (ret == GP_OK || ret == GP_ERR_NOT_CONVERGED);
+    if (tile) {
+        report(&rc, "tiling", 0.9, S->steps, p, S->stability, 1);
+        st = gp_flip_tile(xyzr, n, res->sample_box, spec->tiling, MAX_TILED_SPHERES, &tiled,
+                          &ntiled, err);
+        if (!st)
+            st = gp_flip_contacts(con, ncon, xyzr, n, spec->tiling, &tcon, &ntcon, err);
+        if (st) {
+            ret = st;
+            goto fail;
+        }
+        for (int a = 0; a < 3; a++)
+            res->box[a] = res->sample_box[a] * spec->tiling[a];
+        if (spec->tile_relax_steps > 0) {
+            gp_dem3d_params tp = dp;
+            tp.scaled_radius = dp.scaled_radius;
+            double thi[3] = {res->box[0], res->box[1], res->box[2]};
+            st = gp_dem3d_create(&tp, tiled, ntiled, lo, thi, &dem, err);
+            for (long s = 0; !st && s < spec->tile_relax_steps; s += CHUNK) {
+                st = gp_dem3d_run(dem, CHUNK, err);
+                gp_dem3d_get_state(dem, &ds);
+                if (!st && report(&rc, "tiling", 0.9 + 0.1 * s / spec->tile_relax_steps, S->steps + ds.steps, p, ds.stability, 0))
+                    st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+                if (ds.stability <= STABILITY)
+                    break;
+            }
+            if (!st) {
+                S->tiled_stability = ds.stability;
+                gp_dem3d_spheres(dem, tiled);
+                free(tcon);
+                tcon = NULL;
+                st = gp_dem3d_contacts(dem, &tcon, &ntcon, err);
+            }
+            gp_dem3d_destroy(dem);
+            dem = NULL;
+            if (st) {
+                ret = st;
+                goto fail;
+            }
+        }
+        fc = tcon;
+        nfc = ntcon;
+        fx = tiled;
+        nf = ntiled;
+        /* true solid volume: each copy clipped to its own tile (inner faces are not walls) */
+        double solid = 0;
+        for (size_t t = 0; t < ntile; t++) {
+            size_t kx = t % (size_t)spec->tiling[0], ky = (t / (size_t)spec->tiling[0]) % (size_t)spec->tiling[1],
+                   kz = t / ((size_t)spec->tiling[0] * (size_t)spec->tiling[1]);
+            double tlo[3] = {kx * res->sample_box[0], ky * res->sample_box[1], kz * res->sample_box[2]};
+            double thi[3] = {tlo[0] + res->sample_box[0], tlo[1] + res->sample_box[1], tlo[2] + res->sample_box[2]};
+            solid += gp_dem3d_solid_volume(tiled + 4 * t * n, n, tlo, thi);
+        }
+        S->porosity = 1 - solid / (res->box[0] * res->box[1] * res->box[2]);
+    } else {
+        S->porosity = S->sample_porosity;
+    }
+    res->t_tiling = now() - t_phase;
+
+    /* ---- measures on the final packing ---- */
+    contact_stats(fc, nfc, nf, &S->coordination_number, &S->coordination_spheres, &S->contacts,
+                  &S->wall_contacts);
+    S->particles = nf;
+    res->count = nf;
+    if (spec->outputs & GP_OUT3_FABRIC)
+        gp_dem3d_fabric(fc, nfc, S->fabric);
+    if (spec->outputs & GP_OUT3_STRESS)
+        gp_dem3d_stress(fc, nfc, fx, res->box[0] * res->box[1] * res->box[2], S->stress);
+    if (spec->outputs & GP_OUT3_SPHERES) {
+        if (tile) {
+            res->spheres = tiled;
+            tiled = NULL;
+        } else {
+            res->spheres = xyzr;
+            xyzr = NULL;
+        }
+    }
+    if (spec->outputs & GP_OUT3_CONTACTS) {
+        res->contacts = malloc((nfc ? nfc : 1) * sizeof *res->contacts);
+        if (!res->contacts) {
+            ret = gp_error_set(err, GP_ERR_NOMEM, "out of memory (contacts)");
+            goto fail;
+        }
+        for (size_t k = 0; k < nfc; k++) {
+            res->contacts[k].i = fc[k].i;
+            res->contacts[k].j = fc[k].j;
+            memcpy(res->contacts[k].normal, fc[k].normal, sizeof fc[k].normal);
+            res->contacts[k].overlap = fc[k].overlap;
+            memcpy(res->contacts[k].force, fc[k].force, sizeof fc[k].force);
+        }
+        res->ncontacts = nfc;
+    }
+    report(&rc, "tiling", 1.0, S->steps, S->porosity, S->stability, 1);
+    free(con); free(tcon); free(tiled); free(xyzr); free(diam); free(sd); free(sw);
+    gp_rng_destroy(rng);
+    res->t_total = now() - t0;
+    *out = res;
+    return ret;
+
+fail:
+    gp_dem3d_destroy(dem);
+    free(con); free(tcon); free(tiled); free(xyzr); free(diam); free(sd); free(sw);
+    if (rng) gp_rng_destroy(rng);
+    gp_specimen3d_destroy(res);
+    return ret;
+}
