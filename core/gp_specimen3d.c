@@ -7,13 +7,15 @@
  *    settle under gravity (the "grow radii" variant of pouring: the same loose, gravity-made
  *    structure without minutes of free fall), and left to settle.
  *  phase 1, compaction: the top wall becomes a servo wall (Eq. 10) pressing with
- *    COMPACTION_STRESS; instead of shaking the walls, the friction angle is halved whenever the
- *    packing has come to rest above the target height (the YADE practice of compacting with a
- *    reduced friction); the servo never goes below the target height b_z. When the top wall
- *    reaches b_z the friction is restored, the wall is fixed there, and
- *  relaxation runs until S_c <= 1e-4 (Eq. 7, NOTES.md). If the packing comes to rest above b_z
- *    even without friction, the target is denser than this sieve can pack ("target_too_dense");
- *    if the deposit settles below b_z at full friction, it is looser ("target_too_loose").
+ *    COMPACTION_STRESS and descends onto the deposit at full friction (phase 0's porosity is
+ *    read there); then, instead of shaking the walls, the friction is set to zero (the YADE
+ *    practice of compacting with reduced friction) and the wall pushes on; it never goes below
+ *    the target height b_z. When it reaches b_z the friction is restored, the wall is fixed, and
+ *  relaxation runs until S_c <= 1e-4 (Eq. 7, NOTES.md), with local damping raised to
+ *    RELAX_DAMPING. If the frictionless approach stalls above b_z (less than STALL_FRACTION of
+ *    the remaining porosity gained in STALL_STEPS), the target is denser than this sieve packs
+ *    in this box ("target_too_dense"); if after relaxation the top wall carries no force, the
+ *    packing settled below it ("target_too_loose").
  *  phase 2, tiling: gp_flip.
  */
 #include "gp_specimen3d.h"
