@@ -485,7 +485,7 @@ gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *
             S.ct[b]++;
         }
         double En = current_error(&S), En2 = En <= E ? sec_error(&S) : 0.0;
-        if (En < E || (En == E && En2 < E2nd)) {
+        if (En < E || (En == E && En2 <= E2nd)) {
             for (size_t k = 0; k < nch; k++) {
                 S.clss[ch[k]] = undo_s[k];
                 S.clst[ch[k]] = undo_t[k];
