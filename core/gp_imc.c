@@ -10,6 +10,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "gp_rng.h"
 
@@ -364,7 +365,12 @@ gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *
             seeds[i++] = q;
         }
     }
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
     v = gp_voronoi_create(outer, nouter, holes, nhole, nholes, seeds, n, err);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (rep)
+        rep->t_init = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     if (!v) {
         st = err ? err->code : GP_ERR_INVALID;
         goto done;
@@ -425,7 +431,7 @@ gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *
             break;
         }
         if (steps >= p->max_steps) break;
-        if ((steps % GP_IMC_CANCEL_EVERY) == 0 && cancel && *cancel) {
+        if ((steps % GP_IMC_CANCEL_EVERY) == 0 && cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED)) {
             why = GP_IMC_STOP_CANCELLED;
             break;
         }

@@ -82,6 +82,7 @@ typedef struct gp_imc_report {
     double error_initial;
     double error_size;   /* |h_S - H_S|_2 and |h_t - H_t|_2 at the end */
     double error_orient;
+    double t_init;       /* seconds spent building the initial tessellation (the rest is steps) */
     double floor;        /* the integer-count floor of the chosen kind for these classes */
     gp_imc_stop stop_reason;
     size_t nsize, norient;

@@ -91,7 +91,7 @@ typedef struct run_ctx {
 static int report(run_ctx *c, const char *phase, double fraction, long steps, double porosity,
                   double sc, int force)
 {
-    if (c->cancel && *c->cancel)
+    if (c->cancel && __atomic_load_n((const int *)c->cancel, __ATOMIC_RELAXED))
         return 1;
     if (!c->fn)
         return 0;
