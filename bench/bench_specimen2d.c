@@ -65,7 +65,7 @@ int main(int argc, char **argv)
         {"10,000 grains, 2 thr.", 10000, 0.5, 1.0, 0.1, 0.05, 0.02, 2, all},
     };
     printf("2D Fourier-Voronoi specimen, end to end (F_S = 0.65, E3 threshold 0.002, Np = 128)\n");
-    printf("fill/s = grains filled per second of one thread's fill time\n\n");
+    printf("fill/s = grains filled per second of the fill phase (wall time; per thread divide by th)\n\n");
     printf("| %-22s | %6s | %2s | %8s | %7s | %6s | %6s | %6s | %7s | %8s | %8s | %6s | %5s | %7s |\n",
            "case", "grains", "th", "IMC step", "IMC s", "fill s", "odec s", "desc s", "total s",
            "fill/s", "E3", "SF", "gap", "|dElong|");
