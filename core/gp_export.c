@@ -1,0 +1,497 @@
+/* gp_export.c -- format registry, packs, the cached pack reader and the pull-stream driver.
+ * The formats themselves are in gp_export_{lammps,yade,vtk,csv}.c. */
+#include "gp_export_internal.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CACHE_BYTES (64u * 1024u)
+#define WRITE_CHUNK (64u * 1024u)
+
+/* ------------------------------------------------------------------ registry */
+
+static const struct {
+    const char *name, *ext, *mime;
+    unsigned dims; /* bit 2: 2D, bit 3: 3D */
+} formats[GP_EXPORT_NFORMATS] = {
+    [GP_EXPORT_LAMMPS] = {"lammps", "data", "text/plain; charset=utf-8", 1u << 2 | 1u << 3},
+    [GP_EXPORT_LIGGGHTS] = {"liggghts", "data", "text/plain; charset=utf-8", 1u << 3},
+    [GP_EXPORT_YADE] = {"yade", "txt", "text/plain; charset=utf-8", 1u << 2 | 1u << 3},
+    [GP_EXPORT_VTK] = {"vtk", "vtk", "application/octet-stream", 1u << 2 | 1u << 3},
+    [GP_EXPORT_CSV] = {"csv", "csv", "text/csv; charset=utf-8", 1u << 2 | 1u << 3},
+};
+
+int gp_export_format_parse(const char *name)
+{
+    if (!name) return -1;
+    for (int f = 0; f < GP_EXPORT_NFORMATS; f++)
+        if (!strcmp(name, formats[f].name)) return f;
+    return -1;
+}
+
+const char *gp_export_format_name(gp_export_format f)
+{
+    return (unsigned)f < GP_EXPORT_NFORMATS ? formats[f].name : "?";
+}
+
+int gp_export_format_supports(gp_export_format f, int dim)
+{
+    return (unsigned)f < GP_EXPORT_NFORMATS && (dim == 2 || dim == 3) &&
+           (formats[f].dims >> dim & 1u);
+}
+
+const char *gp_export_format_list(int dim)
+{
+    return dim == 2 ? "lammps, yade, vtk, csv" : "lammps, liggghts, yade, vtk, csv";
+}
+
+const char *gp_export_format_extension(gp_export_format f)
+{
+    return (unsigned)f < GP_EXPORT_NFORMATS ? formats[f].ext : "bin";
+}
+
+const char *gp_export_format_mime(gp_export_format f)
+{
+    return (unsigned)f < GP_EXPORT_NFORMATS ? formats[f].mime : "application/octet-stream";
+}
+
+/* ------------------------------------------------------------------ packs */
+
+typedef struct pack_header {
+    char magic[8];
+    uint32_t bom, version, dim, flags;
+    uint64_t nitems, npoints, ndiscs;
+    double density;
+    double lo[3], hi[3];
+    double max_extent; /* 2D: the largest grain's bounding-box diagonal */
+} pack_header;
+
+_Static_assert(sizeof(pack_header) <= GP_PACK_HEADER, "pack header fits its 128 bytes");
+
+static void header_init(pack_header *h, int dim, double density)
+{
+    memset(h, 0, sizeof *h);
+    memcpy(h->magic, GP_PACK_MAGIC, 8);
+    h->bom = GP_PACK_BOM;
+    h->version = GP_PACK_VERSION;
+    h->dim = (uint32_t)dim;
+    h->density = density;
+}
+
+static gp_status check_density(double density, gp_error *err)
+{
+    if (!(density > 0) || !isfinite(density))
+        return gp_error_set(err, GP_ERR_INVALID, "density must be a finite number > 0");
+    return GP_OK;
+}
+
+gp_status gp_export_pack_3d(const gp_specimen3d *s, double density, void **pack, size_t *len,
+                            gp_error *err)
+{
+    *pack = NULL;
+    *len = 0;
+    if (!s) return gp_error_set(err, GP_ERR_INVALID, "no specimen");
+    if (!s->spheres && s->count > 0)
+        return gp_error_set(err, GP_ERR_INVALID,
+                            "the specimen has no sphere list (outputs must include \"spheres\")");
+    gp_status st = check_density(density, err);
+    if (st) return st;
+    if (s->count > (SIZE_MAX - GP_PACK_HEADER) / 32)
+        return gp_error_set(err, GP_ERR_NOMEM, "too many spheres to pack");
+    size_t n = GP_PACK_HEADER + 32 * s->count;
+    unsigned char *p = calloc(1, n);
+    if (!p) return gp_error_set(err, GP_ERR_NOMEM, "out of memory packing %zu spheres", s->count);
+    pack_header h;
+    header_init(&h, 3, density);
+    h.nitems = s->count;
+    for (int k = 0; k < 3; k++) {
+        h.lo[k] = 0.0;
+        h.hi[k] = s->box[k];
+    }
+    memcpy(p, &h, sizeof h);
+    if (s->count) memcpy(p + GP_PACK_HEADER, s->spheres, 32 * s->count);
+    *pack = p;
+    *len = n;
+    return GP_OK;
+}
+
+static void put_u64(unsigned char **w, uint64_t v)
+{
+    memcpy(*w, &v, 8);
+    *w += 8;
+}
+
+static void put_f64(unsigned char **w, double v)
+{
+    memcpy(*w, &v, 8);
+    *w += 8;
+}
+
+gp_status gp_export_pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, double density,
+                            void **pack, size_t *len, gp_error *err)
+{
+    *pack = NULL;
+    *len = 0;
+    if (!s || !spec) return gp_error_set(err, GP_ERR_INVALID, "no specimen");
+    gp_status st = check_density(density, err);
+    if (st) return st;
+    uint64_t npts = 0, ndisc = 0;
+    for (size_t g = 0; g < s->ngrains; g++) {
+        const gp_grain2d *gr = &s->grains[g];
+        if (!gr->discs || gr->ndiscs == 0)
+            return gp_error_set(err, GP_ERR_INVALID,
+                                "grain %zu has no ODEC discs (outputs must include \"odec\")", g);
+        npts += gr->ncontour;
+        ndisc += gr->ndiscs;
+    }
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    if (spec->container == GP_CONTAINER_CIRCLE) {
+        lo[0] = spec->circle_center.x - spec->circle_radius;
+        hi[0] = spec->circle_center.x + spec->circle_radius;
+        lo[1] = spec->circle_center.y - spec->circle_radius;
+        hi[1] = spec->circle_center.y + spec->circle_radius;
+    } else {
+        for (size_t i = 0; i < spec->outer.n; i++) {
+            lo[0] = fmin(lo[0], spec->outer.pts[i].x);
+            hi[0] = fmax(hi[0], spec->outer.pts[i].x);
+            lo[1] = fmin(lo[1], spec->outer.pts[i].y);
+            hi[1] = fmax(hi[1], spec->outer.pts[i].y);
+        }
+    }
+    if (!(lo[0] < hi[0]) || !(lo[1] < hi[1]))
+        return gp_error_set(err, GP_ERR_INVALID, "the container has no extent");
+    uint64_t bytes = GP_PACK_HEADER + (uint64_t)GP_PACK_GRAIN * s->ngrains + 16 * npts + 24 * ndisc;
+    if (bytes > SIZE_MAX) return gp_error_set(err, GP_ERR_NOMEM, "specimen too large to pack");
+    unsigned char *p = calloc(1, (size_t)bytes);
+    if (!p) return gp_error_set(err, GP_ERR_NOMEM, "out of memory packing %zu grains", s->ngrains);
+    pack_header h;
+    header_init(&h, 2, density);
+    int with_desc = (spec->outputs & GP_OUT_DESCRIPTORS) != 0;
+    h.flags = with_desc ? GP_EXPORT_HAS_DESCRIPTORS : 0;
+    h.nitems = s->ngrains;
+    h.npoints = npts;
+    h.ndiscs = ndisc;
+    h.lo[0] = lo[0];
+    h.lo[1] = lo[1];
+    h.hi[0] = hi[0];
+    h.hi[1] = hi[1];
+    double ext = 0;
+    for (size_t g = 0; g < s->ngrains; g++) {
+        const gp_grain2d *gr = &s->grains[g];
+        double a[2] = {INFINITY, INFINITY}, b[2] = {-INFINITY, -INFINITY};
+        for (size_t k = 0; k < gr->ncontour; k++) {
+            a[0] = fmin(a[0], gr->contour[k].x);
+            b[0] = fmax(b[0], gr->contour[k].x);
+            a[1] = fmin(a[1], gr->contour[k].y);
+            b[1] = fmax(b[1], gr->contour[k].y);
+        }
+        if (gr->ncontour) ext = fmax(ext, hypot(b[0] - a[0], b[1] - a[1]));
+    }
+    h.max_extent = ext;
+    memcpy(p, &h, sizeof h);
+    unsigned char *w = p + GP_PACK_HEADER;
+    unsigned char *wp = p + GP_PACK_HEADER + (size_t)GP_PACK_GRAIN * s->ngrains;
+    unsigned char *wd = wp + 16 * npts;
+    uint64_t pf = 0, df = 0;
+    for (size_t g = 0; g < s->ngrains; g++) {
+        const gp_grain2d *gr = &s->grains[g];
+        put_u64(&w, pf);
+        put_u64(&w, gr->ncontour);
+        put_u64(&w, df);
+        put_u64(&w, gr->ndiscs);
+        put_f64(&w, gr->area);
+        put_f64(&w, gr->orientation_deg);
+        const gp_descriptors *d = &gr->descriptors;
+        put_f64(&w, with_desc ? d->elongation : NAN);
+        put_f64(&w, with_desc ? d->roundness : NAN);
+        put_f64(&w, with_desc ? d->circularity : NAN);
+        put_f64(&w, with_desc ? d->regularity : NAN);
+        for (size_t k = 0; k < gr->ncontour; k++) {
+            put_f64(&wp, gr->contour[k].x);
+            put_f64(&wp, gr->contour[k].y);
+        }
+        memcpy(wd, gr->discs, 24 * gr->ndiscs);
+        wd += 24 * gr->ndiscs;
+        pf += gr->ncontour;
+        df += gr->ndiscs;
+    }
+    *pack = p;
+    *len = (size_t)bytes;
+    return GP_OK;
+}
+
+/* ------------------------------------------------------------------ sources */
+
+/* The pack in memory. Bounds are checked by cache_get() against the source's size before any
+ * read, so the reader itself only copies. */
+static int mem_read(void *user, uint64_t off, void *dst, size_t n)
+{
+    memcpy(dst, (const unsigned char *)user + off, n);
+    return 0;
+}
+
+gp_export_source gp_export_memory_source(const void *pack, size_t len)
+{
+    gp_export_source s = {mem_read, (void *)pack, len};
+    return s;
+}
+
+static int src_read(gp_export *e, uint64_t off, void *dst, size_t n)
+{
+    return e->src.read(e->src.user, off, dst, n);
+}
+
+/* Makes [off, off + n) available in the cache; returns a pointer into it or NULL. */
+static const unsigned char *cache_get(gp_export *e, uint64_t off, size_t n)
+{
+    if (off >= e->cache_off && off + n <= e->cache_off + e->cache_len)
+        return e->cache + (off - e->cache_off);
+    if (off > e->src.size || n > e->src.size - off || n > CACHE_BYTES) {
+        gp_error_set(&e->err, GP_ERR_INVALID, "pack truncated: %zu bytes at offset %llu of %llu",
+                     n, (unsigned long long)off, (unsigned long long)e->src.size);
+        return NULL;
+    }
+    uint64_t want = e->src.size - off;
+    size_t len = want < CACHE_BYTES ? (size_t)want : CACHE_BYTES;
+    if (src_read(e, off, e->cache, len)) {
+        e->cache_len = 0;
+        gp_error_set(&e->err, GP_ERR_INVALID, "reading the pack failed at offset %llu",
+                     (unsigned long long)off);
+        return NULL;
+    }
+    e->cache_off = off;
+    e->cache_len = len;
+    return e->cache;
+}
+
+static int read_f64s(gp_export *e, uint64_t off, double *out, int n)
+{
+    const unsigned char *p = cache_get(e, off, 8 * (size_t)n);
+    if (!p) return -1;
+    memcpy(out, p, 8 * (size_t)n);
+    return 0;
+}
+
+int gp_xr_sphere(gp_export *e, uint64_t i, double q[4])
+{
+    if (i >= e->nitems) return gp_error_set(&e->err, GP_ERR_INTERNAL, "sphere %llu", (unsigned long long)i), -1;
+    return read_f64s(e, e->off_items + 32 * i, q, 4);
+}
+
+int gp_xr_grain(gp_export *e, uint64_t g, gp_xgrain *out)
+{
+    if (g >= e->nitems) return gp_error_set(&e->err, GP_ERR_INTERNAL, "grain %llu", (unsigned long long)g), -1;
+    const unsigned char *p = cache_get(e, e->off_items + (uint64_t)GP_PACK_GRAIN * g, GP_PACK_GRAIN);
+    if (!p) return -1;
+    memcpy(&out->point_first, p, 8);
+    memcpy(&out->point_count, p + 8, 8);
+    memcpy(&out->disc_first, p + 16, 8);
+    memcpy(&out->disc_count, p + 24, 8);
+    memcpy(&out->area, p + 32, 8);
+    memcpy(&out->orientation_deg, p + 40, 8);
+    memcpy(&out->elongation, p + 48, 8);
+    memcpy(&out->roundness, p + 56, 8);
+    memcpy(&out->circularity, p + 64, 8);
+    memcpy(&out->regularity, p + 72, 8);
+    /* a corrupt record must not send the readers past their arrays */
+    if (out->point_first > e->npoints || out->point_count > e->npoints - out->point_first ||
+        out->disc_first > e->ndiscs || out->disc_count > e->ndiscs - out->disc_first) {
+        gp_error_set(&e->err, GP_ERR_INVALID, "pack grain %llu points outside its arrays",
+                     (unsigned long long)g);
+        return -1;
+    }
+    return 0;
+}
+
+int gp_xr_point(gp_export *e, uint64_t k, double p[2])
+{
+    if (k >= e->npoints) return gp_error_set(&e->err, GP_ERR_INTERNAL, "point %llu", (unsigned long long)k), -1;
+    return read_f64s(e, e->off_points + 16 * k, p, 2);
+}
+
+int gp_xr_disc(gp_export *e, uint64_t k, double d[3])
+{
+    if (k >= e->ndiscs) return gp_error_set(&e->err, GP_ERR_INTERNAL, "disc %llu", (unsigned long long)k), -1;
+    return read_f64s(e, e->off_discs + 24 * k, d, 3);
+}
+
+/* ------------------------------------------------------------------ writer */
+
+int gp_xw_printf(gp_export *e, const char *fmt, ...)
+{
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        size_t room = e->cap - e->len;
+        int k = vsnprintf(e->buf + e->len, room, fmt, ap);
+        va_end(ap);
+        if (k < 0) {
+            gp_error_set(&e->err, GP_ERR_INTERNAL, "formatting failed");
+            return -1;
+        }
+        if ((size_t)k < room) {
+            e->len += (size_t)k;
+            return 0;
+        }
+        size_t ncap = e->cap * 2 > e->len + (size_t)k + 1 ? e->cap * 2 : e->len + (size_t)k + 1;
+        char *nb = realloc(e->buf, ncap);
+        if (!nb) {
+            gp_error_set(&e->err, GP_ERR_NOMEM, "out of memory formatting a record");
+            return -1;
+        }
+        e->buf = nb;
+        e->cap = ncap;
+    }
+}
+
+/* ------------------------------------------------------------------ stream */
+
+gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_export **out,
+                         gp_error *err)
+{
+    *out = NULL;
+    if ((unsigned)f >= GP_EXPORT_NFORMATS)
+        return gp_error_set(err, GP_ERR_INVALID, "unknown export format %d", (int)f);
+    if (!src || !src->read) return gp_error_set(err, GP_ERR_INVALID, "no source");
+    if (src->size < GP_PACK_HEADER)
+        return gp_error_set(err, GP_ERR_INVALID, "not an export pack (%llu bytes)",
+                            (unsigned long long)src->size);
+    gp_export *e = calloc(1, sizeof *e);
+    if (!e) return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    e->format = f;
+    e->src = *src;
+    e->cache = malloc(CACHE_BYTES);
+    e->cap = 4096;
+    e->buf = malloc(e->cap);
+    if (!e->cache || !e->buf) {
+        gp_export_destroy(e);
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    }
+    pack_header h;
+    const unsigned char *p = cache_get(e, 0, GP_PACK_HEADER);
+    if (!p) {
+        gp_status st = gp_error_set(err, e->err.code, "%s", e->err.message);
+        gp_export_destroy(e);
+        return st;
+    }
+    memcpy(&h, p, sizeof h);
+    const char *why = NULL;
+    if (memcmp(h.magic, GP_PACK_MAGIC, 8)) why = "bad magic";
+    else if (h.bom != GP_PACK_BOM) why = "written with another byte order";
+    else if (h.version != GP_PACK_VERSION) why = "unknown version";
+    else if (h.dim != 2 && h.dim != 3) why = "bad dimension";
+    if (!why) {
+        e->dim = (int)h.dim;
+        e->flags = h.flags;
+        e->nitems = h.nitems;
+        e->npoints = h.npoints;
+        e->ndiscs = h.ndiscs;
+        e->density = h.density;
+        memcpy(e->lo, h.lo, sizeof e->lo);
+        memcpy(e->hi, h.hi, sizeof e->hi);
+        e->max_extent = h.max_extent;
+        e->off_items = GP_PACK_HEADER;
+        /* sizes are checked in floating point first so that a corrupt count cannot wrap */
+        double need;
+        if (e->dim == 3) {
+            need = GP_PACK_HEADER + 32.0 * (double)e->nitems;
+        } else {
+            need = GP_PACK_HEADER + (double)GP_PACK_GRAIN * (double)e->nitems +
+                   16.0 * (double)e->npoints + 24.0 * (double)e->ndiscs;
+            e->off_points = GP_PACK_HEADER + (uint64_t)GP_PACK_GRAIN * e->nitems;
+            e->off_discs = e->off_points + 16 * e->npoints;
+        }
+        if (need != (double)src->size) why = "its size does not match its counts";
+    }
+    if (why) {
+        gp_export_destroy(e);
+        return gp_error_set(err, GP_ERR_INVALID, "not an export pack: %s", why);
+    }
+    if (!gp_export_format_supports(f, e->dim)) {
+        int dim = e->dim;
+        gp_export_destroy(e);
+        return gp_error_set(err, GP_ERR_INVALID, "format %s does not exist in %dD (valid: %s)",
+                            gp_export_format_name(f), dim, gp_export_format_list(dim));
+    }
+    switch (f) {
+    case GP_EXPORT_LAMMPS:
+        e->step = e->dim == 3 ? gp_export_step_lammps3d : gp_export_step_lammps2d;
+        break;
+    case GP_EXPORT_LIGGGHTS: e->step = gp_export_step_lammps3d; break;
+    case GP_EXPORT_YADE: e->step = gp_export_step_yade; break;
+    case GP_EXPORT_VTK: e->step = e->dim == 3 ? gp_export_step_vtk3d : gp_export_step_vtk2d; break;
+    default: e->step = gp_export_step_csv; break;
+    }
+    *out = e;
+    return GP_OK;
+}
+
+int gp_export_dim(const gp_export *e) { return e->dim; }
+uint64_t gp_export_items(const gp_export *e) { return e->nitems; }
+uint64_t gp_export_discs(const gp_export *e) { return e->ndiscs; }
+
+gp_status gp_export_read(gp_export *e, char *buf, size_t cap, size_t *n, gp_error *err)
+{
+    *n = 0;
+    if (e->failed) return gp_error_set(err, e->err.code, "%s", e->err.message);
+    size_t got = 0;
+    while (got < cap) {
+        if (e->pos < e->len) {
+            size_t k = e->len - e->pos;
+            if (k > cap - got) k = cap - got;
+            memcpy(buf + got, e->buf + e->pos, k);
+            e->pos += k;
+            got += k;
+            continue;
+        }
+        if (e->done) break;
+        e->len = e->pos = 0;
+        int r = e->step(e);
+        if (r < 0) {
+            e->failed = 1;
+            if (e->err.code == GP_OK) gp_error_set(&e->err, GP_ERR_INTERNAL, "export failed");
+            return gp_error_set(err, e->err.code, "%s", e->err.message);
+        }
+        if (r > 0) e->done = 1;
+    }
+    *n = got;
+    return GP_OK;
+}
+
+void gp_export_destroy(gp_export *e)
+{
+    if (!e) return;
+    free(e->cache);
+    free(e->buf);
+    free(e);
+}
+
+gp_status gp_export_write_all(gp_export_format f, const void *pack, size_t len,
+                              int (*write)(void *user, const char *buf, size_t n), void *user,
+                              gp_error *err)
+{
+    gp_export_source src = gp_export_memory_source(pack, len);
+    gp_export *e;
+    gp_status st = gp_export_open(f, &src, &e, err);
+    if (st) return st;
+    char *buf = malloc(WRITE_CHUNK);
+    if (!buf) {
+        gp_export_destroy(e);
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    }
+    for (;;) {
+        size_t n;
+        st = gp_export_read(e, buf, WRITE_CHUNK, &n, err);
+        if (st || n == 0) break;
+        if (write(user, buf, n)) {
+            st = gp_error_set(err, GP_ERR_INVALID, "writing the export failed");
+            break;
+        }
+    }
+    free(buf);
+    gp_export_destroy(e);
+    return st;
+}

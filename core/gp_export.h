@@ -1,0 +1,127 @@
+/* gp_export.h -- a finished specimen as the files DEM codes read (LAMMPS, LIGGGHTS, YADE,
+ * VTK/ParaView, CSV), produced as a pull stream so that a 230,000-sphere packing or a
+ * 10,000-grain ODEC file never has to exist in memory as text.
+ *
+ * Two steps, because the service writes a job's result once and serves it many times:
+ *
+ *  1. gp_export_pack_3d() / gp_export_pack_2d() turn a specimen into a compact binary "pack"
+ *     (layout below), built when the job finishes and stored next to its JSON result.
+ *  2. gp_export_open() reads a pack through a byte-range reader (a memory buffer, an SQLite
+ *     incremental blob, a file...) and gp_export_read() hands the file out in pieces of any
+ *     size. Working memory is O(1) in the specimen size: one staging buffer of one record (a
+ *     line) and a 64 KiB read cache.
+ *
+ * The format families live in gp_export_lammps.c (lammps, liggghts), gp_export_yade.c,
+ * gp_export_vtk.c and gp_export_csv.c, behind one small record-writer interface
+ * (gp_export_internal.h). Everything is SI, as in the JSON result; reals are written with
+ * %.17g, which reads back bit for bit.
+ *
+ * Pack layout (native byte order and IEEE doubles, as the daemon reads what it wrote on the
+ * same machine; the header carries a byte-order mark and a version, checked on open):
+ *
+ *   header, 128 bytes:
+ *     char     magic[8]   "GPEXPACK"
+ *     uint32   bom        0x01020304
+ *     uint32   version    1
+ *     uint32   dim        2 or 3
+ *     uint32   flags      GP_EXPORT_HAS_DESCRIPTORS (2D)
+ *     uint64   nitems     3D: spheres; 2D: grains
+ *     uint64   npoints    2D: contour points of all grains
+ *     uint64   ndiscs     2D: ODEC discs of all grains
+ *     double   density    kg/m^3
+ *     double   lo[3], hi[3]  the box (3D: [0, box]; 2D: the container's bounding box, z 0)
+ *     double   max_extent 2D: the largest grain's bounding-box diagonal (for LAMMPS' cutoff)
+ *     (zero padding to 128)
+ *   3D: nitems records of 4 doubles x, y, z, r.
+ *   2D: nitems grain records of 10 x 8 bytes:
+ *         uint64 point_first, point_count, disc_first, disc_count;
+ *         double area, orientation_deg, elongation, roundness, circularity, regularity
+ *       then npoints x (x, y) doubles, then ndiscs x (x, y, r) doubles.
+ */
+#ifndef GP_EXPORT_H
+#define GP_EXPORT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "gp_error.h"
+#include "gp_specimen2d.h"
+#include "gp_specimen3d.h"
+
+typedef enum gp_export_format {
+    GP_EXPORT_LAMMPS = 0, /* LAMMPS data file (3D atom_style sphere; 2D hybrid sphere molecular) */
+    GP_EXPORT_LIGGGHTS,   /* LIGGGHTS 3.8 data file, atom_style sphere (3D only) */
+    GP_EXPORT_YADE,       /* ymport.text (3D: x y z r) / ymport.textClumps (2D: x y z r clump) */
+    GP_EXPORT_VTK,        /* legacy VTK polydata, ASCII (ParaView, VTK readers) */
+    GP_EXPORT_CSV,        /* 3D: x,y,z,r; 2D: grain,x,y,r (one disc per line) */
+    GP_EXPORT_NFORMATS
+} gp_export_format;
+
+#define GP_EXPORT_HAS_DESCRIPTORS 1u
+
+/* The 2D default density (kg/m^3) when a spec has no material: quartz, 2650. */
+#define GP_EXPORT_DEFAULT_DENSITY 2650.0
+
+/* Parses a format name ("lammps", ...); -1 when unknown. */
+int gp_export_format_parse(const char *name);
+const char *gp_export_format_name(gp_export_format f);
+/* Whether the format exists for specimens of dimension dim (2 or 3). */
+int gp_export_format_supports(gp_export_format f, int dim);
+/* "lammps, liggghts, yade, vtk, csv" for dim 3, "lammps, yade, vtk, csv" for dim 2. */
+const char *gp_export_format_list(int dim);
+/* File name extension (without dot) and MIME type of a format. */
+const char *gp_export_format_extension(gp_export_format f);
+const char *gp_export_format_mime(gp_export_format f);
+
+/* ---- packs ---- */
+
+/* Packs a 3D specimen (which must carry its spheres) with the given density. *pack is
+ * malloc'ed; free() it. */
+gp_status gp_export_pack_3d(const gp_specimen3d *s, double density, void **pack, size_t *len,
+                            gp_error *err);
+
+/* Packs a 2D specimen, which must carry its ODEC discs (outputs "odec"). The box is the
+ * bounding box of spec's container; descriptors are packed when spec->outputs asks for them. */
+gp_status gp_export_pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, double density,
+                            void **pack, size_t *len, gp_error *err);
+
+/* ---- streaming ---- */
+
+/* Reads n bytes at offset off of the pack into dst; returns 0 on success. */
+typedef int (*gp_export_read_fn)(void *user, uint64_t off, void *dst, size_t n);
+
+typedef struct gp_export_source {
+    gp_export_read_fn read;
+    void *user;
+    uint64_t size; /* bytes in the pack */
+} gp_export_source;
+
+/* A source over a pack in memory (the pack must outlive the source's use). */
+gp_export_source gp_export_memory_source(const void *pack, size_t len);
+
+typedef struct gp_export gp_export;
+
+/* Opens an export of the pack behind src in format f. GP_ERR_INVALID when the pack is not one
+ * (magic, byte order, version, sizes) or the format does not exist for its dimension. The
+ * source must stay valid until gp_export_destroy. */
+gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_export **out,
+                         gp_error *err);
+
+/* The pack's dimension (2 or 3), item count (spheres or grains) and disc count (2D). */
+int gp_export_dim(const gp_export *e);
+uint64_t gp_export_items(const gp_export *e);
+uint64_t gp_export_discs(const gp_export *e);
+
+/* Copies up to cap bytes of the file into buf; *n = 0 means the end. GP_ERR_INVALID when the
+ * source failed or the pack is inconsistent (the file is then incomplete: drop it). */
+gp_status gp_export_read(gp_export *e, char *buf, size_t cap, size_t *n, gp_error *err);
+
+void gp_export_destroy(gp_export *e);
+
+/* Convenience: the whole export of an in-memory pack through a write callback (e.g. fwrite
+ * to a file), in 64 KiB pieces. The callback returns 0 on success. */
+gp_status gp_export_write_all(gp_export_format f, const void *pack, size_t len,
+                              int (*write)(void *user, const char *buf, size_t n), void *user,
+                              gp_error *err);
+
+#endif /* GP_EXPORT_H */

@@ -1,0 +1,72 @@
+/* gp_export_internal.h -- the record-writer interface shared by the export format families.
+ *
+ * A format is a step function called by gp_export_read() whenever its staging buffer is empty.
+ * Each call writes one record (a line, or a header block) with gp_xw_printf() and advances
+ * e->section / e->index / e->sub; it returns 0 while there is more, 1 after the last record and
+ * -1 on a failed read (the reader functions below set the error). Keeping a step to one record
+ * is what bounds memory: the staging buffer only ever holds the largest single record.
+ */
+#ifndef GP_EXPORT_INTERNAL_H
+#define GP_EXPORT_INTERNAL_H
+
+#include "gp_export.h"
+
+#define GP_PACK_MAGIC "GPEXPACK"
+#define GP_PACK_BOM 0x01020304u
+#define GP_PACK_VERSION 1u
+#define GP_PACK_HEADER 128u
+#define GP_PACK_GRAIN 80u /* bytes per 2D grain record */
+
+/* One 2D grain record of the pack. */
+typedef struct gp_xgrain {
+    uint64_t point_first, point_count, disc_first, disc_count;
+    double area, orientation_deg, elongation, roundness, circularity, regularity;
+} gp_xgrain;
+
+struct gp_export {
+    gp_export_format format;
+    gp_export_source src;
+    /* header */
+    int dim;
+    unsigned flags;
+    uint64_t nitems, npoints, ndiscs;
+    double density;
+    double lo[3], hi[3];
+    double max_extent;    /* 2D: largest grain bounding-box diagonal */
+    uint64_t off_items, off_points, off_discs; /* byte offsets of the arrays */
+    /* read cache */
+    unsigned char *cache;
+    uint64_t cache_off;
+    size_t cache_len;
+    /* staging buffer: the current record */
+    char *buf;
+    size_t len, pos, cap;
+    /* the format's cursor */
+    int (*step)(gp_export *e);
+    int section;
+    uint64_t index, sub;
+    gp_xgrain grain;      /* the grain at e->index (2D), loaded by the family */
+    double aux;           /* per-grain scratch (e.g. LAMMPS 2D density scale) */
+    int done;
+    gp_error err;
+    int failed;
+};
+
+/* Appends formatted text to the staging buffer (grows it); -1 on out of memory. */
+int gp_xw_printf(gp_export *e, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* Record readers (0 on success, -1 with e->err set). */
+int gp_xr_sphere(gp_export *e, uint64_t i, double q[4]);
+int gp_xr_grain(gp_export *e, uint64_t g, gp_xgrain *out);
+int gp_xr_point(gp_export *e, uint64_t k, double p[2]);
+int gp_xr_disc(gp_export *e, uint64_t k, double d[3]);
+
+/* The step functions of the families. */
+int gp_export_step_lammps3d(gp_export *e);   /* lammps and liggghts */
+int gp_export_step_lammps2d(gp_export *e);
+int gp_export_step_yade(gp_export *e);
+int gp_export_step_vtk3d(gp_export *e);
+int gp_export_step_vtk2d(gp_export *e);
+int gp_export_step_csv(gp_export *e);
+
+#endif /* GP_EXPORT_INTERNAL_H */
