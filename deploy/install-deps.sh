@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
-# Installs the Debian packages grainpack builds against (and the tools its tests use).
-# Idempotent; needs root (or sudo). Usage: bash deploy/install-deps.sh
+# Installs the Debian packages grainpack builds against. With --test, also the tools its tests
+# use: the DEM programs lammps, liggghts and yade, and VTK's Python reader, which prove that the
+# export files load (tests/run.sh passes it).
+# Idempotent; needs root (or sudo). Usage: bash deploy/install-deps.sh [--test]
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PKGS="build-essential cmake pkg-config \
   libmicrohttpd-dev libjansson-dev libsqlite3-dev libfftw3-dev libgsl-dev \
   python3 curl wrk"
+if [ "${1:-}" = "--test" ]; then
+  PKGS="$PKGS lammps liggghts yade python3-vtk9"
+fi
 missing=""
 for p in $PKGS; do
   dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"

@@ -16,6 +16,7 @@
 #include <jansson.h>
 #include <microhttpd.h>
 
+#include "gp_export.h"
 #include "store.h"
 #include "workers.h"
 #ifdef GPD_HAVE_SCHEMA
@@ -394,19 +395,65 @@ static enum MHD_Result not_ready(struct MHD_Connection *c, req *r, const char *i
                       "job %s is %s; the result exists only once it has succeeded", id, status);
 }
 
+/* Results and packs up to this size are read whole; larger ones are streamed from SQLite
+ * (incremental blob I/O on a private connection), so that serving a 230,000-sphere result
+ * costs the daemon a few hundred KB, not the result's size. */
+#define STREAM_SMALL (256u * 1024u)
+#define STREAM_BLOCK (32u * 1024u)
+
+static ssize_t read_result_stream(void *cls, uint64_t pos, char *buf, size_t max)
+{
+    store_stream *s = cls;
+    uint64_t size = store_stream_size(s);
+    if (pos >= size) return MHD_CONTENT_READER_END_OF_STREAM;
+    size_t n = size - pos < max ? (size_t)(size - pos) : max;
+    if (store_stream_read(s, pos, buf, n)) return MHD_CONTENT_READER_END_WITH_ERROR;
+    return (ssize_t)n;
+}
+
+static void free_result_stream(void *cls)
+{
+    store_stream_close(cls);
+}
+
+/* Queues a streamed response (takes ownership of cls, freed by fr even on failure). */
+static enum MHD_Result send_stream(struct MHD_Connection *c, req *r, const char *ctype,
+                                   uint64_t size, MHD_ContentReaderCallback rd, void *cls,
+                                   MHD_ContentReaderFreeCallback fr, const char *disposition)
+{
+    struct MHD_Response *resp = MHD_create_response_from_callback(size, STREAM_BLOCK, rd, cls, fr);
+    if (!resp) {
+        fr(cls);
+        return MHD_NO;
+    }
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, ctype);
+    MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+    if (disposition) MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_DISPOSITION, disposition);
+    r->status = 200;
+    enum MHD_Result ret = MHD_queue_response(c, 200, resp);
+    MHD_destroy_response(resp);
+    return ret;
+}
+
 static enum MHD_Result h_result(struct MHD_Connection *c, req *r, const char *id)
 {
     char *text = NULL;
+    size_t len = 0;
     char st[16];
-    store_rc rc = store_get_text(id, "result", &text, st);
+    store_stream *s = NULL;
+    store_rc rc = store_stream_open(id, "result", STREAM_SMALL, &s, &text, &len, st);
     if (rc == STORE_NOT_FOUND) return not_found(c, r, id);
     if (rc != STORE_OK) return send_store_error(c, r);
-    if (strcmp(st, "succeeded") || !text) {
+    if (strcmp(st, "succeeded") || (!text && !s)) {
         free(text);
+        store_stream_close(s);
         return not_ready(c, r, id, st);
     }
-    return send_buf(c, r, 200, "application/json", text, strlen(text), MHD_RESPMEM_MUST_FREE,
-                    NULL);
+    if (text)
+        return send_buf(c, r, 200, "application/json", text, len, MHD_RESPMEM_MUST_FREE, NULL);
+    return send_stream(c, r, "application/json", store_stream_size(s), read_result_stream, s,
+                       free_result_stream, NULL);
 }
 
 static enum MHD_Result h_spec(struct MHD_Connection *c, req *r, const char *id)
@@ -512,6 +559,42 @@ static enum MHD_Result h_svg(struct MHD_Connection *c, req *r, const char *id)
 #endif
 }
 
+/* An export being downloaded: the pack (in memory when small, else an SQLite stream) and the
+ * format's pull stream over it. */
+typedef struct export_dl {
+    store_stream *stream;
+    char *pack;
+    gp_export *e;
+} export_dl;
+
+static int export_src_read(void *user, uint64_t off, void *dst, size_t n)
+{
+    return store_stream_read(user, off, dst, n);
+}
+
+static ssize_t read_export(void *cls, uint64_t pos, char *buf, size_t max)
+{
+    (void)pos; /* the stream is read in order, once */
+    export_dl *d = cls;
+    size_t n = 0;
+    gp_error err;
+    if (gp_export_read(d->e, buf, max, &n, &err)) {
+        gpd_log(GPD_LOG_ERROR, "export failed mid-stream: %s", err.message);
+        return MHD_CONTENT_READER_END_WITH_ERROR;
+    }
+    return n ? (ssize_t)n : MHD_CONTENT_READER_END_OF_STREAM;
+}
+
+static void free_export(void *cls)
+{
+    export_dl *d = cls;
+    if (!d) return;
+    gp_export_destroy(d->e);
+    store_stream_close(d->stream);
+    free(d->pack);
+    free(d);
+}
+
 static enum MHD_Result h_export(struct MHD_Connection *c, req *r, const char *id)
 {
     char *kind = NULL;
@@ -522,19 +605,48 @@ static enum MHD_Result h_export(struct MHD_Connection *c, req *r, const char *id
         free(kind);
         return send_store_error(c, r);
     }
-    const char *formats = !strcmp(kind, "spheres-3d") ? "lammps, liggghts, yade, vtk, csv"
-                                                      : "lammps, yade, vtk, csv";
+    int dim = !strcmp(kind, "spheres-3d") ? 3 : 2;
     free(kind);
     const char *format = qarg(c, "format");
-    if (!format || !in_list(formats, format))
+    int f = gp_export_format_parse(format);
+    if (f < 0 || !gp_export_format_supports(f, dim))
         return send_error(c, r, 400, "invalid_parameter", NULL,
-                          "format: expected one of %s%s%.64s%s", formats,
+                          "format: expected one of %s%s%.64s%s", gp_export_format_list(dim),
                           format ? "; got \"" : "", format ? format : "", format ? "\"" : "");
     if (strcmp(st, "succeeded")) return not_ready(c, r, id, st);
-    return send_error(c, r, 501, "not_implemented", NULL,
-                      "exports are not implemented yet (a later issue); the result JSON at "
-                      "/v1/jobs/%s/result has the full geometry",
-                      id);
+
+    export_dl *d = calloc(1, sizeof *d);
+    if (!d) return send_error(c, r, 500, "internal", NULL, "out of memory");
+    size_t len = 0;
+    rc = store_stream_open(id, "pack", STREAM_SMALL, &d->stream, &d->pack, &len, st);
+    if (rc == STORE_NOT_FOUND) {
+        free_export(d);
+        return not_found(c, r, id);
+    }
+    if (rc != STORE_OK) {
+        free_export(d);
+        return send_store_error(c, r);
+    }
+    if (!d->pack && !d->stream) {
+        free_export(d);
+        return send_error(c, r, 409, "missing_output", "/outputs",
+                          "job %s has no %s to export (its spec did not ask for it): submit "
+                          "the spec again with \"%s\" in outputs",
+                          id, dim == 3 ? "sphere list" : "ODEC discs", dim == 3 ? "spheres" : "odec");
+    }
+    gp_export_source src = d->pack ? gp_export_memory_source(d->pack, len)
+                                   : (gp_export_source){export_src_read, d->stream,
+                                                        store_stream_size(d->stream)};
+    gp_error err;
+    if (gp_export_open(f, &src, &d->e, &err)) {
+        free_export(d);
+        return send_error(c, r, 500, "internal", NULL, "cannot export: %s", err.message);
+    }
+    char disp[160];
+    snprintf(disp, sizeof disp, "attachment; filename=\"%s-%s.%s\"", id,
+             gp_export_format_name(f), gp_export_format_extension(f));
+    return send_stream(c, r, gp_export_format_mime(f), MHD_SIZE_UNKNOWN, read_export, d,
+                       free_export, disp);
 }
 
 /* ------------------------------------------------------------------ routing */

@@ -41,7 +41,7 @@
  *  "contacts": [{"i", "j", "normal": [3], "overlap", "force": [3]}] (output contacts; j < 0 is
  *              wall -1-j, walls 0..5 = x-, x+, y-, y+, z-, z+)}
  * Histogram "target" is null where there is no target. Non-finite numbers are written as null;
- * reals are printed with 15 significant digits.
+ * reals are printed with 17 significant digits (they read back bit for bit, as in the exports).
  * The field names follow server/svg.h.
  */
 #ifndef GPD_RESULT_JSON_H

@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -141,7 +142,10 @@ static const char *SCHEMA_SQL =
     " error TEXT,"
     " result TEXT,"
     " attempts INTEGER NOT NULL DEFAULT 0);"
-    "CREATE INDEX IF NOT EXISTS jobs_status_seq ON jobs(status, seq);";
+    "CREATE INDEX IF NOT EXISTS jobs_status_seq ON jobs(status, seq);"
+    /* the export pack of a succeeded job (core/gp_export.h), keyed by the job's seq so that
+     * it can be read with incremental blob I/O */
+    "CREATE TABLE IF NOT EXISTS exports(seq INTEGER PRIMARY KEY, pack BLOB NOT NULL);";
 
 static sqlite3 *conn_open(void)
 {
@@ -592,13 +596,163 @@ store_rc store_progress(const char *id, const char *progress_json)
                           progress_json, NULL, NULL);
 }
 
-store_rc store_succeed(const char *id, const char *result_json, const char *progress_json)
+store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
+                       const void *pack, size_t pack_len)
 {
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
     char now[40];
     gpd_now_rfc3339(now, sizeof now);
-    return update_running("UPDATE jobs SET status='succeeded', result=?2, progress=?3, "
-                          "finished_at=?4, error=NULL WHERE id=?1 AND status='running'",
-                          id, result_json, progress_json, now);
+    /* The result, the pack and the status change commit together: a job never shows
+     * succeeded without its files. */
+    if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite begin: %s", sqlite3_errmsg(db));
+        return STORE_ERROR;
+    }
+    store_rc rc = STORE_ERROR;
+    sqlite3_stmt *u = prep(db, "UPDATE jobs SET status='succeeded', result=?2, progress=?3, "
+                               "finished_at=?4, error=NULL WHERE id=?1 AND status='running'");
+    if (u) {
+        bind_text(u, 1, id);
+        bind_text(u, 2, result_json);
+        bind_text(u, 3, progress_json);
+        bind_text(u, 4, now);
+        if (step_done(db, u) == 0) rc = sqlite3_changes(db) > 0 ? STORE_OK : STORE_CONFLICT;
+        done(u);
+    }
+    if (rc == STORE_OK && pack) {
+        sqlite3_stmt *x = prep(db, "INSERT OR REPLACE INTO exports(seq, pack) "
+                                   "SELECT seq, ?2 FROM jobs WHERE id=?1");
+        rc = STORE_ERROR;
+        if (x) {
+            bind_text(x, 1, id);
+            sqlite3_bind_blob64(x, 2, pack, pack_len, SQLITE_STATIC);
+            if (step_done(db, x) == 0) rc = STORE_OK;
+            done(x);
+        }
+    }
+    if (sqlite3_exec(db, rc == STORE_OK ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite commit: %s", sqlite3_errmsg(db));
+        sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL);
+        return STORE_ERROR;
+    }
+    return rc;
+}
+
+/* ------------------------------------------------------------------ streams */
+
+struct store_stream {
+    sqlite3 *db;
+    sqlite3_blob *blob;
+    uint64_t size;
+};
+
+/* Opens table.column of row seq on db; 0 on success, 1 when there is no such value. */
+static int blob_open(sqlite3 *db, const char *table, const char *column, sqlite3_int64 seq,
+                     sqlite3_blob **out)
+{
+    *out = NULL;
+    int rc = sqlite3_blob_open(db, "main", table, column, seq, 0, out);
+    if (rc == SQLITE_OK) return 0;
+    /* a NULL result or a job without a pack: "cannot open value of type null" / "no such
+     * rowid" */
+    sqlite3_blob_close(*out);
+    *out = NULL;
+    return 1;
+}
+
+store_rc store_stream_open(const char *id, const char *what, size_t small,
+                           store_stream **out, char **text, size_t *text_len, char status[16])
+{
+    *out = NULL;
+    *text = NULL;
+    *text_len = 0;
+    status[0] = 0;
+    int is_pack = !strcmp(what, "pack");
+    if (!is_pack && strcmp(what, "result")) return STORE_ERROR;
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
+    sqlite3_stmt *st = prep(db, "SELECT seq, status FROM jobs WHERE id=?1");
+    if (!st) return STORE_ERROR;
+    bind_text(st, 1, id);
+    int s = sqlite3_step(st);
+    sqlite3_int64 seq = 0;
+    if (s == SQLITE_ROW) {
+        seq = sqlite3_column_int64(st, 0);
+        const unsigned char *t = sqlite3_column_text(st, 1);
+        snprintf(status, 16, "%s", t ? (const char *)t : "");
+    }
+    done(st);
+    if (s == SQLITE_DONE) return STORE_NOT_FOUND;
+    if (s != SQLITE_ROW) {
+        gpd_log(GPD_LOG_ERROR, "sqlite stream: %s", sqlite3_errmsg(db));
+        return STORE_ERROR;
+    }
+    const char *table = is_pack ? "exports" : "jobs", *column = is_pack ? "pack" : "result";
+    /* Small values are read whole on this thread's connection and the blob closed at once;
+     * only large ones get a private connection that lives as long as the download. */
+    sqlite3_blob *b;
+    if (blob_open(db, table, column, seq, &b)) return STORE_OK; /* no value */
+    uint64_t size = (uint64_t)sqlite3_blob_bytes(b);
+    if (size <= small) {
+        char *buf = malloc(size + 1);
+        store_rc rc = STORE_ERROR;
+        if (buf && sqlite3_blob_read(b, buf, (int)size, 0) == SQLITE_OK) {
+            buf[size] = 0;
+            *text = buf;
+            *text_len = size;
+            rc = STORE_OK;
+        } else {
+            free(buf);
+        }
+        sqlite3_blob_close(b);
+        return rc;
+    }
+    sqlite3_blob_close(b);
+
+    pthread_mutex_lock(&path_mu);
+    char *path = (closed || !db_path) ? NULL : strdup(db_path);
+    pthread_mutex_unlock(&path_mu);
+    if (!path) return STORE_ERROR;
+    store_stream *ss = calloc(1, sizeof *ss);
+    if (!ss) {
+        free(path);
+        return STORE_ERROR;
+    }
+    int rc = sqlite3_open_v2(path, &ss->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX, NULL);
+    free(path);
+    if (rc == SQLITE_OK) {
+        sqlite3_busy_timeout(ss->db, 5000);
+        /* the blob is read front to back once: a small page cache is enough */
+        sqlite3_exec(ss->db, "PRAGMA cache_size=-256", NULL, NULL, NULL);
+    }
+    if (rc != SQLITE_OK || blob_open(ss->db, table, column, seq, &ss->blob)) {
+        gpd_log(GPD_LOG_ERROR, "sqlite stream open: %s", ss->db ? sqlite3_errmsg(ss->db) : "?");
+        store_stream_close(ss);
+        return STORE_ERROR;
+    }
+    ss->size = (uint64_t)sqlite3_blob_bytes(ss->blob);
+    *out = ss;
+    return STORE_OK;
+}
+
+uint64_t store_stream_size(const store_stream *s)
+{
+    return s->size;
+}
+
+int store_stream_read(store_stream *s, uint64_t off, void *dst, size_t n)
+{
+    if (off > s->size || n > s->size - off || n > INT_MAX) return -1;
+    return sqlite3_blob_read(s->blob, dst, (int)n, (int)off) == SQLITE_OK ? 0 : -1;
+}
+
+void store_stream_close(store_stream *s)
+{
+    if (!s) return;
+    sqlite3_blob_close(s->blob);
+    sqlite3_close_v2(s->db);
+    free(s);
 }
 
 store_rc store_fail(const char *id, const char *code, const char *message)

@@ -13,6 +13,8 @@
  *   result      TEXT                               JSON, written in the same statement as
  *                                                  status='succeeded' (durable before it shows)
  *   attempts    INTEGER NOT NULL DEFAULT 0         times a worker claimed the job
+ * and exports(seq INTEGER PRIMARY KEY = jobs.seq, pack BLOB NOT NULL): the export pack of a
+ * succeeded job (core/gp_export.h), committed with the result.
  *
  * Connections: one per thread (opened lazily, closed when the thread exits or on
  * store_close()); every write is a single statement or an IMMEDIATE transaction, so claims and
@@ -91,7 +93,8 @@ store_rc store_progress(const char *id, const char *progress_json);
 
 /* Final transitions of a running job (no-ops returning STORE_CONFLICT when it is no longer
  * running, e.g. cancelled by DELETE). */
-store_rc store_succeed(const char *id, const char *result_json, const char *progress_json);
+store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
+                       const void *pack, size_t pack_len);
 store_rc store_fail(const char *id, const char *code, const char *message);
 /* Back to queued (graceful shutdown): the attempt is not counted. */
 store_rc store_requeue(const char *id);
@@ -100,5 +103,20 @@ store_rc store_requeue(const char *id);
  * its status in status_out) when it has already finished, STORE_NOT_FOUND when unknown.
  * was_running tells whether a worker must be told. */
 store_rc store_cancel(const char *id, int *was_running, char status_out[16]);
+
+/* ---- reading large values (results, export packs) without holding them in memory ---- */
+typedef struct store_stream store_stream;
+
+/* Opens what ("result" or "pack") of job id. STORE_NOT_FOUND for an unknown job; otherwise
+ * STORE_OK with the job's status and one of: *text (malloc'ed, NUL-terminated, *text_len
+ * bytes) when the value has at most `small` bytes; *out, a stream on a private connection, when
+ * it is larger; neither when the job has no such value (not finished, or no pack). The stream
+ * may be read from any one thread at a time and must be closed. */
+store_rc store_stream_open(const char *id, const char *what, size_t small, store_stream **out,
+                           char **text, size_t *text_len, char status[16]);
+uint64_t store_stream_size(const store_stream *s);
+/* Reads n bytes at off; 0 on success. */
+int store_stream_read(store_stream *s, uint64_t off, void *dst, size_t n);
+void store_stream_close(store_stream *s);
 
 #endif /* GPD_STORE_H */

@@ -10,6 +10,7 @@
 
 #include <jansson.h>
 
+#include "gp_export.h"
 #include "result_json.h"
 #ifdef GPD_HAVE_SCHEMA
 #include "gp_spec.h"
@@ -130,16 +131,19 @@ static void finish_failed(const char *id, const char *code, const char *msg)
         gpd_log(GPD_LOG_INFO, "job %s failed: %s: %s", id, code, msg);
 }
 
-/* Stores a result (takes r) together with status succeeded. */
-__attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r)
+/* Stores a result (takes r) and the export pack (takes pack, may be NULL) together with status
+ * succeeded. Reals get 17 significant digits: the geometry reads back bit for bit, as in the
+ * exports. */
+__attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r, void *pack,
+                                                     size_t pack_len)
 {
-    char *text = r ? json_dumps(r, JSON_COMPACT | JSON_REAL_PRECISION(15)) : NULL;
+    char *text = r ? json_dumps(r, JSON_COMPACT | JSON_REAL_PRECISION(17)) : NULL;
     json_decref(r);
     char *prog = progress_text("done", 1.0, 0.0, NULL);
     if (!text || !prog) {
         finish_failed(ctx->id, "internal", "out of memory while serialising the result");
     } else {
-        store_rc rc = store_succeed(ctx->id, text, prog);
+        store_rc rc = store_succeed(ctx->id, text, prog, pack, pack_len);
         if (rc == STORE_OK)
             gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%zu bytes)", ctx->id,
                     gpd_monotonic_s() - ctx->t0, strlen(text));
@@ -148,6 +152,7 @@ __attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r)
     }
     free(text);
     free(prog);
+    free(pack);
 }
 
 /* A build that did not succeed: cancelled (by DELETE or shutdown) or failed. */
@@ -194,8 +199,17 @@ static void run_2d(slot *s, const char *id, json_t *spec_json)
     gp_status st = gp_specimen2d_build(&spec, on_progress2d, &ctx, &s->cancel, &out, &err);
     if (st == GP_OK && out) {
         json_t *r = gpd_result_2d(out, &spec, spec_json);
+        /* exports need the ODEC discs; without them there is no pack and GET .../export
+         * answers 409 naming the output to ask for */
+        void *pack = NULL;
+        size_t pack_len = 0;
+        if (spec.outputs & GP_OUT_ODEC) {
+            gp_error perr;
+            if (gp_export_pack_2d(out, &spec, GP_EXPORT_DEFAULT_DENSITY, &pack, &pack_len, &perr))
+                gpd_log(GPD_LOG_WARN, "job %s: no export pack: %s", id, perr.message);
+        }
         gp_specimen2d_destroy(out);
-        finish_succeeded(&ctx, r);
+        finish_succeeded(&ctx, r, pack, pack_len);
     } else {
         if (out) gp_specimen2d_destroy(out);
         finish_not_ok(&ctx, st, &err, NULL);
@@ -227,8 +241,15 @@ static void run_3d(slot *s, const char *id, json_t *spec_json)
     gp_status st = gp_specimen3d_build(&spec, on_progress3d, &ctx, &s->cancel, &out, &err);
     if (st == GP_OK && out) {
         json_t *r = gpd_result_3d(out, &spec, spec_json);
+        void *pack = NULL;
+        size_t pack_len = 0;
+        if (out->spheres) {
+            gp_error perr;
+            if (gp_export_pack_3d(out, spec.material.density, &pack, &pack_len, &perr))
+                gpd_log(GPD_LOG_WARN, "job %s: no export pack: %s", id, perr.message);
+        }
         gp_specimen3d_destroy(out);
-        finish_succeeded(&ctx, r);
+        finish_succeeded(&ctx, r, pack, pack_len);
     } else {
         char extra[96] = "";
         if (out && out->stats.stop_reason)

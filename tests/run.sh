@@ -4,7 +4,7 @@
 # UndefinedBehaviorSanitizer (leak checking on). Exits non-zero if any test fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash deploy/install-deps.sh
+bash deploy/install-deps.sh --test
 jobs=$(nproc 2>/dev/null || echo 2)
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release

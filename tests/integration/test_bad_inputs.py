@@ -138,15 +138,15 @@ def test_not_ready_and_finished(env):
     assert st == 200 and j["status"] == "cancelled", (st, j)
     done = d.wait(jid)
     assert done["status"] == "succeeded", done
-    # DELETE of a finished job: 409; export not implemented yet: 501 with an error body
+    # DELETE of a finished job: 409; its export is now a download
     st, _, j = d.json("DELETE", "/v1/jobs/" + jid)
     assert st == 409, (st, j)
     gpd.check_error_body(st, j, "already_finished")
     st, _, j = d.json("DELETE", "/v1/jobs/" + long_id)
     assert st == 409, (st, j)
-    st, _, j = d.json("GET", "/v1/jobs/%s/export?format=vtk" % jid)
-    assert st == 501, (st, j)
-    gpd.check_error_body(st, j, "not_implemented")
+    st, h, b = d.request("GET", "/v1/jobs/%s/export?format=vtk" % jid)
+    assert st == 200 and b.startswith(b"# vtk DataFile"), (st, b[:80])
+    assert h.get("Content-Disposition") == 'attachment; filename="%s-vtk.vtk"' % jid, dict(h)
     assert d.stop() == 0, d.read_log()
 
 
