@@ -437,6 +437,8 @@ gp_status gp_export_read(gp_export *e, char *buf, size_t cap, size_t *n, gp_erro
 {
     *n = 0;
     if (e->failed) return gp_error_set(err, e->err.code, "%s", e->err.message);
+    if (!buf || cap == 0) /* n = 0 would read as the end */
+        return gp_error_set(err, GP_ERR_INVALID, "gp_export_read needs a buffer of cap > 0");
     size_t got = 0;
     while (got < cap) {
         if (e->pos < e->len) {

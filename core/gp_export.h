@@ -112,7 +112,7 @@ int gp_export_dim(const gp_export *e);
 uint64_t gp_export_items(const gp_export *e);
 uint64_t gp_export_discs(const gp_export *e);
 
-/* Copies up to cap bytes of the file into buf; *n = 0 means the end. GP_ERR_INVALID when the
+/* Copies up to cap (> 0) bytes of the file into buf; *n = 0 means the end. GP_ERR_INVALID when the
  * source failed or the pack is inconsistent (the file is then incomplete: drop it). */
 gp_status gp_export_read(gp_export *e, char *buf, size_t cap, size_t *n, gp_error *err);
 
