@@ -33,6 +33,7 @@ struct gp_fill_workspace {
      * unit area, so the search sees the same numbers for a cell at 1e-6 or offset by 1e6 */
     gp_vec2 *cell;
     size_t ncell, cell_cap;
+    int convex;           /* the local cell is convex (and counter-clockwise) */
     double cell_area;     /* in local coordinates (1 up to rounding) */
     int evals;
     gsl_multimin_fminimizer *nm6, *nm8;
@@ -162,9 +163,48 @@ static double ray_exit(const gp_vec2 *p, size_t n, gp_vec2 c, double ux, double 
     return best == DBL_MAX ? -1.0 : best;
 }
 
+/* The exit of ray (ux, uy) from c through edge k of p, or -1 when the ray misses it. */
+static inline double edge_exit(const gp_vec2 *p, size_t n, size_t k, gp_vec2 c, double ux,
+                               double uy)
+{
+    gp_vec2 a = p[k], b = p[k + 1 == n ? 0 : k + 1];
+    double ax = a.x - c.x, ay = a.y - c.y;
+    double ex = b.x - a.x, ey = b.y - a.y;
+    double den = ux * ey - uy * ex;
+    if (den == 0.0) return -1.0;
+    double t = (ax * ey - ay * ex) / den;
+    double s = (ax * uy - ay * ux) / den;
+    return (t > 0.0 && s >= 0.0 && s <= 1.0) ? t : -1.0;
+}
+
+/* rmax_i for a convex counter-clockwise cell and c inside it: a ray from an interior point
+ * leaves a convex polygon through exactly one edge, and as the ray turns counter-clockwise so
+ * does that edge, so one walk round the polygon serves all the rays -- O(np + ncell) instead
+ * of O(np * ncell), which made this the filling's hot spot (40 % of a 2D job). Returns -1
+ * when the walk finds no edge (c on or outside the boundary). */
+static int cast_rays_convex(gp_fill_workspace *ws, gp_vec2 c)
+{
+    const double *cs = ws->cosn + ws->np, *sn = ws->sinn + ws->np; /* n = 1 */
+    const gp_vec2 *p = ws->cell;
+    size_t n = ws->ncell, k = 0;
+    double keep = 1.0 - ws->p.margin;
+    for (size_t i = 0; i < ws->np; i++) {
+        double t = -1.0;
+        for (size_t tries = 0; tries < n; tries++) {
+            t = edge_exit(p, n, k, c, cs[i], sn[i]);
+            if (t > 0.0) break;
+            k = k + 1 == n ? 0 : k + 1;
+        }
+        if (!(t > 0.0)) return -1;
+        ws->rmax[i] = t * keep;
+    }
+    return 0;
+}
+
 /* rmax_i from centre c; 0 on success, -1 if some ray finds no boundary (c outside). */
 static int cast_rays(gp_fill_workspace *ws, gp_vec2 c)
 {
+    if (ws->convex) return cast_rays_convex(ws, c);
     const double *cs = ws->cosn + ws->np, *sn = ws->sinn + ws->np; /* n = 1 */
     double keep = 1.0 - ws->p.margin;
     for (size_t i = 0; i < ws->np; i++) {
@@ -342,6 +382,9 @@ gp_status gp_fill_cell(gp_fill_workspace *ws, const gp_vec2 *cell, size_t ncell,
     }
     ws->ncell = ncell;
     ws->cell_area = gp_poly_area(ws->cell, ncell);
+    /* checked on the rounded cell, the one the rays are cast in; its positive area (the
+     * cell's, checked above) makes it counter-clockwise */
+    ws->convex = is_convex(ws->cell, ncell);
     ws->evals = 0;
     gp_vec2 c = {0.0, 0.0};
     if (cast_rays(ws, c) != 0)
