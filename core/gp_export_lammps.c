@@ -36,7 +36,8 @@ int gp_export_step_lammps3d(gp_export *e)
             "Atoms # sphere\n"
             "\n",
             lig ? "LIGGGHTS" : "LAMMPS", (unsigned long long)e->nitems,
-            lig ? "atom_modify map array / boundary f f f / " : "", (unsigned long long)e->nitems,
+            lig ? "atom_modify map array sort 0 0 / boundary f f f / " : "",
+            (unsigned long long)e->nitems,
             e->lo[0], e->hi[0], e->lo[1], e->hi[1], e->lo[2], e->hi[2]);
         e->section = 1;
         e->index = 0;
