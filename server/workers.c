@@ -1,6 +1,7 @@
 /* workers.c -- worker threads: claim, run, progress, cancel, requeue on shutdown. */
 #include "workers.h"
 
+#include <malloc.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -313,6 +314,11 @@ static void *worker_main(void *arg)
             run_job(s, id, kind, spec);
             free(kind);
             free(spec);
+#ifdef __GLIBC__
+            /* a big job leaves hundreds of MB of freed heap (its JSON tree) that glibc keeps
+             * resident; hand it back so that an idle daemon is small again */
+            malloc_trim(0);
+#endif
             pthread_mutex_lock(&reg_mu);
             s->id[0] = '\0';
             pthread_mutex_unlock(&reg_mu);
