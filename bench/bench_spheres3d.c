@@ -1,7 +1,8 @@
 /* bench_spheres3d.c -- the paper's 3D example (Dang & Meguid 2010: 0.5 m cube, Table 1,
  * Table 2, porosity 0.38) timed per phase, the DEM's sphere-steps per second, and the flip
  * tiling to 4 x 4 x 4 and to ~230,000 spheres, with the porosity and PSD errors next to the
- * timings. Usage: bench_spheres3d [threads] [seed]. */
+ * timings; then a size ratio of 20 (1-20 mm, issue #6) the same way.
+ * Usage: bench_spheres3d [threads] [seed]. */
 #include "gp_dem3d.h"
 #include "gp_flip.h"
 #include "gp_specimen3d.h"
@@ -106,5 +107,38 @@ int main(int argc, char **argv)
     tile_row(r, c, r->ncontacts, 4, 4, 6);
     free(c);
     gp_specimen3d_destroy(r);
+
+    /* size ratio 20: the sieve and seed of tests/test_specimen3d_wide.c, at its target 0.46
+     * (just below the deposit) and at 0.42, and in a 0.15 m cube (~2,600 spheres) */
+    static const gp_sieve_row wide[4] = {{0.001, 0}, {0.005, 1}, {0.010, 10}, {0.020, 100}};
+    static const double cases[3][2] = {{0.1, 0.46}, {0.1, 0.42}, {0.15, 0.42}};
+    printf("## size ratio 20 (1-20 mm: 1 %% below 5 mm, 10 %% below 10 mm)\n");
+    printf("| box (m) | target | spheres | steps | seconds | porosity | S_c | friction at target | "
+           "max PSD error (pp) | stop |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    for (int b = 0; b < 3; b++) {
+        gp_spec3d w;
+        gp_spec3d_defaults(&w);
+        w.threads = s.threads;
+        w.seed = 1;
+        w.box[0] = w.box[1] = w.box[2] = cases[b][0];
+        w.sieve = wide;
+        w.nsieve = 4;
+        w.porosity = cases[b][1];
+        w.outputs = 0;
+        gp_specimen3d *q = NULL;
+        gp_status sq = gp_specimen3d_build(&w, NULL, NULL, NULL, &q, &e);
+        if (!q) {
+            printf("| %.2f | build failed: %s |\n", w.box[0], e.message);
+            continue;
+        }
+        double we = 0;
+        for (size_t k = 0; k < q->stats.psd.n; k++)
+            we = fmax(we, fabs(q->stats.psd.achieved_weight[k] - q->stats.psd.target_weight[k]));
+        printf("| %.2f | %.2f | %zu | %ld | %.2f | %.4f | %.2g | %.2f deg | %.2g | %s%s%s |\n",
+               w.box[0], w.porosity, q->count, q->stats.steps, q->t_total, q->stats.porosity,
+               q->stats.stability, q->stats.compaction_friction_deg, we, q->stats.stop_reason, sq ? ": " : "",
+               sq ? e.message : "");
+        gp_specimen3d_destroy(q);
+    }
     return 0;
 }

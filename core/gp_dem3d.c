@@ -1,4 +1,22 @@
-/* gp_dem3d.c -- see gp_dem3d.h. */
+/* gp_dem3d.c -- see gp_dem3d.h.
+ *
+ * Two details the header does not spell out:
+ *  - free flight: density scaling raises a small sphere's inertia so that its contacts keep
+ *    the time step; gravity acting on the true mass then accelerates it by only g (m / m_i),
+ *    down to g / 100 for a grain a tenth of the scaling radius, and the fines of a wide sieve
+ *    take tens of thousands of steps to fall into the pores of the skeleton. A sphere with
+ *    no surface (sphere or wall) within free_gap has no contact stiffness to protect, so it
+ *    moves with its true mass and without local damping (which is there to take the energy
+ *    out of contact oscillations, and would make it fall at (1 - c) g): it falls at g, as it
+ *    would. The switch happens at a gap, not at contact, because one free step under g moves
+ *    a small sphere about as far as its static overlap (g dt^2 ~ m g / k): switching at
+ *    contact makes a resting sphere bounce for ever. Static states are unchanged (no force
+ *    differs), and so is everything near contact. With the relaxation's damping of 0.7, the
+ *    fines of a size ratio of 20 come to rest in about half the steps.
+ *  - the candidate list holds the pairs with a gap below skin + free_gap, so a sphere sees
+ *    every surface within free_gap until some sphere has moved (or grown) half the skin. The
+ *    skin only trades rebuilds against candidates: results do not depend on it.
+ */
 #include "gp_dem3d.h"
 
 #include <math.h>
@@ -13,9 +31,12 @@
 
 #define BLK 64          /* spheres per reduction block (fixed: results do not depend on threads) */
 #define SERVO_GAIN 0.25 /* fraction of Eq. 10's displacement applied per step */
+#define NLEVEL 8        /* size levels of the cell grids (see rebuild) */
+#define FREE_GAP 0.05   /* free flight beyond this gap, times the smallest radius (see job_spheres) */
 
 typedef struct blk_acc {
-    double sum_f, sum_fn, ke, vmax2, disp2;
+    double sum_f, sum_fn, ke, vmax2;
+    int rebuild;
     double wf[6], wk[6];
     size_t wn;
     size_t nc;
@@ -41,6 +62,45 @@ typedef struct worker_arg {
     int tid;
 } worker_arg;
 
+/* the arrays of one pair list (capacity cap pairs) */
+typedef struct pair_set {
+    size_t cap;
+    uint32_t *pi, *pj;
+    double *fs, *F, *c, *fn;
+    size_t *adj;
+} pair_set;
+
+static void pair_set_free(pair_set *p)
+{
+    free(p->pi); free(p->pj); free(p->fs); free(p->F); free(p->c); free(p->fn); free(p->adj);
+    memset(p, 0, sizeof *p);
+}
+
+static int pair_set_reserve(pair_set *p, size_t cap)
+{
+    if (cap <= p->cap)
+        return 0;
+    cap += cap / 4 + 64;
+    uint32_t *a = realloc(p->pi, cap * sizeof *a);
+    if (a) p->pi = a;
+    uint32_t *b = realloc(p->pj, cap * sizeof *b);
+    if (b) p->pj = b;
+    double *fs = realloc(p->fs, 3 * cap * sizeof *fs);
+    if (fs) p->fs = fs;
+    double *F = realloc(p->F, 3 * cap * sizeof *F);
+    if (F) p->F = F;
+    double *c = realloc(p->c, 3 * cap * sizeof *c);
+    if (c) p->c = c;
+    double *fn = realloc(p->fn, cap * sizeof *fn);
+    if (fn) p->fn = fn;
+    size_t *adj = realloc(p->adj, 2 * cap * sizeof *adj);
+    if (adj) p->adj = adj;
+    if (!a || !b || !fs || !F || !c || !fn || !adj)
+        return -1;
+    p->cap = cap;
+    return 0;
+}
+
 struct gp_dem3d {
     size_t n;
     double *x, *v, *w;         /* 3n */
@@ -48,18 +108,21 @@ struct gp_dem3d {
     double *m, *minv, *iinv;   /* true mass; inverse inertial mass and moment */
     double *xref;              /* positions at the last rebuild */
     double rscale, rscale_ref, r0max, r0min;
-    double E, ks_kn, tanphi, damping, g[3], dt, skin;
+    double E, ks_kn, tanphi, damping, g[3], dt, skin, free_gap;
     double wall[6];            /* positions: lo x, hi x, lo y, hi y, lo z, hi z */
     double servo_f[6], servo_v[6], servo_lim[6];
     double wall_f[6], wall_k[6];
     size_t wall_n;
     /* candidate pairs (i < j), sorted */
-    size_t np, pcap;
-    uint32_t *pi, *pj;
+    size_t np;
+    pair_set cur, spare;       /* the list in use, and the buffers the next rebuild fills */
+    uint32_t *pi, *pj;         /* = cur.pi, cur.pj, ... (short names for the hot loops) */
     double *pfs, *pF, *pc, *pfn; /* shear spring (3), force on i (3), n x fs (3), f_n */
     /* per-sphere pair lists: entries (pair << 1) | (sphere is j) */
-    size_t *off;
+    size_t *off, *fill;
     size_t *adj;
+    /* cell grids of the rebuild, kept between rebuilds */
+    size_t *lv_start[NLEVEL], *lv_list[NLEVEL], lv_start_cap[NLEVEL], lv_list_cap[NLEVEL];
     /* cells */
     size_t *cell_of;
     unsigned char *level;
@@ -189,8 +252,13 @@ void gp_dem3d_destroy(gp_dem3d *d)
     pool_stop(d);
     free(d->x); free(d->v); free(d->w); free(d->r0); free(d->r);
     free(d->m); free(d->minv); free(d->iinv); free(d->xref);
-    free(d->pi); free(d->pj); free(d->pfs); free(d->pF); free(d->pc); free(d->pfn);
-    free(d->off); free(d->adj);
+    pair_set_free(&d->cur);
+    pair_set_free(&d->spare);
+    for (int L = 0; L < NLEVEL; L++) {
+        free(d->lv_start[L]);
+        free(d->lv_list[L]);
+    }
+    free(d->off); free(d->fill);
     free(d->cell_of); free(d->level);
     free(d->blk);
     free(d);
@@ -224,12 +292,13 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
     d->minv = malloc(n * sizeof *d->minv);
     d->iinv = malloc(n * sizeof *d->iinv);
     d->off = calloc(n + 1, sizeof *d->off);
+    d->fill = malloc(n * sizeof *d->fill);
     d->cell_of = malloc(n * sizeof *d->cell_of);
     d->level = malloc(n * sizeof *d->level);
     d->nblk = (n + BLK - 1) / BLK;
     d->blk = calloc(d->nblk, sizeof *d->blk);
     if (!d->x || !d->v || !d->w || !d->xref || !d->r0 || !d->r || !d->m || !d->minv || !d->iinv
-        || !d->off || !d->cell_of || !d->level || !d->blk) {
+        || !d->off || !d->fill || !d->cell_of || !d->level || !d->blk) {
         gp_dem3d_destroy(d);
         return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (%zu spheres)", n);
     }
@@ -253,6 +322,7 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
     memcpy(d->g, p->gravity, sizeof d->g);
     d->rscale = d->rscale_ref = 1;
     d->skin = p->skin > 0 ? p->skin : 0.2 * d->r0min;
+    d->free_gap = FREE_GAP * d->r0min;
     for (int a = 0; a < 3; a++) {
         d->wall[2 * a] = lo[a];
         d->wall[2 * a + 1] = hi[a];
@@ -329,25 +399,30 @@ void gp_dem3d_zero_velocities(gp_dem3d *d)
 /* ------------------------------------------------------------------ neighbour list */
 
 
-static int cmp_u32(const void *a, const void *b)
-{
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return x < y ? -1 : x > y;
-}
-
-static gp_status finish_rebuild(gp_dem3d *d, uint32_t *ni, uint32_t *nj, size_t np, size_t cap,
-                                gp_error *err);
-
-/* One grid per size level (level L holds radii in (rmax / 2^(L+1), rmax / 2^L]); cells of
- * level L are 2 rmax_L + skin wide, so a wide size range does not make the small spheres scan
- * cells sized for the largest ones. */
-#define NLEVEL 8
+/* One grid per size level (level L holds radii in (rmax / 2^(L+1), rmax / 2^L], NLEVEL
+ * levels); cells of level L are as wide as the largest pair reach of the level, so a wide size
+ * range does not make the small spheres scan cells sized for the largest ones. */
 typedef struct level_grid {
     size_t g[3], n;
     double lo[3], inv[3], cs, rmax;
     size_t *start, *list;
 } level_grid;
 
+static int grow_size_t(size_t **buf, size_t *cap, size_t need)
+{
+    if (need <= *cap)
+        return 0;
+    size_t c = need + need / 4 + 64;
+    size_t *b = realloc(*buf, c * sizeof *b);
+    if (!b)
+        return -1;
+    *buf = b;
+    *cap = c;
+    return 0;
+}
+
+/* Rebuilds the candidate pair list, sorted by (i, j); shear springs are carried over by
+ * (i, j). Buffers are kept from one rebuild to the next (no allocation in the steady state). */
 static gp_status rebuild(gp_dem3d *d, gp_error *err)
 {
     size_t n = d->n;
@@ -364,6 +439,9 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
         ext_lo[a] = mn;
         ext_hi[a] = mx;
     }
+    /* a pair is listed when its gap is below the skin plus free_gap: job_spheres then sees
+     * every surface within free_gap until a sphere has moved half the skin */
+    const double reach = d->skin + d->free_gap;
     level_grid lv[NLEVEL];
     memset(lv, 0, sizeof lv);
     unsigned char *lev = d->level;
@@ -376,13 +454,12 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
         lv[L].n++;
         if (r > lv[L].rmax) lv[L].rmax = r;
     }
-    gp_status st = GP_OK;
     size_t *cellbuf = d->cell_of; /* cell index of each sphere in its level */
     for (int L = 0; L < NLEVEL; L++) {
         level_grid *G = lv + L;
         if (!G->n)
             continue;
-        G->cs = 2 * G->rmax + d->skin;
+        G->cs = 2 * G->rmax + reach;
         for (int a = 0; a < 3; a++) {
             double e = ext_hi[a] - ext_lo[a];
             double ga = floor(e / G->cs);
@@ -398,18 +475,14 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
             double e = ext_hi[a] - ext_lo[a];
             G->lo[a] = ext_lo[a];
             G->inv[a] = e > 0 ? (double)G->g[a] / e : 0;
-            /* a cell must stay at least cs wide */
-            if (e > 0 && e / (double)G->g[a] < G->cs) {
-                /* fewer cells than floor(e / cs) is never produced above; nothing to do */
-            }
         }
         size_t nc = G->g[0] * G->g[1] * G->g[2];
-        G->start = calloc(nc + 1, sizeof *G->start);
-        G->list = malloc(G->n * sizeof *G->list);
-        if (!G->start || !G->list) {
-            st = gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (cells)");
-            goto done;
-        }
+        if (grow_size_t(&d->lv_start[L], &d->lv_start_cap[L], nc + 1)
+            || grow_size_t(&d->lv_list[L], &d->lv_list_cap[L], G->n))
+            return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (cells)");
+        G->start = d->lv_start[L];
+        G->list = d->lv_list[L];
+        memset(G->start, 0, (nc + 1) * sizeof *G->start);
     }
     for (size_t i = 0; i < n; i++) {
         level_grid *G = lv + lev[i];
@@ -431,11 +504,11 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
         for (size_t c = 0; c < nc; c++)
             G->start[c + 1] += G->start[c];
     }
-    for (size_t i = 0; i < n; i++) { /* fill, using clist as the per-level cursor store */
+    for (size_t i = 0; i < n; i++) { /* fill (start is used as the cursor, then shifted back) */
         level_grid *G = lv + lev[i];
         G->list[G->start[cellbuf[i]]++] = i;
     }
-    for (int L = 0; L < NLEVEL; L++) { /* shift starts back */
+    for (int L = 0; L < NLEVEL; L++) {
         level_grid *G = lv + L;
         if (!G->n)
             continue;
@@ -444,25 +517,20 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
             G->start[c] = G->start[c - 1];
         G->start[0] = 0;
     }
-    /* new pair list */
-    size_t cap = d->np > 0 ? d->np + d->np / 4 + 64 : 8 * n + 64;
-    uint32_t *ni = malloc(cap * sizeof *ni), *nj = malloc(cap * sizeof *nj);
-    uint32_t *tmp = NULL;
-    size_t tcap = 0;
-    if (!ni || !nj) {
-        free(ni); free(nj);
-        st = gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
-        goto done;
-    }
+    /* new pair list, into the spare buffers */
+    pair_set *P = &d->spare;
+    if (pair_set_reserve(P, d->np > 0 ? d->np + d->np / 4 + 64 : 8 * n + 64))
+        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
     size_t np = 0;
     for (size_t i = 0; i < n; i++) {
-        size_t nt = 0;
-        double xi[3] = {d->x[3 * i], d->x[3 * i + 1], d->x[3 * i + 2]}, ri = d->r[i];
+        size_t first = np;
+        double xi[3] = {d->x[3 * i], d->x[3 * i + 1], d->x[3 * i + 2]};
+        double ri = d->r[i] + reach;
         for (int L = 0; L < NLEVEL; L++) {
             level_grid *G = lv + L;
             if (!G->n)
                 continue;
-            double R = ri + G->rmax + d->skin;
+            double R = ri + G->rmax;
             long c0[3], c1[3];
             for (int a = 0; a < 3; a++) {
                 c0[a] = (long)floor((xi[a] - R - G->lo[a]) * G->inv[a]);
@@ -478,96 +546,58 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
                             size_t j = G->list[k];
                             if (j <= i) continue;
                             double ex = d->x[3 * j] - xi[0], ey = d->x[3 * j + 1] - xi[1], ez = d->x[3 * j + 2] - xi[2];
-                            double rr = ri + d->r[j] + d->skin;
+                            double rr = ri + d->r[j];
                             if (ex * ex + ey * ey + ez * ez < rr * rr) {
-                                if (nt == tcap) {
-                                    tcap = tcap ? 2 * tcap : 64;
-                                    uint32_t *t2 = realloc(tmp, tcap * sizeof *t2);
-                                    if (!t2) {
-                                        free(tmp); free(ni); free(nj);
-                                        st = gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory");
-                                        goto done;
-                                    }
-                                    tmp = t2;
-                                }
-                                tmp[nt++] = (uint32_t)j;
+                                if (np == P->cap && pair_set_reserve(P, np + 1))
+                                    return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
+                                P->pi[np] = (uint32_t)i;
+                                P->pj[np++] = (uint32_t)j;
                             }
                         }
                     }
         }
-        if (nt > 1)
-            qsort(tmp, nt, sizeof *tmp, cmp_u32);
-        if (np + nt > cap) {
-            while (np + nt > cap) cap *= 2;
-            uint32_t *a2 = realloc(ni, cap * sizeof *a2);
-            if (a2) ni = a2;
-            uint32_t *b2 = realloc(nj, cap * sizeof *b2);
-            if (b2) nj = b2;
-            if (!a2 || !b2) {
-                free(tmp); free(ni); free(nj);
-                st = gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
-                goto done;
+        /* sort this sphere's partners (a handful: insertion sort) */
+        for (size_t k = first + 1; k < np; k++) {
+            uint32_t v = P->pj[k];
+            size_t m = k;
+            while (m > first && P->pj[m - 1] > v) {
+                P->pj[m] = P->pj[m - 1];
+                m--;
             }
-        }
-        for (size_t k = 0; k < nt; k++) {
-            ni[np] = (uint32_t)i;
-            nj[np] = tmp[k];
-            np++;
+            P->pj[m] = v;
         }
     }
-    free(tmp);
-    st = finish_rebuild(d, ni, nj, np, cap, err);
-done:
-    for (int L = 0; L < NLEVEL; L++) {
-        free(lv[L].start);
-        free(lv[L].list);
-    }
-    return st;
-}
-
-static gp_status finish_rebuild(gp_dem3d *d, uint32_t *ni, uint32_t *nj, size_t np, size_t cap,
-                                gp_error *err)
-{
-    size_t n = d->n;
-    /* carry the shear springs over (both lists sorted by (i, j)) */
-    size_t alloc = np ? np : 1;
-    double *fs = calloc(3 * alloc, sizeof *fs);
-    double *F = calloc(3 * alloc, sizeof *F);
-    double *pc = calloc(3 * alloc, sizeof *pc);
-    double *fn = calloc(alloc, sizeof *fn);
-    size_t *adj = malloc(2 * alloc * sizeof *adj);
-    if (!fs || !F || !pc || !fn || !adj) {
-        free(fs); free(F); free(pc); free(fn); free(adj); free(ni); free(nj);
-        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
-    }
+    /* carry the shear springs (and the contact state) over: both lists sorted by (i, j) */
+    memset(P->fs, 0, 3 * np * sizeof *P->fs);
+    memset(P->fn, 0, np * sizeof *P->fn);
     size_t o = 0;
     for (size_t k = 0; k < np && o < d->np; k++) {
-        while (o < d->np && (d->pi[o] < ni[k] || (d->pi[o] == ni[k] && d->pj[o] < nj[k])))
+        while (o < d->np && (d->pi[o] < P->pi[k] || (d->pi[o] == P->pi[k] && d->pj[o] < P->pj[k])))
             o++;
-        if (o < d->np && d->pi[o] == ni[k] && d->pj[o] == nj[k])
-            memcpy(fs + 3 * k, d->pfs + 3 * o, 3 * sizeof *fs);
+        if (o < d->np && d->pi[o] == P->pi[k] && d->pj[o] == P->pj[k]) {
+            memcpy(P->fs + 3 * k, d->pfs + 3 * o, 3 * sizeof *P->fs);
+            P->fn[k] = d->pfn[o]; /* job_pairs clears the spring of a contact that opens */
+        }
     }
-    free(d->pi); free(d->pj); free(d->pfs); free(d->pF); free(d->pc); free(d->pfn); free(d->adj);
-    d->pi = ni; d->pj = nj; d->pfs = fs; d->pF = F; d->pc = pc; d->pfn = fn; d->adj = adj;
-    d->np = np;
-    d->pcap = cap;
     /* per-sphere lists in pair order */
     memset(d->off, 0, (n + 1) * sizeof *d->off);
     for (size_t k = 0; k < np; k++) {
-        d->off[ni[k] + 1]++;
-        d->off[nj[k] + 1]++;
+        d->off[P->pi[k] + 1]++;
+        d->off[P->pj[k] + 1]++;
     }
     for (size_t i = 0; i < n; i++)
         d->off[i + 1] += d->off[i];
-    size_t *fill = malloc((n ? n : 1) * sizeof *fill);
-    if (!fill)
-        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory");
-    memcpy(fill, d->off, n * sizeof *fill);
+    memcpy(d->fill, d->off, n * sizeof *d->fill);
     for (size_t k = 0; k < np; k++) {
-        d->adj[fill[ni[k]]++] = k << 1;
-        d->adj[fill[nj[k]]++] = (k << 1) | 1;
+        P->adj[d->fill[P->pi[k]]++] = k << 1;
+        P->adj[d->fill[P->pj[k]]++] = (k << 1) | 1;
     }
-    free(fill);
+    pair_set t = d->cur;
+    d->cur = *P;
+    *P = t;
+    d->np = np;
+    d->pi = d->cur.pi; d->pj = d->cur.pj; d->pfs = d->cur.fs; d->pF = d->cur.F;
+    d->pc = d->cur.c; d->pfn = d->cur.fn; d->adj = d->cur.adj;
     memcpy(d->xref, d->x, 3 * n * sizeof *d->x);
     d->rscale_ref = d->rscale;
     d->need_rebuild = 0;
@@ -582,7 +612,7 @@ static void job_pairs(gp_dem3d *d, int tid, int nt)
     size_t np = d->np;
     size_t k0 = np * (size_t)tid / (size_t)nt, k1 = np * (size_t)(tid + 1) / (size_t)nt;
     const double *x = d->x, *v = d->v, *w = d->w, *r = d->r;
-    const double E2 = 2 * d->E, ksr = d->ks_kn, mu = d->tanphi, dt = d->dt;
+    const double E2 = 2 * d->E, ksr = d->ks_kn, mu = d->tanphi, dt = d->dt, gap = d->free_gap;
     for (size_t k = k0; k < k1; k++) {
         size_t i = d->pi[k], j = d->pj[k];
         double dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1], dz = x[3 * j + 2] - x[3 * i + 2];
@@ -590,10 +620,11 @@ static void job_pairs(gp_dem3d *d, int tid, int nt)
         double d2 = dx * dx + dy * dy + dz * dz;
         double *fs = d->pfs + 3 * k, *F = d->pF + 3 * k, *c = d->pc + 3 * k;
         if (d2 >= R * R || d2 == 0) {
-            fs[0] = fs[1] = fs[2] = 0;
-            F[0] = F[1] = F[2] = 0;
-            c[0] = c[1] = c[2] = 0;
-            d->pfn[k] = 0;
+            /* F and c are read only while f_n > 0; the spring goes when the contact opens */
+            if (d->pfn[k] > 0)
+                fs[0] = fs[1] = fs[2] = 0;
+            double rg = R + gap;
+            d->pfn[k] = d2 < rg * rg ? -1 : 0; /* -1: within free_gap (see job_spheres) */
             continue;
         }
         double dist = sqrt(d2), id = 1.0 / dist;
@@ -647,7 +678,11 @@ static inline double sgn_damp(double f, double v, double c)
 
 static void job_spheres(gp_dem3d *d, int tid, int nt)
 {
-    const double E2 = 2 * d->E, dt = d->dt, c = d->damping;
+    const double E2 = 2 * d->E, dt = d->dt, c = d->damping, gap = d->free_gap;
+    const double dscale = d->rscale > d->rscale_ref ? d->rscale - d->rscale_ref : 0;
+    const double *restrict pfn = d->pfn, *restrict pF = d->pF, *restrict pc = d->pc;
+    const size_t *restrict adj = d->adj, *restrict off = d->off;
+    const double *wall = d->wall;
     for (size_t b = (size_t)tid; b < d->nblk; b += (size_t)nt) {
         blk_acc *acc = d->blk + b;
         memset(acc, 0, sizeof *acc);
@@ -657,13 +692,16 @@ static void job_spheres(gp_dem3d *d, int tid, int nt)
             double ri = d->r[i], m = d->m[i];
             double F[3] = {m * d->g[0], m * d->g[1], m * d->g[2]}, T[3] = {0, 0, 0};
             double sfn = 0;
-            for (size_t e = d->off[i]; e < d->off[i + 1]; e++) {
-                size_t k = d->adj[e] >> 1;
-                double fn = d->pfn[k];
-                if (fn == 0) /* not touching (an overlap always has f_n > 0) */
+            int near = 0;
+            for (size_t e = off[i]; e < off[i + 1]; e++) {
+                size_t k = adj[e] >> 1;
+                double fn = pfn[k];
+                if (fn <= 0) { /* not touching (an overlap always has f_n > 0); -1: near */
+                    near |= fn < 0;
                     continue;
-                const double *Fk = d->pF + 3 * k, *ck = d->pc + 3 * k;
-                if (d->adj[e] & 1) {
+                }
+                const double *Fk = pF + 3 * k, *ck = pc + 3 * k;
+                if (adj[e] & 1) {
                     F[0] -= Fk[0]; F[1] -= Fk[1]; F[2] -= Fk[2];
                 } else {
                     F[0] += Fk[0]; F[1] += Fk[1]; F[2] += Fk[2];
@@ -673,7 +711,7 @@ static void job_spheres(gp_dem3d *d, int tid, int nt)
                 sfn += fn;
             }
             for (int a = 0; a < 3; a++) {
-                double dl = x[a] - d->wall[2 * a];
+                double dl = x[a] - wall[2 * a];
                 if (dl < ri) {
                     double f = E2 * ri * (ri - dl);
                     F[a] += f;
@@ -682,7 +720,7 @@ static void job_spheres(gp_dem3d *d, int tid, int nt)
                     acc->wn++;
                     sfn += f;
                 }
-                double dh = d->wall[2 * a + 1] - x[a];
+                double dh = wall[2 * a + 1] - x[a];
                 if (dh < ri) {
                     double f = E2 * ri * (ri - dh);
                     F[a] -= f;
@@ -691,13 +729,19 @@ static void job_spheres(gp_dem3d *d, int tid, int nt)
                     acc->wn++;
                     sfn += f;
                 }
+                near |= dl < ri + gap || dh < ri + gap;
             }
             acc->sum_f += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
             acc->sum_fn += sfn;
-            double mi = d->minv[i] * dt, ii = d->iinv[i] * dt;
+            /* free flight: nothing within free_gap, so no contact stiffness for density scaling
+             * to serve and no oscillation for local damping to take out; the sphere falls with
+             * its true mass, undamped (see the top of this file) */
+            int fly = !(near || sfn > 0);
+            double mi = (fly ? 1.0 / m : d->minv[i]) * dt, ii = d->iinv[i] * dt;
+            double cf = fly ? 0 : c;
             double v2 = 0, d2 = 0;
             for (int a = 0; a < 3; a++) {
-                v[a] += sgn_damp(F[a], v[a], c) * mi;
+                v[a] += sgn_damp(F[a], v[a], cf) * mi;
                 w[a] += sgn_damp(T[a], w[a], c) * ii;
                 x[a] += v[a] * dt;
                 v2 += v[a] * v[a];
@@ -706,10 +750,13 @@ static void job_spheres(gp_dem3d *d, int tid, int nt)
             }
             acc->ke += 0.5 * m * v2;
             if (v2 > acc->vmax2) acc->vmax2 = v2;
-            if (d2 > acc->disp2) acc->disp2 = d2;
+            /* a pair not listed had a gap of at least skin + free_gap: it cannot come within
+             * free_gap while each sphere has moved (and grown) less than half the skin */
+            double lim = 0.5 * d->skin - dscale * d->r0[i];
+            if (lim <= 0 || d2 >= lim * lim) acc->rebuild = 1;
             if (!(v2 < INFINITY)) acc->bad = 1;
             for (int a = 0; a < 3; a++)
-                if (!(x[a] > d->wall[2 * a] - ri && x[a] < d->wall[2 * a + 1] + ri))
+                if (!(x[a] > wall[2 * a] - ri && x[a] < wall[2 * a + 1] + ri))
                     acc->bad = 1;
         }
     }
@@ -725,15 +772,15 @@ gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err)
         }
         run_job(d, job_pairs);
         run_job(d, job_spheres);
-        double sf = 0, sfn = 0, ke = 0, vm = 0, dm = 0;
+        double sf = 0, sfn = 0, ke = 0, vm = 0;
         size_t nc = 0, wn = 0;
         double wf[6] = {0}, wk[6] = {0};
-        int bad = 0;
+        int bad = 0, reb = 0;
         for (size_t b = 0; b < d->nblk; b++) {
             const blk_acc *a = d->blk + b;
             sf += a->sum_f; sfn += a->sum_fn; ke += a->ke;
             if (a->vmax2 > vm) vm = a->vmax2;
-            if (a->disp2 > dm) dm = a->disp2;
+            reb |= a->rebuild;
             nc += a->nc; wn += a->wn; bad |= a->bad;
             for (int w = 0; w < 6; w++) {
                 wf[w] += a->wf[w];
@@ -769,8 +816,7 @@ gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err)
                     d->wall[w] = d->servo_lim[w];
             }
         }
-        double grow = (d->rscale - d->rscale_ref) * d->r0max;
-        if (2 * sqrt(dm) + 2 * (grow > 0 ? grow : 0) > d->skin)
+        if (reb)
             d->need_rebuild = 1;
     }
     return GP_OK;

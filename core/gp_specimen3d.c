@@ -8,14 +8,20 @@
  *    structure without minutes of free fall), and left to settle.
  *  phase 1, compaction: the top wall becomes a servo wall (Eq. 10) pressing with
  *    COMPACTION_STRESS and descends onto the deposit at full friction (phase 0's porosity is
- *    read there); then, instead of shaking the walls, the friction is set to zero (the YADE
- *    practice of compacting with reduced friction) and the wall pushes on; it never goes below
- *    the target height b_z. When it reaches b_z the friction is restored, the wall is fixed, and
- *  relaxation runs until S_c <= 1e-4 (Eq. 7, NOTES.md), with local damping raised to
- *    RELAX_DAMPING. If the frictionless approach stalls above b_z (less than STALL_FRACTION of
- *    the remaining porosity gained in STALL_STEPS), the target is denser than this sieve packs
- *    in this box ("target_too_dense"); if after relaxation the top wall carries no force, the
- *    packing settled below it ("target_too_loose").
+ *    read where it comes to rest on it); then, instead of shaking the walls, the friction is
+ *    lowered step by step while the wall stops making progress (a friction ladder, as YADE's
+ *    compaction scripts reach a porosity); the wall never goes below the target height b_z.
+ *  relaxation: when the wall reaches b_z the friction is restored and the wall stays a servo
+ *    wall pressing with the same stress (never below b_z), until S_c <= 1e-4 (Eq. 7,
+ *    NOTES.md), with local damping raised to RELAX_DAMPING. Should the packing still settle
+ *    away from the wall, the wall follows it down by at most POROSITY_SLACK. The sample box is
+ *    where the wall ends, so the porosity reported is the one of the spheres in that box.
+ *  If the approach without friction stalls above b_z (less than STALL_FRACTION of the
+ *  remaining porosity gained in STALL_T), the target is denser than this sieve packs in this
+ *  box ("target_too_dense"), unless it stalled within POROSITY_SLACK of it; if after relaxation the top wall carries no force, the deposit
+ *  itself is denser than the target ("target_too_loose").
+ *  Durations are in units of sqrt(d50 / g), not in steps, so that a wide sieve (whose time
+ *  step follows its small grains) gets the same physical time as the paper's.
  *  phase 2, tiling: gp_flip.
  */
 #include "gp_specimen3d.h"
@@ -39,12 +45,26 @@
 #define GRAVITY 9.81
 #define STABILITY 1e-4           /* Eq. 7: 0.01 % */
 #define GROW_FROM 0.6            /* initial radius scale of the placement */
-#define GROW_STEPS 1500
-#define SETTLE_SC 5e-2           /* deposition ends when S_c is below this ... */
-#define SETTLE_STEPS 1000        /* ... or after this many steps */
+/* durations, in units of sqrt(d50 / g) (see where tu is computed; the paper's sieve has ~860
+ * steps per unit, and these are its former step counts) */
+#define GROW_T 1.75              /* growth of the radii */
+#define SETTLE_T 1.2             /* deposition ends after this ... */
+#define SETTLE_SC 5e-2           /* ... or when S_c is below this */
+#define LADDER_T 0.35            /* progress window of the friction ladder */
+#define STALL_T 3.5              /* progress window without friction */
+#define MAX_T 500                /* default cap on the DEM steps (at least 400,000) */
+#define LID_SPEED 1.4            /* top-wall speed limit, times sqrt(g d50) (1 m/s in the paper) */
+#define APPROACH_T 1.0           /* the wall closes the gap to b_z in no less than this */
 #define CHUNK 100
-#define STALL_STEPS 3000
 #define STALL_FRACTION 0.1
+#define LADDER_FRACTION 0.2      /* least progress per window, of the height still to go */
+#define LADDER_MIN_LEFT 0.002    /* ... counted as at least this fraction of b_z */
+#define LADDER_FACTOR 0.5        /* friction step of the ladder */
+#define LADDER_MIN_DEG 0.5       /* below this the ladder goes to zero friction */
+#define MAX_SCALED_RATIO 3.5     /* density scaling radius >= rmax / this */
+#define POROSITY_SLACK 0.003     /* the wall may end this far from the target porosity (the
+                                    tolerance is 0.005): above, where the packing jams without
+                                    friction; below, following a packing that settles away */
 #define DT_SAFETY 0.3            /* of sqrt(m / 2 E R): omega dt <= 0.3 sqrt(12) ~ 1 < 2 even
                                     with 12 contacts as stiff as a wall */
 #define COMPACTION_STRESS 1.0    /* top-wall stress, times the geostatic stress at the bottom */
@@ -346,7 +366,12 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
         }
         lam *= 0.85;
     }
-    /* density scaling radius: the median radius by number (see gp_dem3d.h) */
+    /* density scaling radius (see gp_dem3d.h): the median radius by number, but no less than
+     * rmax / MAX_SCALED_RATIO. With the paper's sieve the median is rmax / 3.4; with a size
+     * ratio of 20 it can be rmax / 12, and then dt (set by the scaled radius) is so small next
+     * to the time the large grains need to move that the protocol costs 3-4 times more steps
+     * than the sieve's range requires. Raising the small grains' inertia does not change the
+     * static state (gravity acts on the true mass). */
     gp_dem3d_params dp;
     gp_dem3d_params_defaults(&dp);
     dp.density = spec->material.density;
@@ -355,8 +380,9 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
     dp.friction_deg = spec->material.friction_deg;
     dp.damping = spec->material.damping;
     dp.gravity[2] = -GRAVITY;
-    dp.scaled_radius = 0.5 * diam[n / 2];
-    dp.skin = 0.5 * (0.5 * diam[n - 1]);   /* half the smallest radius */
+    dp.scaled_radius = fmax(0.5 * diam[n / 2], 0.5 * diam[0] / MAX_SCALED_RATIO);
+    dp.skin = 0.5 * diam[n - 1]; /* the smallest radius (rebuilds against candidates; results
+                                    do not depend on it) */
     dp.dt_safety = DT_SAFETY;
     dp.threads = spec->threads > 0 ? spec->threads : 1;
     for (size_t i = 0; i < n; i++)
@@ -367,28 +393,53 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
         ret = st;
         goto fail;
     }
-    long max_steps = spec->max_steps > 0 ? spec->max_steps : 400000;
+    /* Every duration of the protocol is a multiple of the skeleton's time sqrt(d50 / g) (d50 the
+     * median diameter by weight: the grains that carry the load), the time a grain takes to
+     * fall its own size. In steps this unit is ~860 for the paper's sieve and ~2300 for a size
+     * ratio of 20, where dt follows the small grains: counted in steps, the windows that judge
+     * progress were too short there, and the deposit never had the time to settle. */
+    double d50 = diam[n - 1];
+    {
+        double tot = 0, acc = 0;
+        for (size_t i = 0; i < n; i++)
+            tot += diam[i] * diam[i] * diam[i];
+        for (size_t i = 0; i < n; i++) { /* diam is sorted from the largest */
+            acc += diam[i] * diam[i] * diam[i];
+            if (acc >= 0.5 * tot) {
+                d50 = diam[i];
+                break;
+            }
+        }
+    }
+    double tu = sqrt(d50 / GRAVITY) / gp_dem3d_dt(dem); /* steps per time unit */
+    long grow_steps = 10 * (long)ceil(GROW_T * tu / 10);
+    long settle_steps = CHUNK * (long)ceil(SETTLE_T * tu / CHUNK);
+    long ladder_steps = CHUNK * (long)ceil(LADDER_T * tu / CHUNK);
+    long stall_steps = CHUNK * (long)ceil(STALL_T * tu / CHUNK);
+    double lid_speed = LID_SPEED * sqrt(GRAVITY * d50);
+    long max_steps = spec->max_steps > 0 ? spec->max_steps
+                                         : (long)fmax(400000, MAX_T * tu);
     gp_dem3d_state ds;
     double t_phase = now();
-    for (long s = 0; s < GROW_STEPS; s += 10) {
-        gp_dem3d_set_radius_scale(dem, lam + (1 - lam) * (double)(s + 10) / GROW_STEPS);
+    for (long s = 0; s < grow_steps; s += 10) {
+        gp_dem3d_set_radius_scale(dem, lam + (1 - lam) * (double)(s + 10) / grow_steps);
         if ((st = gp_dem3d_run(dem, 10, err))) {
             ret = st;
             goto fail;
         }
-        if (report(&rc, "deposition", 0.1 * s / GROW_STEPS, s, 0, 0, 0)) {
+        if (report(&rc, "deposition", 0.1 * s / grow_steps, s, 0, 0, 0)) {
             ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
             goto fail;
         }
     }
     gp_dem3d_set_radius_scale(dem, 1.0);
-    for (long s = 0; s < SETTLE_STEPS; s += CHUNK) {
+    for (long s = 0; s < settle_steps; s += CHUNK) {
         if ((st = gp_dem3d_run(dem, CHUNK, err))) {
             ret = st;
             goto fail;
         }
         gp_dem3d_get_state(dem, &ds);
-        if (report(&rc, "deposition", 0.1 + 0.1 * s / SETTLE_STEPS, ds.steps, 0, ds.stability, 0)) {
+        if (report(&rc, "deposition", 0.1 + 0.1 * s / settle_steps, ds.steps, 0, ds.stability, 0)) {
             ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
             goto fail;
         }
@@ -397,15 +448,17 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
     }
     res->t_deposition = now() - t_phase;
 
-    /* ---- phase 1: compaction with the servo top wall (Eq. 10) and reduced friction ---- */
+    /* ---- phase 1: compaction with the servo top wall (Eq. 10) and a friction ladder ---- */
     t_phase = now();
     double area = B[0] * B[1];
     double sigma0 = COMPACTION_STRESS * (1 - p) * spec->material.density * GRAVITY * B[2];
-    gp_dem3d_set_servo(dem, 5, sigma0 * area, 1.0);
+    gp_dem3d_set_servo(dem, 5, sigma0 * area, lid_speed);
     gp_dem3d_set_servo_limit(dem, 5, B[2]);
     double phi = spec->material.friction_deg;
-    double h_touch = NAN;
-    int reached = 0, stall_chunks = 0;
+    double h_touch = NAN, h_prev = H0, h_win = H0;
+    int pushed = 0; /* the wall has pressed on grains */
+    int reached = 0;
+    long win_steps = 0, stall_steps_done = 0;
     double por_cp = 1;
     while (!reached) {
         if ((st = gp_dem3d_run(dem, CHUNK, err))) {
@@ -420,36 +473,65 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
             ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
             goto fail;
         }
-        if (isnan(h_touch) && ds.wall_force[5] >= 0.5 * sigma0 * area) {
-            /* the top wall rests on the deposit (full friction): phase 0's porosity; from now
-             * on compact without friction */
-            h_touch = h;
-            phi = 0;
-            gp_dem3d_set_friction(dem, phi);
-        }
+        pushed |= ds.wall_force[5] > 0;
         if (h <= B[2]) {
             reached = 1;
             break;
         }
-        /* without friction, the approach has stalled: over the last STALL_STEPS the porosity
-         * fell by less than STALL_FRACTION of what remains to the target (or the wall is at
-         * rest): the target is denser than this sieve packs here */
-        
-        if (phi == 0) {
-            if (++stall_chunks * CHUNK >= STALL_STEPS) {
-                double gain = por_cp - por, left = por - p;
-                if (gain < STALL_FRACTION * left) {
-                    reason = "target_too_dense";
-                    ret = gp_error_set(err, GP_ERR_INFEASIBLE,
-                                       "porosity %g is denser than this sieve packs in this box "
-                                       "without friction (stalled at %.4f)", p, por);
-                    break;
-                }
-                por_cp = por;
-                stall_chunks = 0;
-            }
+        /* The wall slows down as it nears b_z (it may not close the remaining gap faster than
+         * in APPROACH_T): the packing arrives at the target height nearly at rest, instead of
+         * being driven there and settling on below the wall once it stops. */
+        gp_dem3d_set_servo(dem, 5, sigma0 * area,
+                           fmin(lid_speed, fmax(h - B[2], LADDER_MIN_LEFT * B[2])
+                                               / (APPROACH_T * sqrt(d50 / GRAVITY))));
+        /* The wall rests on the deposit when it carries half its force and has slowed to less
+         * than half its free speed (a grain still bouncing can push it, but not stop it):
+         * phase 0's porosity, and the start of the ladder. */
+        if (isnan(h_touch) && ds.wall_force[5] >= 0.5 * sigma0 * area
+            && h_prev - h < 0.5 * lid_speed * gp_dem3d_dt(dem) * CHUNK) {
+            h_touch = h;
+            h_win = h;
+            win_steps = 0;
         }
-
+        h_prev = h;
+        /* Friction ladder (YADE's way of reaching a porosity, Chareyre's triaxial scripts):
+         * while the wall, pressing with sigma0, gains less than LADDER_FRACTION of the height
+         * still to go in LADDER_T, the packing is (nearly) jammed at this friction: lower it
+         * by LADDER_FACTOR. The target height is then reached by a packing in equilibrium
+         * at friction phi_c <= phi, which restoring phi can only stiffen: it does not settle
+         * away from the wall during relaxation, as a loose heap pushed there without friction
+         * can (it is not jammed at the target height, and keeps compacting under gravity:
+         * with a size ratio of 20 the wall then lost every contact at once). */
+        if (!isnan(h_touch) && phi > 0 && (win_steps += CHUNK) >= ladder_steps) {
+            double left = fmax(h - B[2], LADDER_MIN_LEFT * B[2]);
+            if (h_win - h < LADDER_FRACTION * left) {
+                phi = phi * LADDER_FACTOR < LADDER_MIN_DEG ? 0 : phi * LADDER_FACTOR;
+                gp_dem3d_set_friction(dem, phi);
+                por_cp = por;
+                stall_steps_done = 0;
+            }
+            h_win = h;
+            win_steps = 0;
+        }
+        /* without friction, the approach has stalled: over the last STALL_T the porosity fell
+         * by less than STALL_FRACTION of what remains to the target: the target is denser
+         * than this sieve packs here (unless it is within POROSITY_SLACK: then this is the
+         * sample's height) */
+        if (phi == 0 && (stall_steps_done += CHUNK) >= stall_steps) {
+            if (por_cp - por < STALL_FRACTION * (por - p) && por - p <= POROSITY_SLACK) {
+                reached = 1;
+                break;
+            }
+            if (por_cp - por < STALL_FRACTION * (por - p)) {
+                reason = "target_too_dense";
+                ret = gp_error_set(err, GP_ERR_INFEASIBLE,
+                                   "porosity %g is denser than this sieve packs in this box "
+                                   "without friction (stalled at %.4f)", p, por);
+                break;
+            }
+            por_cp = por;
+            stall_steps_done = 0;
+        }
         if (ds.steps > max_steps) {
             reason = "max_steps";
             ret = gp_error_set(err, GP_ERR_NOT_CONVERGED, "compaction: %ld steps without reaching "
@@ -464,36 +546,58 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
     /* ---- relaxation at the target height, friction restored ---- */
     t_phase = now();
     if (reached) {
+        /* The top wall stays a servo wall pressing with sigma0 (never below b_z): it keeps
+         * the packing confined as it was compacted, and if the packing pushes harder it rises,
+         * so the box it reports is the one the spheres fill. */
         gp_dem3d_set_friction(dem, spec->material.friction_deg);
-        gp_dem3d_set_wall(dem, 5, B[2]);
         gp_dem3d_set_damping(dem, fmax(spec->material.damping, RELAX_DAMPING));
-        for (;;) {
-            if ((st = gp_dem3d_run(dem, CHUNK, err))) {
-                ret = st;
-                goto fail;
+        /* pass 0: the wall never below b_z. Pass 1, only if the packing settled away from the
+         * wall although the wall had pressed on it: the wall follows it down,
+         * at most to the height of porosity p - POROSITY_SLACK, and relaxation goes on; the
+         * porosity is then that of the lower box, still within the tolerance of the target. */
+        double h_sink = vs / (area * (1 - (p - POROSITY_SLACK)));
+        for (int pass = 0; pass < 2 && ret == GP_OK; pass++) {
+            if (pass == 1) {
+                if (ds.wall_force[5] > 0 || !pushed)
+                    break;
+                gp_dem3d_set_servo_limit(dem, 5, h_sink);
             }
-            gp_dem3d_get_state(dem, &ds);
-            double sc = ds.stability;
-            double fr = log(fmax(sc, STABILITY) / 1.0) / log(STABILITY);
-            if (report(&rc, "relaxation", 0.6 + 0.3 * fmin(1, fmax(0, fr)), ds.steps, p, sc, 0)) {
-                ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-                goto fail;
-            }
-            if (sc <= STABILITY)
-                break;
-            if (ds.steps > max_steps) {
-                reason = "max_steps";
-                ret = gp_error_set(err, GP_ERR_NOT_CONVERGED,
-                                   "relaxation: S_c = %.3g after %ld steps (> 1e-4)", sc, ds.steps);
-                break;
+            for (;;) {
+                if ((st = gp_dem3d_run(dem, CHUNK, err))) {
+                    ret = st;
+                    goto fail;
+                }
+                gp_dem3d_get_state(dem, &ds);
+                double sc = ds.stability;
+                double fr = log(fmax(sc, STABILITY) / 1.0) / log(STABILITY);
+                if (report(&rc, "relaxation", 0.6 + 0.3 * fmin(1, fmax(0, fr)), ds.steps,
+                           1 - vs / (area * gp_dem3d_wall(dem, 5)), sc, 0)) {
+                    ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+                    goto fail;
+                }
+                /* (pass 1: and the wall is back on the packing, or as low as it may go) */
+                if (sc <= STABILITY
+                    && (pass == 0 || ds.wall_force[5] > 0 || gp_dem3d_wall(dem, 5) <= h_sink))
+                    break;
+                if (ds.steps > max_steps) {
+                    reason = "max_steps";
+                    ret = gp_error_set(err, GP_ERR_NOT_CONVERGED,
+                                       "relaxation: S_c = %.3g after %ld steps (> 1e-4)", sc,
+                                       ds.steps);
+                    break;
+                }
             }
         }
         if (ret == GP_OK && !(ds.wall_force[5] > 0)) {
+            /* the wall never touched a grain above b_z: the deposit is denser than the target;
+             * or (pass 1) the packing settled further than POROSITY_SLACK */
             reason = "target_too_loose";
             ret = gp_error_set(err, GP_ERR_INFEASIBLE,
-                               "porosity %g is looser than the deposit of this sieve at friction "
-                               "%g deg: the packing settles below the top wall", p,
-                               spec->material.friction_deg);
+                               "porosity %g is looser than this sieve holds at friction %g deg: "
+                               "the packing settles below the top wall (%s)", p,
+                               spec->material.friction_deg,
+                               !pushed ? "the deposit is denser"
+                                       : "after compaction to the target height");
         }
     }
     res->t_relaxation = now() - t_phase;
