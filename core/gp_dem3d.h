@@ -14,11 +14,14 @@
  *   - density scaling for quasi-static runs (YADE's NewtonIntegrator.densityScaling idea): the
  *     inertia of a sphere smaller than scaled_radius is raised to that of a sphere whose critical
  *     time step is the one of scaled_radius. Gravity uses the true mass, so the static state
- *     (what a specimen is) does not change; only how fast it is reached.
+ *     (what a specimen is) does not change; only how fast it is reached. A sphere with no
+ *     surface within 0.05 x the smallest radius flies with its true mass and no damping
+ *     (free flight: fines fall at g, not at g scaled down; see gp_dem3d.c);
  *   - time step dt = dt_safety * min_i sqrt(m_i / (2 E R_i)) (2 E R_i is the stiffest contact a
  *     sphere of radius R_i can have: with a wall or a much larger sphere);
- *   - contact detection with a linked-cell grid and a Verlet skin (pairs closer than the skin
- *     are listed; rebuilt when a sphere has moved more than skin / 2); shear springs persist
+ *   - contact detection with a linked-cell grid and a Verlet skin (pairs with a gap below
+ *     skin + the free-flight gap are listed; rebuilt when a sphere has moved more than
+ *     skin / 2; results do not depend on the skin); shear springs persist
  *     across rebuilds by (i, j).
  *   - threads: per-pair forces, then per-sphere sums in a fixed order; every reduction is done
  *     over fixed blocks of spheres, so results are bit for bit the same for any thread count.
