@@ -239,11 +239,6 @@ gp_export_source gp_export_memory_source(const void *pack, size_t len)
     return s;
 }
 
-static int src_read(gp_export *e, uint64_t off, void *dst, size_t n)
-{
-    return e->src.read(e->src.user, off, dst, n);
-}
-
 /* Makes [off, off + n) available in the cache; returns a pointer into it or NULL. */
 static const unsigned char *cache_get(gp_export *e, uint64_t off, size_t n)
 {
@@ -256,7 +251,7 @@ static const unsigned char *cache_get(gp_export *e, uint64_t off, size_t n)
     }
     uint64_t want = e->src.size - off;
     size_t len = want < CACHE_BYTES ? (size_t)want : CACHE_BYTES;
-    if (src_read(e, off, e->cache, len)) {
+    if (e->src.read(e->src.user, off, e->cache, len)) {
         e->cache_len = 0;
         gp_error_set(&e->err, GP_ERR_INVALID, "reading the pack failed at offset %llu",
                      (unsigned long long)off);

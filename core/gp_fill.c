@@ -143,26 +143,6 @@ gp_fill_workspace *gp_fill_workspace_create(const gp_fill_params *p, gp_error *e
     return ws;
 }
 
-/* Distance from c along (ux, uy) to the first crossing of the polygon boundary, or -1 if the
- * ray meets no edge (c outside or on a degenerate polygon). */
-static double ray_exit(const gp_vec2 *p, size_t n, gp_vec2 c, double ux, double uy)
-{
-    double best = DBL_MAX;
-    for (size_t k = 0; k < n; k++) {
-        gp_vec2 a = p[k], b = p[(k + 1) % n];
-        double ax = a.x - c.x, ay = a.y - c.y;
-        double ex = b.x - a.x, ey = b.y - a.y;
-        double den = ux * ey - uy * ex;          /* cross(u, e) */
-        if (den == 0.0)
-            continue;                            /* parallel edge: met at its ends instead */
-        double t = (ax * ey - ay * ex) / den;    /* cross(a - c, e) / cross(u, e) */
-        double s = (ax * uy - ay * ux) / den;    /* cross(a - c, u) / cross(u, e) */
-        if (t > 0.0 && s >= 0.0 && s <= 1.0 && t < best)
-            best = t;
-    }
-    return best == DBL_MAX ? -1.0 : best;
-}
-
 /* The exit of ray (ux, uy) from c through edge k of p, or -1 when the ray misses it. */
 static inline double edge_exit(const gp_vec2 *p, size_t n, size_t k, gp_vec2 c, double ux,
                                double uy)
@@ -175,6 +155,20 @@ static inline double edge_exit(const gp_vec2 *p, size_t n, size_t k, gp_vec2 c, 
     double t = (ax * ey - ay * ex) / den;
     double s = (ax * uy - ay * ux) / den;
     return (t > 0.0 && s >= 0.0 && s <= 1.0) ? t : -1.0;
+}
+
+/* Distance from c along (ux, uy) to the first crossing of the polygon boundary, or -1 if the
+ * ray meets no edge (c outside or on a degenerate polygon). Parallel edges are met at their
+ * ends instead. */
+static double ray_exit(const gp_vec2 *p, size_t n, gp_vec2 c, double ux, double uy)
+{
+    double best = DBL_MAX;
+    for (size_t k = 0; k < n; k++) {
+        double t = edge_exit(p, n, k, c, ux, uy);
+        if (t > 0.0 && t < best)
+            best = t;
+    }
+    return best == DBL_MAX ? -1.0 : best;
 }
 
 /* rmax_i for a convex counter-clockwise cell and c inside it: a ray from an interior point
