@@ -1,6 +1,9 @@
-/* test_imc.c -- inverse Monte-Carlo: convergence on the paper's two configurations and N = 2000,
- * the error floor, the hard cases (they converge or stop with a reason, never hang), determinism,
- * cancellation, and the report against an independent recount of the final tessellation. */
+/* test_imc.c -- inverse Monte-Carlo: convergence on the paper's two configurations and N = 2000
+ * with the paper's E3 and with the default Anderson-Darling objective (whose value is recomputed
+ * here from the cells with an independent lognormal CDF and sort), a specimen that E3 passes
+ * and the AD objective does not, the error floor, the hard cases (they converge or stop with a
+ * reason, never hang), determinism, cancellation, and the report against an independent
+ * recount of the final tessellation. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,6 +11,72 @@
 
 #include "gp_imc.h"
 #include "gp_test.h"
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* A^2 of sorted u (brute force, the textbook formula) */
+static double a2_sorted(const double *u, size_t n)
+{
+    double s = 0.0;
+    for (size_t i = 1; i <= n; i++)
+        s += (2.0 * i - 1.0) * (log(u[i - 1]) + log1p(-u[n - i]));
+    return -(double)n - s / n;
+}
+
+/* Sample statistics of the cells, computed here from the tessellation: the cell-area KS
+ * distance to the lognormal, the COV, and the AD size and orientation errors as gp_imc.h
+ * defines them (excess over the floor; the size error adds N (COV / COV_q - 1)^2). */
+typedef struct cell_stats {
+    double ks, cov, ad_size, ad_orient;
+} cell_stats;
+
+static cell_stats cell_stats_of(const gp_voronoi *v, const gp_imc_params *p)
+{
+    size_t n = gp_voronoi_count(v);
+    double mu = gp_voronoi_container_area(v) / n, s = sqrt(log(1 + p->cov * p->cov));
+    double m = log(mu) - 0.5 * s * s;
+    double *a = malloc(n * sizeof *a), *u = malloc(n * sizeof *u), *t = malloc(n * sizeof *t);
+    double sum2 = 0.0, fl = 0.0, q2 = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        a[i] = gp_voronoi_cell_area(v, i);
+        sum2 += (a[i] - mu) * (a[i] - mu);
+        /* orientation CDF on the window [mean - 90, mean + 90), written out here */
+        double th = gp_voronoi_cell_orientation(v, i) * 180 / M_PI - (p->mean_deg - 90);
+        th = fmod(fmod(th, 180) + 180, 180) * M_PI / 180;
+        double al = p->anisotropy;
+        double w = ((1 + al) / 2 * th - (1 - al) / 4 * sin(2 * th)) / ((1 + al) * M_PI / 2);
+        t[i] = fmin(fmax(w, 0.25 / n), 1 - 0.25 / n);
+    }
+    qsort(a, n, sizeof *a, cmp_double);
+    qsort(t, n, sizeof *t, cmp_double);
+    cell_stats c = {0, 0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        u[i] = 0.5 * erfc(-(log(a[i]) - m) / s / sqrt(2.0));
+        c.ks = fmax(c.ks, fmax((i + 1.0) / n - u[i], u[i] - (double)i / n));
+        double pq = (2.0 * i + 1.0) / (2.0 * n), z = 0.0;
+        /* quantile of the lognormal by bisection on the CDF (independent of the library) */
+        double lo = -40, hi = 40;
+        for (int k = 0; k < 200; k++) {
+            z = 0.5 * (lo + hi);
+            if (0.5 * erfc(-z / sqrt(2.0)) < pq) lo = z; else hi = z;
+        }
+        q2 += pow(exp(m + s * z) - mu, 2);
+        fl += (2.0 * i + 1.0) * 2.0 * log(pq);
+    }
+    double floor_ad = -(double)n - fl / n;
+    c.cov = sqrt(sum2 / (n - 1)) / mu;
+    double covp = sqrt(sum2 / n) / mu, covq = sqrt(q2 / n) / mu;
+    c.ad_size = a2_sorted(u, n) - floor_ad + n * pow(covp / covq - 1, 2);
+    c.ad_orient = a2_sorted(t, n) - floor_ad;
+    free(a);
+    free(u);
+    free(t);
+    return c;
+}
 
 static const gp_vec2 SQ[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
 
@@ -81,10 +150,13 @@ static gp_status run(const gp_vec2 *outer, size_t no, const gp_vec2 *const *hole
     return st;
 }
 
-static void converge(size_t n, double cov, double aniso, double mean, int init, long max_steps, const char *name)
+static void converge(int kind, size_t n, double cov, double aniso, double mean, int init, long max_steps,
+                     const char *name)
 {
     gp_imc_params p;
     gp_imc_params_default(&p);
+    p.error_kind = kind;
+    p.threshold = gp_imc_default_threshold(kind);
     p.cov = cov;
     p.anisotropy = aniso;
     p.mean_deg = mean;
@@ -95,11 +167,23 @@ static void converge(size_t n, double cov, double aniso, double mean, int init, 
     gp_status st = run(SQ, 4, NULL, NULL, 0, n, &p, &v, &r, name);
     CHECK(st == GP_OK);
     CHECK(r.stop_reason == GP_IMC_STOP_THRESHOLD);
-    CHECK(r.error <= 0.002);
+    CHECK(r.error <= p.threshold);
     CHECK(v != NULL);
     if (v) {
         CHECK(gp_voronoi_count(v) == n);
         check_report(v, &r, &p);
+    }
+    if (v && kind == GP_IMC_ERROR_AD) {
+        /* the reported errors are the statistic of the cells, and the cells follow the law:
+         * KS far inside its 5 % critical value, COV within 5 % */
+        cell_stats c = cell_stats_of(v, &p);
+        printf("    AD size %.5f (recomputed %.5f), orient %.5f (%.5f); KS %.4f (critical %.4f), COV %.4f for %.2f\n",
+               r.error_size_ad, c.ad_size, r.error_orient_ad, c.ad_orient, c.ks, 1.36 / sqrt(n), c.cov, cov);
+        CHECK_NEAR(r.error_size_ad, c.ad_size, 1e-6 * (1 + fabs(c.ad_size)));
+        CHECK_NEAR(r.error_orient_ad, c.ad_orient, 1e-6 * (1 + fabs(c.ad_orient)));
+        CHECK(fmax(c.ad_size, c.ad_orient) <= p.threshold * (1 + 1e-6));
+        CHECK(c.ks < 0.5 * 1.36 / sqrt(n));
+        CHECK(fabs(c.cov / cov - 1) < 0.05);
     }
     gp_voronoi_destroy(v);
     gp_imc_report_free(&r);
@@ -115,9 +199,12 @@ static void hard(const char *name, const gp_vec2 *outer, size_t no, const gp_vec
     CHECK(st == GP_OK || st == GP_ERR_NOT_CONVERGED);
     CHECK(v != NULL);
     CHECK(r.steps <= p->max_steps);
-    CHECK(r.error <= r.error_initial);
+    /* the descent: E1-E3 never rise; AD descends on the sum of its two errors */
+    if (p->error_kind == GP_IMC_ERROR_AD) CHECK(r.error_size_ad + r.error_orient_ad <= 2 * r.error_initial);
+    else CHECK(r.error <= r.error_initial);
     CHECK(st != GP_OK || r.error <= p->threshold);
-    CHECK(st != GP_ERR_NOT_CONVERGED || r.stop_reason == GP_IMC_STOP_MAX_STEPS);
+    CHECK(st != GP_ERR_NOT_CONVERGED || r.stop_reason == GP_IMC_STOP_MAX_STEPS ||
+          r.stop_reason == GP_IMC_STOP_STALLED);
     if (v) check_report(v, &r, p);
     gp_voronoi_destroy(v);
     gp_imc_report_free(&r);
@@ -136,13 +223,50 @@ static int progress_cb(void *user, long steps, double error)
 int main(void)
 {
     /* --- the paper's two configurations (Mollon & Zhao §3.3.3) and N = 2000 --- */
-    converge(500, 0.8, 1.0, 0.0, 0, 1000000, "config 1 (cov 0.8, a 1)");
-    converge(500, 0.2, 0.1, 0.0, 1, 1000000, "config 2 (cov 0.2, a 0.1)");
-    converge(2000, 0.8, 1.0, 0.0, 0, 1000000, "N 2000 (cov 0.8, a 1)");
+    converge(3, 500, 0.8, 1.0, 0.0, 0, 1000000, "E3: config 1 (cov 0.8, a 1)");
+    converge(3, 500, 0.2, 0.1, 0.0, 1, 1000000, "E3: config 2 (cov 0.2, a 0.1)");
+    converge(3, 2000, 0.8, 1.0, 0.0, 0, 1000000, "E3: N 2000 (cov 0.8, a 1)");
+    converge(GP_IMC_ERROR_AD, 500, 0.8, 1.0, 0.0, 0, 1000000, "AD: config 1 (cov 0.8, a 1)");
+    converge(GP_IMC_ERROR_AD, 500, 0.2, 0.1, 0.0, 1, 1000000, "AD: config 2 (cov 0.2, a 0.1)");
+    converge(GP_IMC_ERROR_AD, 2000, 1.2, 0.3, 30.0, 0, 1000000, "AD: N 2000 (cov 1.2, a 0.3)");
+    converge(GP_IMC_ERROR_AD, 500, 0.1, 1.0, 0.0, 0, 1000000, "AD: cov 0.1");
 
     gp_imc_params p;
+    /* --- a wrong specimen that a histogram error passes: 4 equal-probability classes at
+     * COV 0.2 are matched exactly by cells whose COV is far from 0.2; the AD error is not --- */
+    gp_imc_params_default(&p);
+    p.error_kind = 3;
+    p.threshold = 1e-9;
+    p.cov = 0.2;
+    p.classes_size = p.classes_orient = 4;
+    {
+        gp_voronoi *v = NULL;
+        gp_imc_report r;
+        gp_status st = run(SQ, 4, NULL, NULL, 0, 500, &p, &v, &r, "E3, 4 classes, cov 0.2");
+        cell_stats c = cell_stats_of(v, &p);
+        printf("    E3 %.5f but KS %.4f (critical %.4f), COV %.4f for 0.2, AD size error %.2f\n", r.error, c.ks,
+               1.36 / sqrt(500), c.cov, c.ad_size);
+        CHECK(st == GP_OK && r.error == 0.0);
+        CHECK(c.ks > 1.36 / sqrt(500) || fabs(c.cov / 0.2 - 1) > 0.2);
+        CHECK(c.ad_size > 10 * gp_imc_default_threshold(GP_IMC_ERROR_AD));
+        gp_voronoi_destroy(v);
+        gp_imc_report_free(&r);
+    }
+    /* --- N = 1: nothing can move; the run says so at once --- */
+    gp_imc_params_default(&p);
+    {
+        gp_voronoi *v = NULL;
+        gp_imc_report r;
+        gp_status st = run(SQ, 4, NULL, NULL, 0, 1, &p, &v, &r, "one cell");
+        CHECK(st == GP_ERR_NOT_CONVERGED && r.stop_reason == GP_IMC_STOP_SINGLE_CELL && r.steps == 0);
+        CHECK(v && gp_voronoi_cell_area(v, 0) == 1.0);
+        gp_voronoi_destroy(v);
+        gp_imc_report_free(&r);
+    }
     /* --- floor: 25 classes at N = 500 cannot reach 0.002 (NOTES.md: ~0.0029) --- */
     gp_imc_params_default(&p);
+    p.error_kind = 3;
+    p.threshold = 0.002;
     p.cov = 0.3;
     p.anisotropy = 0.3;
     p.classes_size = 25;
@@ -157,6 +281,7 @@ int main(void)
         CHECK(r.steps == 0);
         CHECK(r.floor > 0.002 && r.floor < 0.004);
         CHECK(strstr(e.message, "floor") != NULL);
+        CHECK(gp_imc_reachable_threshold(&p, 500) == r.floor);
         CHECK(v != NULL);
         gp_voronoi_destroy(v);
         gp_imc_report_free(&r);
@@ -171,8 +296,12 @@ int main(void)
         CHECK_NEAR(gp_imc_floor(t, 3, 100, 3), sqrt(6.0 / 9.0) / 100, 1e-12);
         CHECK_NEAR(gp_imc_floor(t, 3, 100, 2), (2.0 / 3.0) / 100, 1e-12);
     }
-    /* automatic classes keep the threshold reachable */
+    /* automatic classes keep the threshold reachable; AD has no floor */
     gp_imc_params_default(&p);
+    CHECK(gp_imc_reachable_threshold(&p, 20) == 0.0);
+    p.error_kind = 3;
+    p.threshold = 0.002;
+    CHECK(gp_imc_reachable_threshold(&p, 20) > 0.01); /* 3 x 3 classes at N = 20 */
     p.max_steps = 0;
     {
         gp_voronoi *v = NULL;
@@ -332,6 +461,7 @@ int main(void)
         p.mean_deg = 30;
         hard("anisotropy 0.05, 30 deg", SQ, 4, NULL, NULL, 0, 300, &p);
         p.error_kind = 1;
+        p.threshold = 0.002;
         hard("E1", SQ, 4, NULL, NULL, 0, 300, &p);
         p.error_kind = 2;
         hard("E2", SQ, 4, NULL, NULL, 0, 300, &p);
