@@ -55,9 +55,13 @@ const char *gp_law_name(gp_law_kind kind)
 static double log_phic(double z)
 {
     /* libm's erfc is accurate to the last bits until it underflows (z ~ 37); GSL's log-erfc
-     * beyond. libm first because the IMC calls this for every changed cell of every step. */
+     * beyond, up to where it breaks down (NaN near z ~ 1e61); then the asymptotic series,
+     * exact to double precision there. libm first because the IMC calls this for every
+     * changed cell of every step. */
     if (z < 30.0) return log(0.5 * erfc(z / LAW_SQRT2));
-    return LAW_LN_HALF + gsl_sf_log_erfc(z / LAW_SQRT2);
+    if (z < 1e6) return LAW_LN_HALF + gsl_sf_log_erfc(z / LAW_SQRT2);
+    if (!(z < INFINITY)) return -INFINITY;
+    return -0.5 * z * z - log(z) - 0.5 * log(2.0 * LAW_PI);
 }
 static double log_phi(double z) { return log_phic(-z); }
 
@@ -351,11 +355,18 @@ static void log_cdf_sf_exact(const gp_law *l, double a, double *lf, double *ls)
         return;
     }
     case GP_LAW_NORMAL: {
-        double z = (a - l->mu) / l->sigma, lq0 = log(l->q0);
-        *ls = log_phic(z) - lq0;
-        /* F = (P(Z <= z) - P(Z <= z0)) / q0; near a = 0 this is a small difference */
+        double z = (a - l->mu) / l->sigma, lq0 = log(l->q0), z0 = -l->mu / l->sigma;
+        double dz = a / l->sigma;
+        *ls = fmin(0.0, log_phic(z) - lq0);
+        /* F = (Phi(z) - Phi(z0)) / q0. Near a = 0 that difference cancels (z rounds to z0
+         * below a ~ 1e-16 sigma): there F = phi(z0) dz (1 - z0 dz / 2 + O(dz^2)) / q0. */
         double f = gp_law_cdf(l, a);
-        *lf = f > 1e-3 ? log(f) : log(gsl_cdf_ugaussian_P(z) - gsl_cdf_ugaussian_P(-l->mu / l->sigma)) - lq0;
+        if (f > 1e-3)
+            *lf = log(f);
+        else if (dz > 1e-5)
+            *lf = log(gsl_cdf_ugaussian_P(z) - gsl_cdf_ugaussian_P(z0)) - lq0;
+        else
+            *lf = -0.5 * z0 * z0 - 0.5 * log(2.0 * LAW_PI) + log(dz) + log1p(-0.5 * z0 * dz) - lq0;
         return;
     }
     default: {
@@ -373,8 +384,8 @@ void gp_law_log_cdf_sf(const gp_law *l, double a, double *lf, double *ls)
     log_cdf_sf_exact(l, a, lf, ls);
     if (l->kind == GP_LAW_LOGNORMAL || l->kind == GP_LAW_NORMAL) return;
     double z = (log(a) - l->tm) / l->ts;
-    *lf = log_add(log1p(-LAW_ETA) + *lf, log(LAW_ETA) + log_phi(z));
-    *ls = log_add(log1p(-LAW_ETA) + *ls, log(LAW_ETA) + log_phic(z));
+    *lf = fmin(0.0, log_add(log1p(-LAW_ETA) + *lf, log(LAW_ETA) + log_phi(z)));
+    *ls = fmin(0.0, log_add(log1p(-LAW_ETA) + *ls, log(LAW_ETA) + log_phic(z)));
 }
 
 /* ---------------------------------------------------------------- orientation */
