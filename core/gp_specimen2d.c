@@ -6,16 +6,20 @@
  * 1 + i. Cells are filled by a pool of threads that take cells from a shared counter and
  * write results by cell index, so the specimen is the same bits whatever the thread count.
  */
+#define _GNU_SOURCE /* qsort_r */
 #include "gp_specimen2d.h"
 
 #include <math.h>
 #include <pthread.h>
+#include <stdarg.h>
 #include <stdatomic.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "gp_fill.h"
+#include "gp_fit.h"
 #include "gp_fourier.h"
 #include "gp_imc.h"
 #include "gp_odec.h"
@@ -38,6 +42,7 @@ void gp_spec2d_defaults(gp_spec2d *s)
     s->outer.pts = unit_square;
     s->outer.n = 4;
     s->particles = 100;
+    s->size_law = GP_LAW_LOGNORMAL;
     s->cov = 0.5;
     s->mean_deg = 0.0;
     s->anisotropy = 1.0;
@@ -47,8 +52,8 @@ void gp_spec2d_defaults(gp_spec2d *s)
     s->alpha = -2.0;
     s->beta = -2.0;
     s->solid_fraction = 0.65;
-    s->imc_error = GP_IMC_E3;
-    s->imc_threshold = 0.002;
+    s->imc_error = GP_IMC_AD;
+    s->imc_threshold = gp_imc_default_threshold(GP_IMC_ERROR_AD);
     s->imc_max_steps = 1000000;
     s->imc_init = GP_INIT_UNIFORM;
     s->imc_classes = 0;
@@ -208,15 +213,29 @@ static gp_status container_make(const gp_spec2d *s, container *c, gp_error *err)
 
 /* ---------------------------------------------------------------- filling pool */
 
+/* What pass A leaves for pass B about one grain: the curve it was cut from. The random phases
+ * are not kept (nmodes doubles a cell): pass B draws them again from the cell's stream. */
+typedef struct grain_curve {
+    gp_vec2 centre;
+    double r0;
+    double phases27[6];        /* the optimised phases of modes 2..7 */
+} grain_curve;
+
+enum { PASS_FILL = 0, PASS_FINISH = 1 };
+
 typedef struct fill_job {
     const gp_spec2d *spec;
     const gp_voronoi *vor;
     const double *D;
     size_t nmodes, np;
     unsigned outputs;
+    double fill_fraction;      /* what pass A fills each cell to */
     gp_specimen2d *out;
     gp_vec2 **cell_poly;       /* per cell: the seed's part (owned here) */
     size_t *cell_n;
+    grain_curve *curve;        /* per cell, from pass A */
+    const double *area_scale;  /* per cell area factor for pass B (NULL: 1) */
+    int pass;
     atomic_size_t next;
     atomic_size_t done;
     atomic_int stop;
@@ -239,8 +258,19 @@ static void job_fail(fill_job *j, size_t cell, const gp_error *e)
     atomic_store(&j->stop, 1);
 }
 
-static void fill_one(fill_job *j, gp_fill_workspace *ws, double *phases, size_t i,
-                     double *tf, double *to, double *td)
+/* the cell's own random phases (stream 1 + i), the same in both passes */
+static gp_status cell_phases(const fill_job *j, size_t i, double *phases, gp_error *e)
+{
+    gp_rng *rng = gp_rng_create(j->spec->seed, 1 + (uint64_t)i, e);
+    if (!rng)
+        return e->code;
+    gp_status st = gp_fourier_random_phases(j->nmodes, rng_u01, rng, phases, e);
+    gp_rng_destroy(rng);
+    return st;
+}
+
+/* pass A: the grain of cell i, filled to j->fill_fraction */
+static void fill_one(fill_job *j, gp_fill_workspace *ws, double *phases, size_t i, double *tf)
 {
     gp_error e;
     gp_error_clear(&e);
@@ -254,14 +284,8 @@ static void fill_one(fill_job *j, gp_fill_workspace *ws, double *phases, size_t 
         return;
     }
     double t0 = now_s();
-    gp_rng *rng = gp_rng_create(j->spec->seed, 1 + (uint64_t)i, &e);
-    if (!rng) {
-        job_fail(j, i, &e);
-        return;
-    }
-    gp_status st = gp_fourier_random_phases(j->nmodes, rng_u01, rng, phases, &e);
-    gp_rng_destroy(rng);
     gp_fill_result fr;
+    gp_status st = cell_phases(j, i, phases, &e);
     if (st == GP_OK)
         st = gp_fill_cell(ws, j->cell_poly[i], j->cell_n[i], phases, g->contour, &fr, &e);
     if (st != GP_OK) {
@@ -270,65 +294,100 @@ static void fill_one(fill_job *j, gp_fill_workspace *ws, double *phases, size_t 
         job_fail(j, i, &e);
         return;
     }
+    double cell_area = gp_voronoi_cell_area(j->vor, i);
     g->area = fr.area;
-    g->cell_fraction = gp_voronoi_cell_area(j->vor, i) > 0.0
-                           ? fr.area / gp_voronoi_cell_area(j->vor, i) : 0.0;
-    g->target_met = fr.target_met;
+    g->cell_fraction = cell_area > 0.0 ? fr.area / cell_area : 0.0;
+    g->target_met = g->cell_fraction >= j->spec->solid_fraction * (1.0 - 1e-9);
     double w, ang, len;
     g->orientation_deg = gp_min_caliper(g->contour, g->ncontour, &w, &ang, &len, NULL) == GP_OK
                              ? ang * DEG : 0.0;
-    double t1 = now_s();
-    *tf += t1 - t0;
+    grain_curve *c = &j->curve[i];
+    c->centre = fr.centre;
+    c->r0 = fr.r0;
+    for (size_t k = 2; k < 8; k++)
+        c->phases27[k - 2] = fr.phases[k];
+    *tf += now_s() - t0;
+}
 
-    /* the optimised phases replace the random ones for modes 2..7 */
+/* scales grain i about its centre so that its area is multiplied by f (<= 1: it stays in
+ * its cell, every contour point moving along its own ray towards the centre) */
+static void grain_scale(gp_grain2d *g, grain_curve *c, double f)
+{
+    double k = sqrt(f);
+    for (size_t p = 0; p < g->ncontour; p++) {
+        g->contour[p].x = c->centre.x + k * (g->contour[p].x - c->centre.x);
+        g->contour[p].y = c->centre.y + k * (g->contour[p].y - c->centre.y);
+    }
+    g->area *= f;
+    g->cell_fraction *= f;
+    c->r0 *= k;
+}
+
+static gp_status odec_one(gp_grain2d *g, gp_odec_result *od, gp_error *e)
+{
+    gp_status st = gp_odec_build(g->contour, g->ncontour, NULL, od, e);
+    if (st != GP_OK)
+        return st;
+    g->ndiscs = od->ndiscs;
+    g->discs = malloc((od->ndiscs ? od->ndiscs : 1) * 3 * sizeof(double));
+    if (!g->discs)
+        return gp_error_set(e, GP_ERR_NOMEM, "out of memory");
+    for (size_t k = 0; k < od->ndiscs; k++) {
+        g->discs[3 * k] = od->discs[k].x;
+        g->discs[3 * k + 1] = od->discs[k].y;
+        g->discs[3 * k + 2] = od->discs[k].r;
+    }
+    return GP_OK;
+}
+
+/* Descriptors of the grain as it goes into the DEM code: its contour and ODEC, with the
+ * perimeters from the analytic curve at >= 512 points (the paper's 500-point note; gp_shape.h)
+ * so that regularity does not depend on contour_points. */
+static gp_status describe_one(const fill_job *j, size_t i, double *phases, const gp_odec_result *od,
+                              gp_error *e)
+{
+    gp_grain2d *g = &j->out->grains[i];
+    const grain_curve *c = &j->curve[i];
+    gp_status st = cell_phases(j, i, phases, e);
+    if (st != GP_OK)
+        return st;
     for (size_t k = 2; k < 8 && k < j->nmodes; k++)
-        phases[k] = fr.phases[k];
+        phases[k] = c->phases27[k - 2];
+    gp_shape_curve curve = {c->centre, c->r0, j->D, phases, j->nmodes};
+    gp_shape_result sr;
+    st = gp_shape_describe_ex(g->contour, g->ncontour, NULL, od->ndiscs ? od->discs : NULL,
+                              od->ndiscs, &curve, &sr, e);
+    if (st != GP_OK)
+        return st;
+    g->descriptors.elongation = sr.elongation;
+    g->descriptors.roundness = sr.roundness;
+    g->descriptors.circularity = sr.circularity;
+    g->descriptors.regularity = sr.regularity;
+    return GP_OK;
+}
 
+/* pass B: the grain's final size, then its ODEC and descriptors */
+static void finish_one(fill_job *j, double *phases, size_t i, double *to, double *td)
+{
+    gp_error e;
+    gp_error_clear(&e);
+    gp_grain2d *g = &j->out->grains[i];
+    if (j->area_scale && j->area_scale[i] != 1.0)
+        grain_scale(g, &j->curve[i], j->area_scale[i]);
+    double t1 = now_s();
     gp_odec_result od;
     memset(&od, 0, sizeof od);
-    if (j->outputs & GP_OUT_ODEC) {
-        st = gp_odec_build(g->contour, g->ncontour, NULL, &od, &e);
-        if (st != GP_OK) {
-            job_fail(j, i, &e);
-            return;
-        }
-        g->ndiscs = od.ndiscs;
-        g->discs = malloc((od.ndiscs ? od.ndiscs : 1) * 3 * sizeof(double));
-        if (!g->discs) {
-            gp_odec_result_free(&od);
-            gp_error_set(&e, GP_ERR_NOMEM, "out of memory");
-            job_fail(j, i, &e);
-            return;
-        }
-        for (size_t k = 0; k < od.ndiscs; k++) {
-            g->discs[3 * k] = od.discs[k].x;
-            g->discs[3 * k + 1] = od.discs[k].y;
-            g->discs[3 * k + 2] = od.discs[k].r;
-        }
-    }
+    gp_status st = GP_OK;
+    if (j->outputs & GP_OUT_ODEC)
+        st = odec_one(g, &od, &e);
     double t2 = now_s();
     *to += t2 - t1;
-
-    if (j->outputs & GP_OUT_DESCRIPTORS) {
-        /* Descriptors of the grain as it goes into the DEM code: its contour and ODEC, with
-         * the perimeters from the analytic curve at >= 512 points (the paper's 500-point
-         * note; gp_shape.h) so that regularity does not depend on contour_points. */
-        gp_shape_curve curve = {fr.centre, fr.r0, j->D, phases, j->nmodes};
-        gp_shape_result sr;
-        st = gp_shape_describe_ex(g->contour, g->ncontour, NULL, od.ndiscs ? od.discs : NULL,
-                                  od.ndiscs, &curve, &sr, &e);
-        if (st != GP_OK) {
-            gp_odec_result_free(&od);
-            job_fail(j, i, &e);
-            return;
-        }
-        g->descriptors.elongation = sr.elongation;
-        g->descriptors.roundness = sr.roundness;
-        g->descriptors.circularity = sr.circularity;
-        g->descriptors.regularity = sr.regularity;
-    }
+    if (st == GP_OK && (j->outputs & GP_OUT_DESCRIPTORS))
+        st = describe_one(j, i, phases, &od, &e);
     gp_odec_result_free(&od);
     *td += now_s() - t2;
+    if (st != GP_OK)
+        job_fail(j, i, &e);
 }
 
 typedef struct worker_arg {
@@ -343,14 +402,14 @@ static void *fill_worker(void *p)
     fill_job *j = a->job;
     gp_fill_params fp;
     gp_fill_params_defaults(&fp);
-    fp.solid_fraction = j->spec->solid_fraction;
+    fp.solid_fraction = j->fill_fraction;
     fp.D = j->D;
     fp.nmodes = j->nmodes;
     fp.contour_points = j->np;
-    gp_fill_workspace *ws = gp_fill_workspace_create(&fp, &a->err);
+    gp_fill_workspace *ws = j->pass == PASS_FILL ? gp_fill_workspace_create(&fp, &a->err) : NULL;
     double *phases = malloc(j->nmodes * sizeof(double));
-    if (!ws || !phases) {
-        if (ws)
+    if ((j->pass == PASS_FILL && !ws) || !phases) {
+        if (ws || j->pass != PASS_FILL)
             gp_error_set(&a->err, GP_ERR_NOMEM, "out of memory");
         job_fail(j, 0, &a->err);
         gp_fill_workspace_destroy(ws);
@@ -364,12 +423,77 @@ static void *fill_worker(void *p)
         size_t i = atomic_fetch_add(&j->next, 1);
         if (i >= n)
             break;
-        fill_one(j, ws, phases, i, &a->tf, &a->to, &a->td);
+        if (j->pass == PASS_FILL)
+            fill_one(j, ws, phases, i, &a->tf);
+        else
+            finish_one(j, phases, i, &a->to, &a->td);
         atomic_fetch_add(&j->done, 1);
     }
     gp_fill_workspace_destroy(ws);
     free(phases);
     return NULL;
+}
+
+/* Runs one pass over every cell on spec->threads threads; this thread relays progress (from
+ * f0 to f1 of the job) and cancellation. */
+static gp_status run_pass(fill_job *job, int pass, double f0, double f1, gp_progress_fn progress,
+                          void *user, const volatile int *cancel, gp_error *err)
+{
+    size_t n = job->out->ngrains;
+    job->pass = pass;
+    atomic_store(&job->next, 0);
+    atomic_store(&job->done, 0);
+    int nthreads = job->spec->threads > 0 ? job->spec->threads : 1;
+    if ((size_t)nthreads > n)
+        nthreads = (int)n;
+    worker_arg *args = calloc((size_t)nthreads, sizeof *args);
+    pthread_t *tids = calloc((size_t)nthreads, sizeof *tids);
+    if (!args || !tids) {
+        free(args);
+        free(tids);
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    }
+    int started = 0;
+    for (int t = 0; t < nthreads; t++) {
+        args[t].job = job;
+        if (pthread_create(&tids[t], NULL, fill_worker, &args[t]) != 0)
+            break;
+        started++;
+    }
+    if (started == 0)
+        fill_worker(&args[0]); /* no thread could start: do the work here */
+    while (started > 0 && atomic_load(&job->done) < n && !atomic_load(&job->stop)) {
+        struct timespec ts = {0, 50 * 1000 * 1000};
+        nanosleep(&ts, NULL);
+        int stop = cancelled(cancel);
+        if (!stop && progress) {
+            gp_progress p = {pass == PASS_FILL ? "fill" : "odec",
+                             f0 + (f1 - f0) * (double)atomic_load(&job->done) / (double)n,
+                             job->out->imc_steps, job->out->imc_error};
+            stop = progress(user, &p);
+        }
+        if (stop) {
+            gp_error e;
+            gp_error_set(&e, GP_ERR_CANCELLED, "cancelled");
+            job_fail(job, 0, &e);
+        }
+    }
+    for (int t = 0; t < started; t++)
+        pthread_join(tids[t], NULL);
+    for (int t = 0; t < nthreads; t++) {
+        /* CPU seconds summed over threads, scaled to wall time by the thread count */
+        job->t_fill += args[t].tf / nthreads;
+        job->t_odec += args[t].to / nthreads;
+        job->t_desc += args[t].td / nthreads;
+    }
+    free(args);
+    free(tids);
+    if (job->err.code != GP_OK) {
+        if (err)
+            *err = job->err;
+        return job->err.code;
+    }
+    return GP_OK;
 }
 
 /* ---------------------------------------------------------------- build */
@@ -417,10 +541,10 @@ static gp_status spectrum_make(const gp_spec2d *s, size_t nmodes, double *D, gp_
 
 static gp_status check_spec(const gp_spec2d *s, gp_error *err)
 {
-    if (s->particles < 1)
+    if (s->particles < 1 && s->size_law != GP_LAW_SIEVE)
         return gp_error_set(err, GP_ERR_INVALID, "particles must be >= 1");
-    if (!(s->cov >= 0.0) || !isfinite(s->cov))
-        return gp_error_set(err, GP_ERR_INVALID, "size.cov must be >= 0");
+    if (s->size_law == GP_LAW_SIEVE && (!s->sieve_d || !s->sieve_pass || s->nsieve < 2))
+        return gp_error_set(err, GP_ERR_INVALID, "size.sieve needs at least 2 rows");
     if (!(s->anisotropy > 0.0 && s->anisotropy <= 1.0))
         return gp_error_set(err, GP_ERR_INVALID, "orientation.anisotropy must be in (0, 1]");
     if (!isfinite(s->mean_deg))
@@ -435,6 +559,94 @@ static gp_status check_spec(const gp_spec2d *s, gp_error *err)
     if (s->imc_max_steps < 0)
         return gp_error_set(err, GP_ERR_INVALID, "imc.max_steps must be >= 0");
     return GP_OK;
+}
+
+/* ---------------------------------------------------------------- laws and cell count */
+
+static double container_area(const container *c)
+{
+    double a = fabs(gp_poly_area(c->outer, c->nouter));
+    for (size_t h = 0; h < c->nholes; h++)
+        a -= fabs(gp_poly_area(c->holes[h], c->nhole[h]));
+    return a;
+}
+
+/* The law the grains are asked to follow, before any scaling: the sieve, or the parametric
+ * law with mean container area / N (cells) or solid_fraction times that (grains). */
+static gp_law *given_law(const gp_spec2d *s, double area, size_t n, gp_error *err)
+{
+    if (s->size_law == GP_LAW_SIEVE)
+        return gp_law_create_sieve(s->sieve_d, s->sieve_pass, s->nsieve, err);
+    double mean = area / (double)n * (s->size_of_grains ? s->solid_fraction : 1.0);
+    return gp_law_create(s->size_law, mean, s->cov, err);
+}
+
+static gp_status cell_count(const gp_spec2d *s, double area, size_t *count, gp_error *err)
+{
+    if (!(area > 0.0) || !isfinite(area))
+        return gp_error_set(err, GP_ERR_INVALID, "container has no area");
+    if (s->size_law != GP_LAW_SIEVE) {
+        *count = s->particles;
+        return GP_OK;
+    }
+    gp_law *g = gp_law_create_sieve(s->sieve_d, s->sieve_pass, s->nsieve, err);
+    if (!g)
+        return err ? err->code : GP_ERR_INVALID;
+    double nf = s->solid_fraction * area / gp_law_mean(g);
+    gp_law_destroy(g);
+    if (!(nf < 1e12))
+        return gp_error_set(err, GP_ERR_INVALID, "the sieve needs %.3g grains", nf);
+    *count = nf < 1.5 ? 1 : (size_t)llround(nf);
+    return GP_OK;
+}
+
+gp_status gp_spec2d_cell_count(const gp_spec2d *spec, double *area, size_t *count, gp_error *err)
+{
+    container c;
+    gp_status st = container_make(spec, &c, err);
+    double a = st == GP_OK ? container_area(&c) : 0.0;
+    container_free(&c);
+    if (area)
+        *area = a;
+    size_t n = 0;
+    if (st == GP_OK)
+        st = cell_count(spec, a, &n, err);
+    if (count)
+        *count = n;
+    return st;
+}
+
+/* Cells: the grain law scaled so that its mean is exactly the container area / N (the cells
+ * tile the container); grains: the law as given, or the cell law scaled by solid_fraction. */
+static gp_status make_laws(const gp_spec2d *s, double area, size_t n, gp_law **cells,
+                           gp_law **grains, gp_error *err)
+{
+    *cells = *grains = NULL;
+    gp_law *given = given_law(s, area, n, err);
+    if (!given)
+        return err ? err->code : GP_ERR_INVALID;
+    int on_grains = s->size_of_grains || s->size_law == GP_LAW_SIEVE;
+    *cells = gp_law_scaled(given, area / (double)n / gp_law_mean(given), err);
+    *grains = on_grains ? given : gp_law_scaled(given, s->solid_fraction, err);
+    if (!on_grains)
+        gp_law_destroy(given);
+    if (!*cells || !*grains) {
+        gp_law_destroy(*cells);
+        gp_law_destroy(*grains);
+        *cells = *grains = NULL;
+        return err ? err->code : GP_ERR_NOMEM;
+    }
+    return GP_OK;
+}
+
+gp_status gp_spec2d_laws(const gp_spec2d *spec, gp_law **cells, gp_law **grains, gp_error *err)
+{
+    double area;
+    size_t n;
+    gp_status st = gp_spec2d_cell_count(spec, &area, &n, err);
+    if (st != GP_OK)
+        return st;
+    return make_laws(spec, area, n, cells, grains, err);
 }
 
 static gp_status descriptor_stats(gp_specimen2d *out, gp_error *err)
@@ -477,6 +689,389 @@ static gp_status descriptor_stats(gp_specimen2d *out, gp_error *err)
     return GP_OK;
 }
 
+/* ---------------------------------------------------------------- phases of the build */
+
+typedef struct build_ctx {
+    const gp_spec2d *spec;
+    gp_progress_fn progress;
+    void *user;
+    const volatile int *cancel;
+    container cont;
+    size_t n;
+    gp_law *cell_law, *grain_law;
+    gp_voronoi *vor;
+    gp_specimen2d *out;
+} build_ctx;
+
+static const char *error_kind_name(gp_imc_error_kind k)
+{
+    static const char *names[] = {"E1", "E2", "E3", "AD"};
+    return k >= GP_IMC_E1 && k <= GP_IMC_AD ? names[k - 1] : "?";
+}
+
+static gp_status run_imc(build_ctx *b, gp_error *err)
+{
+    const gp_spec2d *spec = b->spec;
+    gp_specimen2d *out = b->out;
+    gp_imc_params ip;
+    gp_imc_params_default(&ip);
+    ip.seed = spec->seed;
+    ip.law = b->cell_law;
+    ip.mean_deg = spec->mean_deg;
+    ip.anisotropy = spec->anisotropy;
+    ip.error_kind = (int)spec->imc_error;
+    ip.threshold = spec->imc_threshold;
+    ip.max_steps = spec->imc_max_steps;
+    ip.init = spec->imc_init == GP_INIT_HALTON ? 1 : 0;
+    ip.classes_size = spec->imc_classes;
+    ip.classes_orient = spec->imc_classes;
+    imc_relay relay = {b->progress, b->user, b->cancel, spec->imc_threshold, -1.0};
+    gp_imc_report rep;
+    memset(&rep, 0, sizeof rep);
+    double t0 = now_s();
+    gp_status st = gp_imc_run(b->cont.outer, b->cont.nouter, b->cont.holes, b->cont.nhole,
+                              b->cont.nholes, b->n, &ip, imc_progress, &relay, b->cancel, &b->vor,
+                              &rep, err);
+    out->t_tessellation = rep.t_init;
+    out->t_imc = now_s() - t0 - rep.t_init;
+    /* Reaching max_steps is not a failure: the specimen is built and its warnings say how far
+     * the IMC got. A threshold below the integer-count floor (refused at submit by the
+     * service), a cancel or bad input end the job with the IMC's message. */
+    if (st == GP_ERR_NOT_CONVERGED) {
+        st = GP_OK;
+        gp_error_clear(err);
+    }
+    if (st == GP_OK) {
+        out->container_area = gp_voronoi_container_area(b->vor);
+        out->imc_error = rep.error;
+        out->imc_steps = rep.steps;
+        out->imc_stop_reason = gp_imc_stop_name(rep.stop_reason);
+        out->imc_error_floor = rep.floor;
+        out->imc_threshold = spec->imc_threshold;
+        out->imc_error_kind = error_kind_name(spec->imc_error);
+        if (report_hist(&out->size_hist, rep.nsize, rep.size_edges, rep.size_target,
+                        rep.size_achieved, b->vor) != 0 ||
+            report_hist(&out->orientation_hist, rep.norient, rep.orient_edges, rep.orient_target,
+                        rep.orient_achieved, NULL) != 0)
+            st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    }
+    gp_imc_report_free(&rep);
+    return st;
+}
+
+static gp_status output_cells(build_ctx *b, gp_error *err)
+{
+    size_t n = b->n;
+    gp_specimen2d *out = b->out;
+    out->cells = calloc(n, sizeof *out->cells);
+    if (!out->cells)
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    out->ncells = n;
+    for (size_t i = 0; i < n; i++) {
+        gp_cell2d *c = &out->cells[i];
+        c->seed = gp_voronoi_seed(b->vor, i);
+        c->area = gp_voronoi_cell_area(b->vor, i);
+        c->orientation_deg = gp_voronoi_cell_orientation(b->vor, i) * DEG;
+        c->npolygons = gp_voronoi_cell_parts(b->vor, i);
+        c->polygons = calloc(c->npolygons, sizeof *c->polygons);
+        if (!c->polygons)
+            return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+        for (size_t k = 0; k < c->npolygons; k++) {
+            size_t m = gp_voronoi_cell_polygon(b->vor, i, k, NULL, 0);
+            c->polygons[k].pts = malloc((m ? m : 1) * sizeof(gp_vec2));
+            if (!c->polygons[k].pts)
+                return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+            c->polygons[k].n = gp_voronoi_cell_polygon(b->vor, i, k, c->polygons[k].pts, m);
+        }
+    }
+    return GP_OK;
+}
+
+/* Headroom of the fill when the grains themselves must follow the law: each cell is filled
+ * up to solid_fraction * this (stopping there), and the rank matching below then shrinks every
+ * grain to its exact share. 1.2 lets a cell a fifth above its rank's target still supply it;
+ * more only costs optimiser time in cells that cannot reach it anyway. */
+#define GRAIN_LAW_HEADROOM 1.2
+
+static int cmp_index_by_value(const void *a, const void *b, void *v)
+{
+    const double *x = v;
+    double p = x[*(const size_t *)a], q = x[*(const size_t *)b];
+    if (p != q)
+        return p < q ? -1 : 1;
+    return *(const size_t *)a < *(const size_t *)b ? -1 : *(const size_t *)a > *(const size_t *)b;
+}
+
+/* "of": "grains": the k-th smallest reachable grain gets the k-th smallest of the law's N
+ * quantiles at (2k - 1) / 2N -- the closest sample of N to the law, and the assignment that
+ * asks least of every cell (any other order asks a smaller grain to give more). A grain that
+ * cannot reach its quantile keeps its largest size (target_met 0; the fit report shows it).
+ * Writes the area factor of each grain into scale[]. */
+static gp_status rank_match(build_ctx *b, double *scale, gp_error *err)
+{
+    size_t n = b->n;
+    gp_specimen2d *out = b->out;
+    size_t *idx = malloc(n * sizeof *idx);
+    double *reach = malloc(n * sizeof *reach);
+    if (!idx || !reach) {
+        free(idx);
+        free(reach);
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    }
+    for (size_t i = 0; i < n; i++) {
+        idx[i] = i;
+        reach[i] = out->grains[i].area;
+    }
+    qsort_r(idx, n, sizeof *idx, cmp_index_by_value, reach);
+    for (size_t k = 0; k < n; k++) {
+        size_t i = idx[k];
+        double q = gp_law_quantile(b->grain_law, (2.0 * (double)k + 1.0) / (2.0 * (double)n));
+        scale[i] = reach[i] > 0.0 && q < reach[i] ? q / reach[i] : 1.0;
+        out->grains[i].target_met = q <= reach[i];
+    }
+    free(idx);
+    free(reach);
+    return GP_OK;
+}
+
+static gp_status grain_stats(build_ctx *b, gp_error *err)
+{
+    gp_specimen2d *out = b->out;
+    size_t n = b->n;
+    double solid = 0.0, gap = 0.0;
+    size_t met = 0;
+    for (size_t i = 0; i < n; i++) {
+        const gp_grain2d *g = &out->grains[i];
+        solid += g->area;
+        met += g->target_met != 0;
+        double d = fmod(fabs(g->orientation_deg - gp_voronoi_cell_orientation(b->vor, i) * DEG),
+                        180.0);
+        gap += d > 90.0 ? 180.0 - d : d;
+    }
+    out->solid_fraction = solid / out->container_area;
+    out->cells_target_met = met;
+    out->mean_orientation_gap_deg = n ? gap / (double)n : 0.0;
+    /* grain sizes on the cell classes scaled by the target fraction */
+    if (hist_copy(&out->grain_size_hist, &out->size_hist, b->spec->solid_fraction) != 0)
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    double *v = malloc((n ? n : 1) * sizeof *v);
+    if (!v)
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < n; i++)
+        v[i] = out->grains[i].area;
+    hist_fill(&out->grain_size_hist, v, n);
+    /* the grains' orientations on the IMC's classes, against the same cosine law */
+    if (hist_copy(&out->grain_orientation_hist, &out->orientation_hist, 1.0) != 0) {
+        free(v);
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    }
+    for (size_t i = 0; i < n; i++)
+        v[i] = out->grains[i].orientation_deg >= 90.0 ? out->grains[i].orientation_deg - 180.0
+                                                      : out->grains[i].orientation_deg;
+    hist_fill(&out->grain_orientation_hist, v, n);
+    free(v);
+    if (b->spec->outputs & GP_OUT_DESCRIPTORS)
+        return descriptor_stats(out, err);
+    return GP_OK;
+}
+
+static gp_status job_setup(build_ctx *b, fill_job *job, gp_error *err)
+{
+    const gp_spec2d *spec = b->spec;
+    size_t n = b->n, np = spec->contour_points, nmodes = np / 2;
+    gp_specimen2d *out = b->out;
+    double *D = malloc(nmodes * sizeof *D);
+    job->D = D;
+    out->grains = calloc(n, sizeof *out->grains);
+    job->cell_poly = calloc(n, sizeof *job->cell_poly);
+    job->cell_n = calloc(n, sizeof *job->cell_n);
+    job->curve = calloc(n, sizeof *job->curve);
+    if (!D || !out->grains || !job->cell_poly || !job->cell_n || !job->curve)
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    out->ngrains = n;
+    gp_status st = spectrum_make(spec, nmodes, D, err);
+    if (st != GP_OK)
+        return st;
+    for (size_t i = 0; i < n; i++) {
+        size_t part = gp_voronoi_cell_seed_part(b->vor, i);
+        size_t m = gp_voronoi_cell_polygon(b->vor, i, part, NULL, 0);
+        job->cell_poly[i] = malloc((m ? m : 1) * sizeof(gp_vec2));
+        if (!job->cell_poly[i])
+            return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+        job->cell_n[i] = gp_voronoi_cell_polygon(b->vor, i, part, job->cell_poly[i], m);
+    }
+    job->spec = spec;
+    job->vor = b->vor;
+    job->nmodes = nmodes;
+    job->np = np;
+    job->outputs = spec->outputs;
+    job->out = out;
+    int on_grains = spec->size_of_grains || spec->size_law == GP_LAW_SIEVE;
+    job->fill_fraction = on_grains ? fmin(1.0, spec->solid_fraction * GRAIN_LAW_HEADROOM)
+                                   : spec->solid_fraction;
+    return GP_OK;
+}
+
+static void job_free(fill_job *job, size_t n)
+{
+    for (size_t i = 0; job->cell_poly && i < n; i++)
+        free(job->cell_poly[i]);
+    free(job->cell_poly);
+    free(job->cell_n);
+    free(job->curve);
+    free((double *)job->D);
+}
+
+/* Filling (pass A), the grain law's rank matching, then ODEC and descriptors (pass B). */
+static gp_status build_grains(build_ctx *b, gp_error *err)
+{
+    fill_job job;
+    memset(&job, 0, sizeof job);
+    pthread_mutex_init(&job.lock, NULL);
+    double *scale = NULL;
+    gp_status st = job_setup(b, &job, err);
+    if (st == GP_OK)
+        st = run_pass(&job, PASS_FILL, 0.65, 0.9, b->progress, b->user, b->cancel, err);
+    int on_grains = b->spec->size_of_grains || b->spec->size_law == GP_LAW_SIEVE;
+    if (st == GP_OK && on_grains) {
+        scale = malloc(b->n * sizeof *scale);
+        st = scale ? rank_match(b, scale, err) : gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+        job.area_scale = scale;
+    }
+    if (st == GP_OK && (scale || (b->spec->outputs & (GP_OUT_ODEC | GP_OUT_DESCRIPTORS))))
+        st = run_pass(&job, PASS_FINISH, 0.9, 1.0, b->progress, b->user, b->cancel, err);
+    b->out->t_fill = job.t_fill;
+    b->out->t_odec = job.t_odec;
+    b->out->t_descriptors = job.t_desc;
+    free(scale);
+    job_free(&job, b->n);
+    pthread_mutex_destroy(&job.lock);
+    if (st == GP_OK)
+        st = grain_stats(b, err);
+    return st;
+}
+
+/* ---------------------------------------------------------------- fit report and warnings */
+
+#define FIT_CURVE_POINTS 64
+
+static gp_status fit_report(build_ctx *b, gp_error *err)
+{
+    gp_specimen2d *out = b->out;
+    size_t n = b->n, ng = out->ngrains;
+    double *v = malloc(n * sizeof *v);
+    if (!v)
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    gp_fit2d *f = &out->fit;
+    for (size_t i = 0; i < n; i++)
+        v[i] = gp_voronoi_cell_area(b->vor, i);
+    gp_status st = gp_fit_area_measure(v, n, b->cell_law, FIT_CURVE_POINTS, &f->cell_area, err);
+    for (size_t i = 0; i < n && st == GP_OK; i++)
+        v[i] = gp_voronoi_cell_orientation(b->vor, i) * DEG;
+    if (st == GP_OK)
+        st = gp_fit_orient_measure(v, n, b->spec->mean_deg, b->spec->anisotropy,
+                                   &f->cell_orientation, err);
+    if (st == GP_OK && ng > 0) {
+        for (size_t i = 0; i < ng; i++)
+            v[i] = out->grains[i].area;
+        st = gp_fit_area_measure(v, ng, b->grain_law, FIT_CURVE_POINTS, &f->grain_area, err);
+        if (st == GP_OK && b->spec->size_law == GP_LAW_SIEVE)
+            st = gp_fit_passing_measure(v, ng, b->grain_law, &f->passing, err);
+        for (size_t i = 0; i < ng && st == GP_OK; i++)
+            v[i] = out->grains[i].orientation_deg;
+        if (st == GP_OK)
+            st = gp_fit_orient_measure(v, ng, b->spec->mean_deg, b->spec->anisotropy,
+                                       &f->grain_orientation, err);
+    }
+    free(v);
+    return st;
+}
+
+static void warn(gp_specimen2d *out, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void warn(gp_specimen2d *out, const char *fmt, ...)
+{
+    char buf[GP_ERROR_MESSAGE_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    char **w = realloc(out->warnings, (out->nwarnings + 1) * sizeof *w);
+    if (!w)
+        return; /* a warning lost to memory exhaustion; the numbers are still in the stats */
+    out->warnings = w;
+    if ((w[out->nwarnings] = strdup(buf)))
+        out->nwarnings++;
+}
+
+static void warn_fit_area(gp_specimen2d *out, const char *what, const gp_fit_area *f)
+{
+    if (f->present && f->ks > f->ks_critical)
+        warn(out, "%s areas: KS distance %.4f to the %s law is above its 5 %% critical value "
+                  "%.4f (mean %.4g for %.4g, COV %.3f for %.3f)", what, f->ks, gp_law_name(f->law),
+             f->ks_critical, f->mean, f->target_mean, f->cov, f->target_cov);
+}
+
+static void warn_fit_orient(gp_specimen2d *out, const char *what, const gp_fit_orient *f)
+{
+    if (f->present && f->ks > f->ks_critical)
+        warn(out, "%s orientations: KS distance %.4f to the cosine law is above its 5 %% "
+                  "critical value %.4f", what, f->ks, f->ks_critical);
+}
+
+/* Every target not reached, with how close it came (issue #12: an honest end). */
+static void collect_warnings(build_ctx *b)
+{
+    gp_specimen2d *out = b->out;
+    const gp_spec2d *spec = b->spec;
+    if (b->n == 1)
+        warn(out, "1 cell: the tessellation is the container itself; its area and orientation "
+                  "cannot be shaped");
+    else if (out->imc_error > out->imc_threshold)
+        warn(out, "imc: the error %.4g (%s) is above the threshold %.4g: the run stopped (%s) "
+                  "after %ld steps", out->imc_error, out->imc_error_kind, out->imc_threshold,
+             out->imc_stop_reason, out->imc_steps);
+    warn_fit_area(out, "cell", &out->fit.cell_area);
+    warn_fit_area(out, "grain", &out->fit.grain_area);
+    warn_fit_orient(out, "cell", &out->fit.cell_orientation);
+    warn_fit_orient(out, "grain", &out->fit.grain_orientation);
+    if (out->fit.passing.n > 0 && out->fit.passing.max_error_pp > 3.0)
+        warn(out, "sieve: passing by mass off by up to %.1f percentage points",
+             out->fit.passing.max_error_pp);
+    if (out->ngrains > 0 && out->solid_fraction < 0.98 * spec->solid_fraction)
+        warn(out, "fill: solid fraction %.4f for a target of %.4f (%zu of %zu grains reached "
+                  "their size)", out->solid_fraction, spec->solid_fraction, out->cells_target_met,
+             out->ngrains);
+}
+
+/* ---------------------------------------------------------------- build */
+
+static gp_status build_steps(build_ctx *b, gp_error *err)
+{
+    const gp_spec2d *spec = b->spec;
+    gp_status st = container_make(spec, &b->cont, err);
+    double area = st == GP_OK ? container_area(&b->cont) : 0.0;
+    if (st == GP_OK)
+        st = cell_count(spec, area, &b->n, err);
+    if (st == GP_OK)
+        st = make_laws(spec, area, b->n, &b->cell_law, &b->grain_law, err);
+    if (st == GP_OK && b->progress) {
+        gp_progress p = {"tessellation", 0.0, 0, 0.0};
+        if (b->progress(b->user, &p) || cancelled(b->cancel))
+            st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+    }
+    if (st == GP_OK)
+        st = run_imc(b, err);
+    if (st == GP_OK && (spec->outputs & GP_OUT_CELLS))
+        st = output_cells(b, err);
+    if (st == GP_OK && (spec->outputs & (GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS)))
+        st = build_grains(b, err);
+    if (st == GP_OK)
+        st = fit_report(b, err);
+    if (st == GP_OK)
+        collect_warnings(b);
+    return st;
+}
+
 gp_status gp_specimen2d_build(const gp_spec2d *spec, gp_progress_fn progress, void *user,
                               const volatile int *cancel, gp_specimen2d **outp, gp_error *err)
 {
@@ -487,278 +1082,31 @@ gp_status gp_specimen2d_build(const gp_spec2d *spec, gp_progress_fn progress, vo
     if (st != GP_OK)
         return st;
     double t_start = now_s();
-
-    gp_specimen2d *out = calloc(1, sizeof *out);
-    if (!out)
+    build_ctx b;
+    memset(&b, 0, sizeof b);
+    b.spec = spec;
+    b.progress = progress;
+    b.user = user;
+    b.cancel = cancel;
+    b.out = calloc(1, sizeof *b.out);
+    if (!b.out)
         return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-    container cont;
-    gp_voronoi *vor = NULL;
-    fill_job job;
-    memset(&job, 0, sizeof job);
-    double *D = NULL;
-
-    st = container_make(spec, &cont, err);
-    if (st != GP_OK)
-        goto fail;
-
-    /* ---- tessellation + IMC */
-    if (progress) {
-        gp_progress p = {"tessellation", 0.0, 0, 0.0};
-        if (progress(user, &p) || cancelled(cancel)) {
-            st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-            goto fail;
-        }
-    }
-    gp_imc_params ip;
-    gp_imc_params_default(&ip);
-    ip.seed = spec->seed;
-    ip.cov = spec->cov;
-    ip.mean_deg = spec->mean_deg;
-    ip.anisotropy = spec->anisotropy;
-    ip.error_kind = (int)spec->imc_error;
-    ip.threshold = spec->imc_threshold;
-    ip.max_steps = spec->imc_max_steps;
-    ip.init = spec->imc_init == GP_INIT_HALTON ? 1 : 0;
-    ip.classes_size = spec->imc_classes;
-    ip.classes_orient = spec->imc_classes;
-    imc_relay relay = {progress, user, cancel, spec->imc_threshold, -1.0};
-    gp_imc_report rep;
-    memset(&rep, 0, sizeof rep);
-    double t_imc0 = now_s();
-    st = gp_imc_run(cont.outer, cont.nouter, cont.holes, cont.nhole, cont.nholes,
-                    spec->particles, &ip, imc_progress, &relay, cancel, &vor, &rep, err);
-    /* timings: the initial tessellation, then the IMC steps */
-    out->t_tessellation = rep.t_init;
-    out->t_imc = now_s() - t_imc0 - rep.t_init;
-    /* Reaching max_steps is not a failure: the specimen is built and the stats say how far
-     * the IMC got ("max_steps"). A threshold below the integer-count floor, a cancel or bad
-     * input end the job with the IMC's message. */
-    if (st == GP_ERR_NOT_CONVERGED) {
-        st = GP_OK;
-        gp_error_clear(err);
-    }
+    st = build_steps(&b, err);
+    gp_voronoi_destroy(b.vor);
+    container_free(&b.cont);
+    gp_law_destroy(b.cell_law);
+    gp_law_destroy(b.grain_law);
     if (st != GP_OK) {
-        gp_imc_report_free(&rep);
-        goto fail;
+        gp_specimen2d_destroy(b.out);
+        return st;
     }
-    out->container_area = gp_voronoi_container_area(vor);
-    out->imc_error = rep.error;
-    out->imc_steps = rep.steps;
-    out->imc_stop_reason = gp_imc_stop_name(rep.stop_reason);
-    out->imc_error_floor = rep.floor;
-    if (report_hist(&out->size_hist, rep.nsize, rep.size_edges, rep.size_target,
-                    rep.size_achieved, vor) != 0 ||
-        report_hist(&out->orientation_hist, rep.norient, rep.orient_edges, rep.orient_target,
-                    rep.orient_achieved, NULL) != 0) {
-        gp_imc_report_free(&rep);
-        st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    gp_imc_report_free(&rep);
-
-    size_t n = gp_voronoi_count(vor);
-
-    /* ---- cells output */
-    if (spec->outputs & GP_OUT_CELLS) {
-        out->cells = calloc(n, sizeof *out->cells);
-        if (!out->cells) {
-            st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        out->ncells = n;
-        for (size_t i = 0; i < n; i++) {
-            gp_cell2d *c = &out->cells[i];
-            c->seed = gp_voronoi_seed(vor, i);
-            c->area = gp_voronoi_cell_area(vor, i);
-            c->orientation_deg = gp_voronoi_cell_orientation(vor, i) * DEG;
-            c->npolygons = gp_voronoi_cell_parts(vor, i);
-            c->polygons = calloc(c->npolygons, sizeof *c->polygons);
-            if (!c->polygons) {
-                st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-                goto fail;
-            }
-            for (size_t k = 0; k < c->npolygons; k++) {
-                size_t m = gp_voronoi_cell_polygon(vor, i, k, NULL, 0);
-                c->polygons[k].pts = malloc((m ? m : 1) * sizeof(gp_vec2));
-                if (!c->polygons[k].pts) {
-                    st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-                    goto fail;
-                }
-                c->polygons[k].n = gp_voronoi_cell_polygon(vor, i, k, c->polygons[k].pts, m);
-            }
-        }
-    }
-
-    /* ---- grains: filling (+ ODEC, descriptors) on a pool of threads */
-    unsigned need_grains = spec->outputs & (GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS);
-    if (need_grains) {
-        size_t np = spec->contour_points;
-        size_t nmodes = np / 2;
-        D = malloc(nmodes * sizeof *D);
-        out->grains = calloc(n, sizeof *out->grains);
-        job.cell_poly = calloc(n, sizeof *job.cell_poly);
-        job.cell_n = calloc(n, sizeof *job.cell_n);
-        if (!D || !out->grains || !job.cell_poly || !job.cell_n) {
-            st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        out->ngrains = n;
-        st = spectrum_make(spec, nmodes, D, err);
-        if (st != GP_OK)
-            goto fail;
-        for (size_t i = 0; i < n; i++) {
-            size_t part = gp_voronoi_cell_seed_part(vor, i);
-            size_t m = gp_voronoi_cell_polygon(vor, i, part, NULL, 0);
-            job.cell_poly[i] = malloc((m ? m : 1) * sizeof(gp_vec2));
-            if (!job.cell_poly[i]) {
-                st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-                goto fail;
-            }
-            job.cell_n[i] = gp_voronoi_cell_polygon(vor, i, part, job.cell_poly[i], m);
-        }
-        job.spec = spec;
-        job.vor = vor;
-        job.D = D;
-        job.nmodes = nmodes;
-        job.np = np;
-        job.outputs = spec->outputs;
-        job.out = out;
-        atomic_init(&job.next, 0);
-        atomic_init(&job.done, 0);
-        atomic_init(&job.stop, 0);
-        pthread_mutex_init(&job.lock, NULL);
-
-        int nthreads = spec->threads > 0 ? spec->threads : 1;
-        if ((size_t)nthreads > n)
-            nthreads = (int)n;
-        worker_arg *args = calloc((size_t)nthreads, sizeof *args);
-        pthread_t *tids = calloc((size_t)nthreads, sizeof *tids);
-        int started = 0;
-        if (!args || !tids) {
-            free(args);
-            free(tids);
-            pthread_mutex_destroy(&job.lock);
-            st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        for (int t = 0; t < nthreads; t++) {
-            args[t].job = &job;
-            if (pthread_create(&tids[t], NULL, fill_worker, &args[t]) == 0)
-                started++;
-            else
-                break;
-        }
-        if (started == 0)
-            fill_worker(&args[0]); /* no thread could start: do the work here */
-        /* This thread reports progress and relays cancellation while the pool works. */
-        while (started > 0 && atomic_load(&job.done) < n && !atomic_load(&job.stop)) {
-            struct timespec ts = {0, 50 * 1000 * 1000};
-            nanosleep(&ts, NULL);
-            int stop = cancelled(cancel);
-            if (!stop && progress) {
-                gp_progress p = {"fill", 0.65 + 0.35 * (double)atomic_load(&job.done) / (double)n,
-                                 out->imc_steps, out->imc_error};
-                stop = progress(user, &p);
-            }
-            if (stop) {
-                gp_error e;
-                gp_error_set(&e, GP_ERR_CANCELLED, "cancelled");
-                job_fail(&job, 0, &e);
-            }
-        }
-        for (int t = 0; t < started; t++)
-            pthread_join(tids[t], NULL);
-        for (int t = 0; t < nthreads; t++) {
-            job.t_fill += args[t].tf;
-            job.t_odec += args[t].to;
-            job.t_desc += args[t].td;
-        }
-        free(args);
-        free(tids);
-        pthread_mutex_destroy(&job.lock);
-        if (job.err.code != GP_OK) {
-            st = job.err.code;
-            if (err)
-                *err = job.err;
-            goto fail;
-        }
-        /* CPU seconds summed over threads, scaled to wall time by the thread count */
-        out->t_fill = job.t_fill / nthreads;
-        out->t_odec = job.t_odec / nthreads;
-        out->t_descriptors = job.t_desc / nthreads;
-
-        /* ---- statistics of the grains */
-        double solid = 0.0, gap = 0.0;
-        size_t met = 0;
-        for (size_t i = 0; i < n; i++) {
-            const gp_grain2d *g = &out->grains[i];
-            solid += g->area;
-            met += g->target_met != 0;
-            double d = fmod(fabs(g->orientation_deg - gp_voronoi_cell_orientation(vor, i) * DEG),
-                            180.0);
-            gap += d > 90.0 ? 180.0 - d : d;
-        }
-        out->solid_fraction = solid / out->container_area;
-        out->cells_target_met = met;
-        out->mean_orientation_gap_deg = n ? gap / (double)n : 0.0;
-        /* grain sizes on the cell classes scaled by the target fraction */
-        if (hist_copy(&out->grain_size_hist, &out->size_hist, spec->solid_fraction) != 0) {
-            st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        double *v = malloc(n * sizeof *v);
-        if (!v) {
-            st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        for (size_t i = 0; i < n; i++)
-            v[i] = out->grains[i].area;
-        hist_fill(&out->grain_size_hist, v, n);
-        /* the grains' orientations on the IMC's classes, against the same cosine law */
-        if (hist_copy(&out->grain_orientation_hist, &out->orientation_hist, 1.0) != 0) {
-            free(v);
-            st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        for (size_t i = 0; i < n; i++)
-            v[i] = out->grains[i].orientation_deg >= 90.0 ? out->grains[i].orientation_deg - 180.0
-                                                          : out->grains[i].orientation_deg;
-        hist_fill(&out->grain_orientation_hist, v, n);
-        free(v);
-        if (spec->outputs & GP_OUT_DESCRIPTORS) {
-            st = descriptor_stats(out, err);
-            if (st != GP_OK)
-                goto fail;
-        }
-    }
-
-    for (size_t i = 0; job.cell_poly && i < n; i++)
-        free(job.cell_poly[i]);
-    free(job.cell_poly);
-    free(job.cell_n);
-    free(D);
-    gp_voronoi_destroy(vor);
-    container_free(&cont);
-    out->t_total = now_s() - t_start;
+    b.out->t_total = now_s() - t_start;
     if (progress) {
-        gp_progress p = {"done", 1.0, out->imc_steps, out->imc_error};
+        gp_progress p = {"done", 1.0, b.out->imc_steps, b.out->imc_error};
         progress(user, &p);
     }
-    *outp = out;
+    *outp = b.out;
     return GP_OK;
-
-fail:
-    if (job.cell_poly) {
-        for (size_t i = 0; i < out->ngrains; i++)
-            free(job.cell_poly[i]);
-    }
-    free(job.cell_poly);
-    free(job.cell_n);
-    free(D);
-    gp_voronoi_destroy(vor);
-    container_free(&cont);
-    gp_specimen2d_destroy(out);
-    return st;
 }
 
 void gp_specimen2d_destroy(gp_specimen2d *s)
@@ -782,5 +1130,11 @@ void gp_specimen2d_destroy(gp_specimen2d *s)
     hist_free(&s->grain_orientation_hist);
     for (int d = 0; d < 4; d++)
         hist_free(&s->descriptor_hist[d]);
+    gp_fit_area_free(&s->fit.cell_area);
+    gp_fit_area_free(&s->fit.grain_area);
+    gp_fit_passing_free(&s->fit.passing);
+    for (size_t i = 0; i < s->nwarnings; i++)
+        free(s->warnings[i]);
+    free(s->warnings);
     free(s);
 }

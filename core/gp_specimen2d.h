@@ -4,6 +4,31 @@
  * tessellation -> IMC -> filling -> ODEC -> descriptors. It computes only the outputs the spec
  * lists (model only what a scene needs). The schema/ parser fills gp_spec2d from JSON; the
  * service calls gp_specimen2d_build() on a worker thread and serialises the result.
+ *
+ * Size laws (api.md "2D size laws", gp_law.h). With size.of = "cells" (the paper) the IMC
+ * shapes the cells to the law and every grain is filled to solid_fraction of its cell, so the
+ * grains follow the law scaled by solid_fraction where the fill reaches it (the paper's §5
+ * warns that grains that cannot be filled shift the grain sizes left; the fit report shows by
+ * how much). With size.of = "grains", and always for a sieve curve (which is a law of grains),
+ * the grains themselves follow the law:
+ *   1. the cells follow the grain law scaled to the cells' mean (container area / N), so that
+ *      a cell filled to solid_fraction holds a grain of about the right size;
+ *   2. pass A fills every cell up to solid_fraction x 1.2 (GRAIN_LAW_HEADROOM), giving each
+ *      cell the largest grain it can hold up to that;
+ *   3. rank matching: the k-th smallest of those grains is given the k-th smallest of the
+ *      grain law's N quantiles at (2k - 1) / 2N, and shrunk about its centre to that area
+ *      (every contour point moves along its own ray, so it stays in its cell, and shape and
+ *      orientation are kept). Sorted matching is the assignment that asks least of every
+ *      cell; a grain that cannot reach its quantile keeps its largest size;
+ *   4. pass B builds ODEC and descriptors on the final grains.
+ * The number of grains of a sieve law follows from the container: N = round(solid_fraction x
+ * area / mean grain area of the law) (gp_spec2d_cell_count).
+ *
+ * Fit and warnings. Every result carries stats.fit (gp_fit.h), measured on the cells and
+ * grains themselves, and a list of warnings: each target not reached (IMC threshold, a KS
+ * distance above its 5 % critical value, a sieve missed by more than 3 points, a solid
+ * fraction more than 2 % short), with how close it came. A run that stops short is a valid
+ * specimen that says so, never a failed job.
  */
 #ifndef GP_SPECIMEN2D_H
 #define GP_SPECIMEN2D_H
@@ -13,6 +38,8 @@
 
 #include "gp_error.h"
 #include "gp_geom.h"
+#include "gp_fit.h"
+#include "gp_law.h"
 
 /* outputs (bit flags) */
 enum {
@@ -23,7 +50,9 @@ enum {
 };
 
 typedef enum { GP_CONTAINER_POLYGON = 0, GP_CONTAINER_CIRCLE = 1 } gp_container_kind;
-typedef enum { GP_IMC_E1 = 1, GP_IMC_E2 = 2, GP_IMC_E3 = 3 } gp_imc_error_kind;
+/* GP_IMC_AD: the Anderson-Darling objective on the whole laws (the default, gp_imc.h); E1-E3:
+ * the paper's histogram errors (Eqs. 16-18), kept to reproduce it. */
+typedef enum { GP_IMC_E1 = 1, GP_IMC_E2 = 2, GP_IMC_E3 = 3, GP_IMC_AD = 4 } gp_imc_error_kind;
 typedef enum { GP_INIT_UNIFORM = 0, GP_INIT_HALTON = 1 } gp_init_kind;
 
 typedef struct gp_ring {
@@ -41,8 +70,14 @@ typedef struct gp_spec2d {
     size_t nholes;
     gp_vec2 circle_center;      /* container.circle */
     double circle_radius;
-    size_t particles;
-    double cov;                 /* size.cov */
+    size_t particles;           /* 0 with a sieve law: derived (gp_spec2d_cell_count) */
+    gp_law_kind size_law;       /* size.law */
+    double cov;                 /* size.cov (parametric laws) */
+    const double *sieve_d;      /* size.sieve diameters, in container length units (the parser
+                                 * converts from size.sieve_units) */
+    const double *sieve_pass;   /* size.sieve percent passing by mass */
+    size_t nsieve;
+    int size_of_grains;         /* size.of: 0 "cells" (the paper), 1 "grains" */
     double mean_deg;            /* orientation.mean_deg */
     double anisotropy;          /* orientation.anisotropy (min/max ratio, in (0, 1]) */
     int has_spectrum;           /* shape.spectrum given in full */
@@ -60,10 +95,24 @@ typedef struct gp_spec2d {
     int threads;                /* worker threads for filling; 0 = 1 */
 } gp_spec2d;
 
-/* Fills a spec with the API defaults (unit square, 100 particles, cov 0.5, isotropic, D2 0.1,
- * D3 0.05, D8 0.02, alpha = beta = -2, F_S 0.65, E3 0.002, 1e6 steps, uniform, 128 points,
- * outputs grains). */
+/* Fills a spec with the API defaults (unit square, 100 particles, lognormal cov 0.5 on cells,
+ * isotropic, D2 0.1, D3 0.05, D8 0.02, alpha = beta = -2, F_S 0.65, AD with its default
+ * threshold (gp_imc_default_threshold), 1e6 steps, uniform, 128 points, outputs grains). */
 void gp_spec2d_defaults(gp_spec2d *spec);
+
+/* The container's area (polygon minus holes, or the circle's polygon as the tessellation uses
+ * it) and the number of cells the spec asks for: `particles`, or for a sieve law
+ * round(solid_fraction * area / mean grain area), at least 1. Fails (GP_ERR_INVALID with a
+ * message) on a bad container or law. Cheap: the service calls it at submit. */
+gp_status gp_spec2d_cell_count(const gp_spec2d *spec, double *area, size_t *count,
+                               gp_error *err);
+
+/* The laws a spec asks for, both by number of grains/cells: `cells` is the law of the cell
+ * areas the IMC aims at, `grains` the law of the grain areas (the cell law scaled by
+ * solid_fraction, or the law as given with size.of = "grains" or a sieve). Caller destroys
+ * both. */
+gp_status gp_spec2d_laws(const gp_spec2d *spec, gp_law **cells, gp_law **grains,
+                         gp_error *err);
 
 /* A histogram: nclasses classes [edges[k], edges[k+1]), target and achieved normalised by the
  * number of items (so each sums to ~1). */
@@ -73,6 +122,13 @@ typedef struct gp_hist {
     double *target;             /* nclasses, NULL where there is no target */
     double *achieved;           /* nclasses */
 } gp_hist;
+
+/* the parts (gp_fit_area, gp_fit_orient, gp_fit_passing) are declared in gp_fit.h */
+typedef struct gp_fit2d {
+    gp_fit_area cell_area, grain_area;
+    gp_fit_orient cell_orientation, grain_orientation;
+    gp_fit_passing passing;
+} gp_fit2d;
 
 typedef struct gp_descriptors {
     double elongation, roundness, circularity, regularity;
@@ -109,7 +165,15 @@ typedef struct gp_specimen2d {
     double imc_error;
     long imc_steps;
     const char *imc_stop_reason;/* static string: "threshold", "max_steps", "floor", ... */
-    double imc_error_floor;     /* the integer-count floor of the chosen classes (NOTES.md) */
+    double imc_error_floor;     /* E1-E3: the integer-count floor of the chosen classes (NOTES.md);
+                                 * AD: 0 (the error is the excess over N's least A^2) */
+    double imc_threshold;       /* the threshold used */
+    const char *imc_error_kind; /* "AD", "E1", "E2", "E3" */
+    gp_fit2d fit;               /* measured on the cells and grains themselves */
+    char **warnings;            /* nwarnings one-line messages: a target not reached, and how
+                                 * close it came (IMC threshold, fit beyond its KS critical
+                                 * value, cells short of solid_fraction) */
+    size_t nwarnings;
     double solid_fraction;      /* total grain area / container area */
     size_t cells_target_met;
     double mean_orientation_gap_deg; /* mean |theta_grain - theta_cell| (pi-periodic) */

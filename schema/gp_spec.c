@@ -2,6 +2,8 @@
  * the parsers from JSON to the core's spec structs. See gp_spec.h. */
 #include "gp_spec.h"
 
+#include "gp_imc.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -623,19 +625,86 @@ static json_t *with_defaults_k(const json_t *spec, int k)
 
 static int semantic_2d(const json_t *full, gp_spec_problem *p);
 static int semantic_3d(const json_t *full, gp_spec_problem *p);
+static int no_memory(gp_spec_problem *p);
+static int str_is(const json_t *o, const char *key, const char *value);
+static gp_imc_error_kind error_kind_of(const json_t *imc);
+
+/* 2D: size.law decides which size fields belong; checked on the spec as posted, since
+ * particles and size.cov have schema defaults. 0 or -1 with *p (422) */
+static int check_size_fields_2d(const json_t *spec, gp_spec_problem *p)
+{
+    const json_t *size = json_object_get(spec, "size");
+    const char *law = json_string_value(json_object_get(size, "law"));
+    if (!law || strcmp(law, "sieve") != 0) {
+        const char *f = json_object_get(size, "sieve")         ? "sieve"
+                        : json_object_get(size, "sieve_units") ? "sieve_units" : NULL;
+        if (!f) return 0;
+        char ptr[32];
+        snprintf(ptr, sizeof ptr, "/size/%s", f);
+        set_problem(p, 422, ptr, "only allowed with law \"sieve\" (the law here is \"%s\"); "
+                    "add \"law\": \"sieve\" or leave %s out", law ? law : "lognormal", f);
+        return -1;
+    }
+    if (json_object_get(spec, "particles"))
+        set_problem(p, 422, "/particles", "leave particles out with size.law \"sieve\": the "
+                    "number of grains follows from the container area and solid_fraction");
+    else if (json_object_get(size, "cov"))
+        set_problem(p, 422, "/size/cov", "not allowed with law \"sieve\": the sieve curve sets "
+                    "the spread of sizes; leave cov out");
+    else if (!json_object_get(size, "sieve"))
+        set_problem(p, 422, "/size/sieve", "required with law \"sieve\": expected rows "
+                    "[diameter, percent passing by mass]");
+    else if (str_is(size, "of", "cells"))
+        set_problem(p, 422, "/size/of", "expected \"grains\" (or nothing) with law \"sieve\", "
+                    "got \"cells\": a sieve curve is a law of the grains");
+    else
+        return 0;
+    return -1;
+}
+
+/* 2D defaults that depend on other fields: a sieve law has no particles (derived) and no cov,
+ * and is a law of the grains; sieve_units belongs to a sieve; the threshold follows
+ * imc.error. 0, or -1 out of memory */
+static int settle_defaults_2d(json_t *full)
+{
+    json_t *size = json_object_get(full, "size");
+    int rc = 0;
+    if (str_is(size, "law", "sieve")) {
+        json_object_del(full, "particles");
+        json_object_del(size, "cov");
+        rc |= json_object_set_new(size, "of", json_string("grains"));
+    } else {
+        json_object_del(size, "sieve_units");
+    }
+    json_t *imc = json_object_get(full, "imc");
+    if (!json_object_get(imc, "threshold"))
+        rc |= json_object_set_new(imc, "threshold",
+                                  json_real(gp_imc_default_threshold((int)error_kind_of(imc))));
+    return rc ? -1 : 0;
+}
+
+/* the schema, the 2D field rules, then every default; *k the kind. NULL with *p filled */
+static json_t *effective(const json_t *spec, int *k, gp_spec_problem *p)
+{
+    *k = schema_validate(spec, p);
+    if (*k < 0 || (*k == 0 && check_size_fields_2d(spec, p))) return NULL;
+    json_t *full = with_defaults_k(spec, *k);
+    if (!full || (*k == 0 && settle_defaults_2d(full))) {
+        json_decref(full);
+        no_memory(p);
+        return NULL;
+    }
+    return full;
+}
 
 json_t *gp_spec_with_defaults(const json_t *spec, gp_spec_problem *p)
 {
     gp_spec_problem local;
     if (!p) p = &local;
     clear_problem(p);
-    int k = schema_validate(spec, p);
-    if (k < 0) return NULL;
-    json_t *full = with_defaults_k(spec, k);
-    if (!full) {
-        set_problem(p, 500, "", "out of memory");
-        return NULL;
-    }
+    int k;
+    json_t *full = effective(spec, &k, p);
+    if (!full) return NULL;
     int rc = k == 0 ? semantic_2d(full, p) : semantic_3d(full, p);
     if (rc) {
         json_decref(full);
@@ -850,6 +919,55 @@ static int check_rings(const gp_ring *rings, size_t nr, gp_spec_problem *p)
 }
 
 /* ------------------------------------------------------------------------------------------ */
+/* sieve curves (3D sieve, 2D size.sieve) */
+
+/* rows [d, percent passing] of a schema-valid sieve at pointer base: d strictly increasing,
+ * passing non-decreasing from 0 (first row) to 100 (last row); 0 or -1 with *p (422) */
+static int check_sieve_rows(const json_t *sieve, const char *base, gp_spec_problem *p)
+{
+    size_t n = json_array_size(sieve);
+    char ptr[96];
+    double prev_d = 0, prev_q = 0;
+    for (size_t i = 0; i < n; i++) {
+        const json_t *row = json_array_get(sieve, i);
+        double d = json_number_value(json_array_get(row, 0));
+        double q = json_number_value(json_array_get(row, 1));
+        if (i > 0 && !(d > prev_d)) {
+            snprintf(ptr, sizeof ptr, "%s/%zu/0", base, i);
+            set_problem(p, 422, ptr,
+                        "sieve diameters must increase strictly: %.15g follows %.15g", d, prev_d);
+            return -1;
+        }
+        if (i > 0 && q < prev_q) {
+            snprintf(ptr, sizeof ptr, "%s/%zu/1", base, i);
+            set_problem(p, 422, ptr,
+                        "percent passing must not decrease: %.15g follows %.15g", q, prev_q);
+            return -1;
+        }
+        if (i == 0 && q != 0) {
+            snprintf(ptr, sizeof ptr, "%s/0/1", base);
+            set_problem(p, 422, ptr,
+                        "the first sieve row must pass 0 %% (the smallest grain), got %.15g", q);
+            return -1;
+        }
+        prev_d = d;
+        prev_q = q;
+    }
+    if (n && prev_q != 100) {
+        snprintf(ptr, sizeof ptr, "%s/%zu/1", base, n - 1);
+        set_problem(p, 422, ptr, "the last sieve row must pass 100 %%, got %.15g", prev_q);
+        return -1;
+    }
+    return 0;
+}
+
+/* metres per sieve unit ("mm" or "m") */
+static double sieve_scale(const char *units)
+{
+    return units && !strcmp(units, "m") ? 1.0 : 1e-3;
+}
+
+/* ------------------------------------------------------------------------------------------ */
 /* 2D parser */
 
 static double num(const json_t *o, const char *key)
@@ -882,118 +1000,334 @@ void gp_spec_2d_free(gp_spec2d *s)
     for (size_t i = 0; i < s->nholes; i++) free(s->holes[i].pts);
     free(s->holes);
     free((double *)s->spectrum);
+    free((double *)s->sieve_d);
+    free((double *)s->sieve_pass);
     memset(s, 0, sizeof *s);
 }
 
-/* fills out from a valid spec with defaults applied; semantic checks; 0 / -1 */
-static int parse_2d_full(const json_t *full, gp_spec2d *out, gp_spec_problem *p)
+static int no_memory(gp_spec_problem *p)
 {
-    memset(out, 0, sizeof *out);
-    out->seed = (uint64_t)json_number_value(json_object_get(full, "seed"));
-    const json_t *cont = json_object_get(full, "container");
-    const json_t *circle = json_object_get(cont, "circle");
-    if (circle) {
-        out->container = GP_CONTAINER_CIRCLE;
-        const json_t *c = json_object_get(circle, "center");
-        out->circle_center.x = json_number_value(json_array_get(c, 0));
-        out->circle_center.y = json_number_value(json_array_get(c, 1));
-        out->circle_radius = num(circle, "radius");
-        double s = fmax(fabs(out->circle_center.x), fabs(out->circle_center.y));
-        if (!(out->circle_radius > 1e-12 * s)) {
-            set_problem(p, 422, "/container/circle/radius",
-                        "the radius is too small next to the centre's coordinates");
-            return -1;
-        }
-    } else {
-        out->container = GP_CONTAINER_POLYGON;
-        const json_t *holes = json_object_get(cont, "holes");
-        size_t nh = json_array_size(holes);
-        gp_ring *rings = calloc(nh + 1, sizeof *rings);
-        if (!rings) goto nomem;
-        int bad = read_ring(json_object_get(cont, "polygon"), &rings[0]);
-        for (size_t i = 0; i < nh && !bad; i++) bad = read_ring(json_array_get(holes, i), &rings[i + 1]);
-        out->outer = rings[0];
-        if (nh) {
-            out->holes = malloc(nh * sizeof *out->holes);
-            if (out->holes) {
-                memcpy(out->holes, rings + 1, nh * sizeof *rings);
-                out->nholes = nh;
-            } else {
-                for (size_t i = 1; i <= nh; i++) free(rings[i].pts);
-                bad = 1;
-            }
-        }
-        free(rings);
-        if (bad) goto nomem;
-        /* check_rings wants one array: outer then holes */
-        gp_ring *all = malloc((nh + 1) * sizeof *all);
-        if (!all) goto nomem;
-        all[0] = out->outer;
-        if (nh) memcpy(all + 1, out->holes, nh * sizeof *all);
-        int rc = check_rings(all, nh + 1, p);
-        free(all);
-        if (rc == -2) goto nomem;
-        if (rc) return -1;
+    set_problem(p, 500, "", "out of memory");
+    return -1;
+}
+
+/* o[key] is the string value */
+static int str_is(const json_t *o, const char *key, const char *value)
+{
+    const char *s = json_string_value(json_object_get(o, key));
+    return s && !strcmp(s, value);
+}
+
+static int parse_circle_2d(const json_t *circle, gp_spec2d *out, gp_spec_problem *p)
+{
+    out->container = GP_CONTAINER_CIRCLE;
+    const json_t *c = json_object_get(circle, "center");
+    out->circle_center.x = json_number_value(json_array_get(c, 0));
+    out->circle_center.y = json_number_value(json_array_get(c, 1));
+    out->circle_radius = num(circle, "radius");
+    double s = fmax(fabs(out->circle_center.x), fabs(out->circle_center.y));
+    if (!(out->circle_radius > 1e-12 * s)) {
+        set_problem(p, 422, "/container/circle/radius",
+                    "the radius is too small next to the centre's coordinates");
+        return -1;
     }
-    out->particles = (size_t)json_number_value(json_object_get(full, "particles"));
-    out->cov = num(json_object_get(full, "size"), "cov");
-    const json_t *ori = json_object_get(full, "orientation");
-    out->mean_deg = num(ori, "mean_deg");
-    out->anisotropy = num(ori, "anisotropy");
-    const json_t *shape = json_object_get(full, "shape");
-    out->contour_points = (size_t)json_number_value(json_object_get(full, "contour_points"));
-    const json_t *spec = json_object_get(shape, "spectrum");
-    if (spec) {
-        size_t n = json_array_size(spec);
-        if (n > out->contour_points / 2) {
-            set_problem(p, 422, "/shape/spectrum",
-                        "%zu amplitudes are too many for contour_points = %zu (at most %zu)", n,
-                        out->contour_points, out->contour_points / 2);
-            return -1;
+    return 0;
+}
+
+/* container: a circle, or a polygon with its holes (simple, holes inside and apart) */
+static int parse_container_2d(const json_t *cont, gp_spec2d *out, gp_spec_problem *p)
+{
+    const json_t *circle = json_object_get(cont, "circle");
+    if (circle) return parse_circle_2d(circle, out, p);
+    out->container = GP_CONTAINER_POLYGON;
+    const json_t *holes = json_object_get(cont, "holes");
+    size_t nh = json_array_size(holes);
+    gp_ring *rings = calloc(nh + 1, sizeof *rings);
+    if (!rings) return no_memory(p);
+    int bad = read_ring(json_object_get(cont, "polygon"), &rings[0]);
+    for (size_t i = 0; i < nh && !bad; i++) bad = read_ring(json_array_get(holes, i), &rings[i + 1]);
+    out->outer = rings[0];
+    if (nh) {
+        out->holes = malloc(nh * sizeof *out->holes);
+        if (out->holes) {
+            memcpy(out->holes, rings + 1, nh * sizeof *rings);
+            out->nholes = nh;
+        } else {
+            for (size_t i = 1; i <= nh; i++) free(rings[i].pts);
+            bad = 1;
         }
-        double *d = malloc(n * sizeof *d);
-        if (!d) goto nomem;
-        for (size_t i = 0; i < n; i++) d[i] = json_number_value(json_array_get(spec, i));
-        out->has_spectrum = 1;
-        out->spectrum = d;
-        out->nspectrum = n;
-        /* D2, D3, D8 are still meaningful for reporting: take them from the spectrum */
-        out->D2 = n > 2 ? d[2] / d[0] : 0;
-        out->D3 = n > 3 ? d[3] / d[0] : 0;
-        out->D8 = n > 8 ? d[8] / d[0] : 0;
-        out->alpha = out->beta = -2;
-    } else {
+    }
+    if (!bad) {
+        /* check_rings wants one array: outer then holes, as rings is */
+        int rc = check_rings(rings, nh + 1, p);
+        free(rings);
+        return rc == -2 ? no_memory(p) : rc;
+    }
+    free(rings);
+    return no_memory(p);
+}
+
+/* index = gp_law_kind */
+static const char *const g_laws[] = {"lognormal", "normal", "uniform", "sieve"};
+
+static gp_law_kind law_of(const json_t *size)
+{
+    for (int k = 0; k < 4; k++)
+        if (str_is(size, "law", g_laws[k])) return (gp_law_kind)k;
+    return GP_LAW_LOGNORMAL;
+}
+
+/* size.cov of a parametric law: GP_LAW_COV_MIN and each law's own maximum (gp_law.h) */
+static int check_cov(gp_law_kind law, double cov, gp_spec_problem *p)
+{
+    if (cov < GP_LAW_COV_MIN) {
+        set_problem(p, 422, "/size/cov",
+                    "expected at least %g, got %.15g: equal sizes cannot be tessellated exactly; "
+                    "use %g for nearly equal sizes", GP_LAW_COV_MIN, cov, GP_LAW_COV_MIN);
+        return -1;
+    }
+    if (law == GP_LAW_NORMAL && cov > GP_LAW_NORMAL_COV_MAX) {
+        set_problem(p, 422, "/size/cov",
+                    "expected at most %g for law \"normal\", got %.15g (a wider normal law is "
+                    "mostly cut off at area 0); use law \"lognormal\" for a wider spread",
+                    GP_LAW_NORMAL_COV_MAX, cov);
+        return -1;
+    }
+    if (law == GP_LAW_UNIFORM && cov > GP_LAW_UNIFORM_COV_MAX) {
+        set_problem(p, 422, "/size/cov",
+                    "expected at most 0.5773 (1/√3) for law \"uniform\", got %.15g (its least "
+                    "area, mean (1 - √3 cov), would be negative)", cov);
+        return -1;
+    }
+    return 0;
+}
+
+/* size.sieve as two arrays owned by out, diameters converted to metres */
+static int parse_sieve_2d(const json_t *size, gp_spec2d *out, gp_spec_problem *p)
+{
+    const json_t *sieve = json_object_get(size, "sieve");
+    if (check_sieve_rows(sieve, "/size/sieve", p)) return -1;
+    size_t n = json_array_size(sieve);
+    double scale = sieve_scale(json_string_value(json_object_get(size, "sieve_units")));
+    double *d = malloc(n * sizeof *d), *pw = malloc(n * sizeof *pw);
+    out->sieve_d = d;
+    out->sieve_pass = pw;
+    if (!d || !pw) return no_memory(p);
+    for (size_t i = 0; i < n; i++) {
+        const json_t *row = json_array_get(sieve, i);
+        d[i] = json_number_value(json_array_get(row, 0)) * scale;
+        pw[i] = json_number_value(json_array_get(row, 1));
+    }
+    out->nsieve = n;
+    return 0;
+}
+
+static int parse_size_2d(const json_t *size, gp_spec2d *out, gp_spec_problem *p)
+{
+    out->size_law = law_of(size);
+    out->size_of_grains = str_is(size, "of", "grains");
+    if (out->size_law == GP_LAW_SIEVE) return parse_sieve_2d(size, out, p);
+    out->cov = num(size, "cov");
+    return check_cov(out->size_law, out->cov, p);
+}
+
+static int parse_shape_2d(const json_t *shape, gp_spec2d *out, gp_spec_problem *p)
+{
+    const json_t *spec = json_object_get(shape, "spectrum");
+    if (!spec) {
         out->D2 = num(shape, "D2");
         out->D3 = num(shape, "D3");
         out->D8 = num(shape, "D8");
         out->alpha = num(shape, "alpha");
         out->beta = num(shape, "beta");
+        return 0;
     }
-    out->solid_fraction = num(full, "solid_fraction");
-    const json_t *imc = json_object_get(full, "imc");
-    const char *err = json_string_value(json_object_get(imc, "error"));
-    out->imc_error = !strcmp(err, "E1") ? GP_IMC_E1 : !strcmp(err, "E2") ? GP_IMC_E2 : GP_IMC_E3;
-    out->imc_threshold = num(imc, "threshold");
+    size_t n = json_array_size(spec);
+    if (n > out->contour_points / 2) {
+        set_problem(p, 422, "/shape/spectrum",
+                    "%zu amplitudes are too many for contour_points = %zu (at most %zu)", n,
+                    out->contour_points, out->contour_points / 2);
+        return -1;
+    }
+    double *d = malloc(n * sizeof *d);
+    if (!d) return no_memory(p);
+    for (size_t i = 0; i < n; i++) d[i] = json_number_value(json_array_get(spec, i));
+    out->has_spectrum = 1;
+    out->spectrum = d;
+    out->nspectrum = n;
+    /* D2, D3, D8 are still meaningful for reporting: take them from the spectrum */
+    out->D2 = n > 2 ? d[2] / d[0] : 0;
+    out->D3 = n > 3 ? d[3] / d[0] : 0;
+    out->D8 = n > 8 ? d[8] / d[0] : 0;
+    out->alpha = out->beta = -2;
+    return 0;
+}
+
+static gp_imc_error_kind error_kind_of(const json_t *imc)
+{
+    if (str_is(imc, "error", "E1")) return GP_IMC_E1;
+    if (str_is(imc, "error", "E2")) return GP_IMC_E2;
+    if (str_is(imc, "error", "E3")) return GP_IMC_E3;
+    return GP_IMC_AD;
+}
+
+static void parse_imc_2d(const json_t *imc, gp_spec2d *out)
+{
+    out->imc_error = error_kind_of(imc);
+    const json_t *t = json_object_get(imc, "threshold");
+    out->imc_threshold = t ? json_number_value(t) : gp_imc_default_threshold((int)out->imc_error);
     out->imc_max_steps = (long)num(imc, "max_steps");
-    out->imc_init = !strcmp(json_string_value(json_object_get(imc, "init")), "halton")
-                        ? GP_INIT_HALTON : GP_INIT_UNIFORM;
+    out->imc_init = str_is(imc, "init", "halton") ? GP_INIT_HALTON : GP_INIT_UNIFORM;
     const json_t *cl = json_object_get(imc, "classes");
     out->imc_classes = cl ? (int)json_number_value(cl) : 0;
-    out->outputs = 0;
+}
+
+static unsigned parse_outputs_2d(const json_t *outputs)
+{
+    unsigned bits = 0;
     size_t i;
     const json_t *o;
-    json_array_foreach(json_object_get(full, "outputs"), i, o) {
+    json_array_foreach(outputs, i, o) {
         const char *s = json_string_value(o);
-        if (!strcmp(s, "grains")) out->outputs |= GP_OUT_GRAINS;
-        else if (!strcmp(s, "odec")) out->outputs |= GP_OUT_ODEC;
-        else if (!strcmp(s, "descriptors")) out->outputs |= GP_OUT_DESCRIPTORS;
-        else if (!strcmp(s, "cells")) out->outputs |= GP_OUT_CELLS;
+        if (!strcmp(s, "grains")) bits |= GP_OUT_GRAINS;
+        else if (!strcmp(s, "odec")) bits |= GP_OUT_ODEC;
+        else if (!strcmp(s, "descriptors")) bits |= GP_OUT_DESCRIPTORS;
+        else if (!strcmp(s, "cells")) bits |= GP_OUT_CELLS;
     }
-    out->threads = 0;
-    return 0;
-nomem:
-    set_problem(p, 500, "", "out of memory");
+    return bits;
+}
+
+/* the schema's particles maximum: the bound of a derived cell count too */
+static double max_particles(void)
+{
+    const json_t *props = json_object_get(schema_of(0), "properties");
+    double m = 1e6;
+    get_num(json_object_get(props, "particles"), "maximum", &m);
+    return m;
+}
+
+/* 422 too_large at /size/sieve: the count ("what") beyond the bound of particles; -1 */
+static int too_many(const gp_spec2d *s, double area, gp_spec_problem *p, const char *what)
+{
+    set_problem(p, 422, "/size/sieve",
+                "%s in the container (area %.6g m², solid_fraction %g), over the limit of %.0f "
+                "(the most particles allows); check sieve_units or use a smaller container",
+                what, area, s->solid_fraction, max_particles());
+    snprintf(p->code, sizeof p->code, "too_large");
     return -1;
+}
+
+/* a sieve law: its largest grain's cell fits in the container, and the derived count is
+ * within particles' bound (422 too_large) */
+static int check_sieve_count(const gp_spec2d *s, double area, size_t n, gp_spec_problem *p)
+{
+    double dmax = s->sieve_d[s->nsieve - 1];
+    double cell = M_PI / 4 * dmax * dmax / s->solid_fraction;
+    if (cell > area) {
+        char ptr[64];
+        snprintf(ptr, sizeof ptr, "/size/sieve/%zu/0", s->nsieve - 1);
+        set_problem(p, 422, ptr,
+                    "a grain of the largest sieve diameter (%.6g m) needs a cell of %.6g m² at "
+                    "solid_fraction %g, more than the container's area %.6g m²; check "
+                    "sieve_units", dmax, cell, s->solid_fraction, area);
+        return -1;
+    }
+    if ((double)n <= max_particles()) return 0;
+    char count[64];
+    snprintf(count, sizeof count, "this sieve curve makes about %zu grains", n);
+    return too_many(s, area, p, count);
+}
+
+/* the number of cells: particles, or derived from the container and a sieve law */
+static int cell_count_2d(const gp_spec2d *s, size_t *n, gp_spec_problem *p)
+{
+    double area = 0;
+    gp_error err;
+    memset(&err, 0, sizeof err);
+    if (gp_spec2d_cell_count(s, &area, n, &err) != GP_OK) {
+        if (err.code == GP_ERR_NOMEM) return no_memory(p);
+        int sieve = s->size_law == GP_LAW_SIEVE;
+        set_problem(p, 422, sieve ? "/size/sieve" : "/container", "%s", err.message);
+        /* the rows are checked and the container has an area: the count is out of reach */
+        if (sieve && area > 0) too_many(s, area, p, err.message);
+        return -1;
+    }
+    return s->size_law == GP_LAW_SIEVE ? check_sieve_count(s, area, *n, p) : 0;
+}
+
+/* v rounded up, as short text that reads back >= v (v > 0) */
+static void fmt_up(char *buf, size_t n, double v)
+{
+    for (int digits = 3; digits <= 17; digits++) {
+        double e = pow(10, floor(log10(v)) - (digits - 1));
+        snprintf(buf, n, "%.*g", digits, ceil(v / e) * e);
+        if (strtod(buf, NULL) >= v) return;
+    }
+}
+
+/* a short threshold >= least that clears the floor of the classes it picks itself (automatic
+ * classes follow the threshold) */
+static void suggest_threshold(gp_imc_params *q, size_t n, double least, char *use, size_t len)
+{
+    double v = least;
+    for (int i = 0; i < 8; i++) {
+        fmt_up(use, len, v);
+        q->threshold = strtod(use, NULL);
+        double r = gp_imc_reachable_threshold(q, n);
+        if (r <= q->threshold) return;
+        v = r;
+    }
+}
+
+/* E1-E3: the threshold must clear the integer-count floor of n cells (gp_imc.h) */
+static int check_threshold_2d(const gp_spec2d *s, size_t n, gp_spec_problem *p)
+{
+    if (s->imc_error == GP_IMC_AD) return 0;
+    gp_imc_params q;
+    gp_imc_params_default(&q);
+    q.error_kind = (int)s->imc_error;
+    q.threshold = s->imc_threshold;
+    q.classes_size = q.classes_orient = s->imc_classes;
+    if (s->size_law != GP_LAW_SIEVE) q.cov = s->cov;
+    q.mean_deg = s->mean_deg;
+    q.anisotropy = s->anisotropy;
+    double least = gp_imc_reachable_threshold(&q, n);
+    if (!(s->imc_threshold < least)) return 0;
+    char use[40], classes[80];
+    suggest_threshold(&q, n, least, use, sizeof use);
+    if (s->imc_classes)
+        snprintf(classes, sizeof classes, "%d size x %d orientation classes", s->imc_classes,
+                 s->imc_classes);
+    else snprintf(classes, sizeof classes, "its automatic histogram classes");
+    set_problem(p, 422, "/imc/threshold",
+                "%.6g is below the least error %.4g that %zu cells can reach with E%d and %s "
+                "(integer counts); use >= %s%s or the default error AD", s->imc_threshold, least,
+                n, (int)s->imc_error, classes, use, s->imc_classes ? ", fewer imc.classes" : "");
+    return -1;
+}
+
+/* fills out from a valid spec with defaults applied (settle_defaults_2d); semantic checks;
+ * 0 / -1 */
+static int parse_2d_full(const json_t *full, gp_spec2d *out, gp_spec_problem *p)
+{
+    memset(out, 0, sizeof *out);
+    out->seed = (uint64_t)json_number_value(json_object_get(full, "seed"));
+    out->particles = (size_t)json_number_value(json_object_get(full, "particles"));
+    const json_t *ori = json_object_get(full, "orientation");
+    out->mean_deg = num(ori, "mean_deg");
+    out->anisotropy = num(ori, "anisotropy");
+    out->contour_points = (size_t)json_number_value(json_object_get(full, "contour_points"));
+    out->solid_fraction = num(full, "solid_fraction");
+    parse_imc_2d(json_object_get(full, "imc"), out);
+    out->outputs = parse_outputs_2d(json_object_get(full, "outputs"));
+    out->threads = 0;
+    if (parse_container_2d(json_object_get(full, "container"), out, p) ||
+        parse_size_2d(json_object_get(full, "size"), out, p) ||
+        parse_shape_2d(json_object_get(full, "shape"), out, p))
+        return -1;
+    size_t n = 0;
+    if (cell_count_2d(out, &n, p)) return -1;
+    return check_threshold_2d(out, n, p);
 }
 
 static int semantic_2d(const json_t *full, gp_spec_problem *p)
@@ -1010,18 +1344,14 @@ int gp_spec_parse_2d(const json_t *spec, gp_spec2d *out, gp_spec_problem *p)
     if (!p) p = &local;
     clear_problem(p);
     memset(out, 0, sizeof *out);
-    int k = schema_validate(spec, p);
-    if (k < 0) return -1;
-    if (k != 0) {
+    int k;
+    json_t *full = effective(spec, &k, p);
+    if (!full) return -1;
+    int rc = -1;
+    if (k != 0)
         set_problem(p, 400, "/kind", "expected \"%s\" here, got \"%s\"", g_kinds[0], g_kinds[k]);
-        return -1;
-    }
-    json_t *full = with_defaults_k(spec, k);
-    if (!full) {
-        set_problem(p, 500, "", "out of memory");
-        return -1;
-    }
-    int rc = parse_2d_full(full, out, p);
+    else
+        rc = parse_2d_full(full, out, p);
     json_decref(full);
     if (rc) gp_spec_2d_free(out);
     return rc;
@@ -1035,46 +1365,17 @@ static int semantic_3d(const json_t *full, gp_spec_problem *p)
     const json_t *sieve = json_object_get(full, "sieve");
     size_t n = json_array_size(sieve);
     char ptr[64];
-    double prev_d = 0, prev_q = 0;
-    for (size_t i = 0; i < n; i++) {
-        const json_t *row = json_array_get(sieve, i);
-        double d = json_number_value(json_array_get(row, 0));
-        double q = json_number_value(json_array_get(row, 1));
-        if (i > 0 && !(d > prev_d)) {
-            snprintf(ptr, sizeof ptr, "/sieve/%zu/0", i);
-            set_problem(p, 422, ptr,
-                        "sieve diameters must increase strictly: %.15g follows %.15g", d, prev_d);
-            return -1;
-        }
-        if (i > 0 && q < prev_q) {
-            snprintf(ptr, sizeof ptr, "/sieve/%zu/1", i);
-            set_problem(p, 422, ptr,
-                        "percent passing must not decrease: %.15g follows %.15g", q, prev_q);
-            return -1;
-        }
-        if (i == 0 && q != 0) {
-            set_problem(p, 422, "/sieve/0/1",
-                        "the first sieve row must pass 0 %% (the smallest grain), got %.15g", q);
-            return -1;
-        }
-        prev_d = d;
-        prev_q = q;
-    }
-    if (n && prev_q != 100) {
-        snprintf(ptr, sizeof ptr, "/sieve/%zu/1", n - 1);
-        set_problem(p, 422, ptr, "the last sieve row must pass 100 %%, got %.15g", prev_q);
-        return -1;
-    }
-    const char *units = json_string_value(json_object_get(full, "sieve_units"));
-    double scale = units && !strcmp(units, "m") ? 1.0 : 1e-3;
+    if (check_sieve_rows(sieve, "/sieve", p)) return -1;
+    double dmax = json_number_value(json_array_get(json_array_get(sieve, n - 1), 0));
+    double scale = sieve_scale(json_string_value(json_object_get(full, "sieve_units")));
     const json_t *box = json_object_get(full, "box");
     double bmin = INFINITY;
     for (size_t i = 0; i < 3; i++) bmin = fmin(bmin, json_number_value(json_array_get(box, i)));
-    if (n && prev_d * scale > bmin) {
+    if (dmax * scale > bmin) {
         snprintf(ptr, sizeof ptr, "/sieve/%zu/0", n - 1);
         set_problem(p, 422, ptr,
                     "the largest sieve diameter (%.6g m) does not fit in the box (smallest side "
-                    "%.6g m); check sieve_units", prev_d * scale, bmin);
+                    "%.6g m); check sieve_units", dmax * scale, bmin);
         return -1;
     }
     return 0;
@@ -1107,8 +1408,7 @@ int gp_spec_parse_3d(const json_t *spec, gp_spec3d *out, gp_spec_problem *p)
     out->seed = (uint64_t)json_number_value(json_object_get(full, "seed"));
     const json_t *box = json_object_get(full, "box");
     for (size_t i = 0; i < 3; i++) out->box[i] = json_number_value(json_array_get(box, i));
-    const char *units = json_string_value(json_object_get(full, "sieve_units"));
-    double scale = !strcmp(units, "m") ? 1.0 : 1e-3;
+    double scale = sieve_scale(json_string_value(json_object_get(full, "sieve_units")));
     const json_t *sieve = json_object_get(full, "sieve");
     size_t n = json_array_size(sieve);
     gp_sieve_row *rows = malloc(n * sizeof *rows);

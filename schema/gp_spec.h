@@ -22,7 +22,12 @@
  *   http_status 422, code "invalid_spec"  -- the spec fits the schema but is not meaningful
  *                                            (self-intersecting polygon, hole outside the
  *                                            container, sieve rows not increasing, largest
- *                                            sieve diameter larger than the box, ...);
+ *                                            sieve diameter larger than the box, a size.cov
+ *                                            out of its law's range, a field that size.law
+ *                                            excludes or needs, an E1-E3 imc.threshold below
+ *                                            the integer-count floor of the cell count, ...);
+ *   http_status 422, code "too_large"     -- a 2D sieve law whose derived cell count exceeds
+ *                                            the schema's particles maximum (/size/sieve);
  *   http_status 500, code "internal"      -- out of memory, broken embedded schema.
  * pointer is an RFC 6901 JSON pointer into the spec ("" is the whole document, keys escaped
  * with ~0/~1). For a missing required field the pointer names the missing field itself
@@ -62,14 +67,20 @@ const char *gp_schema_text(const char *kind);
 int gp_spec_validate(const json_t *spec, gp_spec_problem *p);
 
 /* A new reference to a copy of a valid spec with every default filled in (for storing the
- * effective spec and echoing it back). NULL (and *p filled) when the spec is invalid. */
+ * effective spec and echoing it back). NULL (and *p filled) when the spec is invalid.
+ * 2D defaults that depend on other fields: with size.law "sieve" the copy has no particles
+ * (the count is derived: gp_spec2d_cell_count) and no size.cov, and size.of is "grains";
+ * without it there is no size.sieve_units; imc.threshold, when absent, is
+ * gp_imc_default_threshold() of imc.error. The copy is itself a valid spec whose effective
+ * spec is the same copy. */
 json_t *gp_spec_with_defaults(const json_t *spec, gp_spec_problem *p);
 
 /* Validates and parses a spec of kind "fourier-voronoi-2d" into *out, defaults applied
- * (out->threads is set to 0: the caller picks). Returns 0 on success; *out then owns its
- * arrays (outer.pts, holes[*].pts, holes, spectrum) and must be released with
- * gp_spec_2d_free(). On failure returns -1, fills *p, and *out owns nothing (freeing it is
- * still allowed). */
+ * (out->threads is set to 0: the caller picks; out->particles is 0 with a sieve law, whose
+ * sieve_d are in metres, converted from size.sieve_units). Returns 0 on success; *out then
+ * owns its arrays (outer.pts, holes[*].pts, holes, spectrum, sieve_d, sieve_pass) and must be
+ * released with gp_spec_2d_free(). On failure returns -1, fills *p, and *out owns nothing
+ * (freeing it is still allowed). */
 int gp_spec_parse_2d(const json_t *spec, gp_spec2d *out, gp_spec_problem *p);
 void gp_spec_2d_free(gp_spec2d *s);
 

@@ -6,6 +6,7 @@
 
 #include <jansson.h>
 
+#include "gp_imc.h"
 #include "gp_spec.h"
 #include "gp_test.h"
 
@@ -19,6 +20,8 @@ static const char *EX2D =
     " \"imc\": {\"error\": \"E3\", \"threshold\": 0.002, \"max_steps\": 1000000, \"init\": \"halton\"},"
     " \"contour_points\": 128,"
     " \"outputs\": [\"grains\", \"odec\", \"descriptors\", \"cells\"]}";
+
+static const char *MIN2D = "{\"kind\": \"fourier-voronoi-2d\"}";
 
 static const char *EX3D =
     "{\"kind\": \"spheres-3d\", \"seed\": 7, \"box\": [0.5, 0.5, 0.5],"
@@ -74,14 +77,15 @@ static json_t *patched(const char *base, const char *pointer, const char *value)
 static int g_verbose = 0;
 
 /* expects the spec to fail with this pointer, status, and message containing needle */
-static void expect_bad(const char *base, const char *ptr, const char *value,
-                       const char *want_ptr, int want_status, const char *needle, int line)
+static void expect_bad_code(const char *base, const char *ptr, const char *value,
+                            const char *want_ptr, int want_status, const char *want_code,
+                            const char *needle, int line)
 {
     json_t *doc = patched(base, ptr, value);
     gp_spec_problem p;
     int rc = gp_spec_validate(doc, &p);
     int ok = rc != 0 && !strcmp(p.pointer, want_ptr) && p.http_status == want_status &&
-             !strcmp(p.code, "invalid_spec") && (!needle || strstr(p.message, needle));
+             !strcmp(p.code, want_code) && (!needle || strstr(p.message, needle));
     if (!ok || g_verbose)
         fprintf(stderr, "line %d: set %s = %s -> rc %d status %d pointer '%s' message '%s'\n",
                 line, ptr, value ? value : "(deleted)", rc, p.http_status, p.pointer, p.message);
@@ -97,6 +101,12 @@ static void expect_bad(const char *base, const char *ptr, const char *value,
         gp_spec_2d_free(&s);
     }
     json_decref(doc);
+}
+
+static void expect_bad(const char *base, const char *ptr, const char *value,
+                       const char *want_ptr, int want_status, const char *needle, int line)
+{
+    expect_bad_code(base, ptr, value, want_ptr, want_status, "invalid_spec", needle, line);
 }
 #define BAD2(ptr, val, wptr, st, needle) expect_bad(EX2D, ptr, val, wptr, st, needle, __LINE__)
 #define BAD3(ptr, val, wptr, st, needle) expect_bad(EX3D, ptr, val, wptr, st, needle, __LINE__)
@@ -127,7 +137,10 @@ static void test_examples(void)
     CHECK_NEAR(s.outer.pts[2].y, 1, 0);
     CHECK(s.nholes == 0);
     CHECK(s.particles == 500);
+    CHECK(s.size_law == GP_LAW_LOGNORMAL);
     CHECK_NEAR(s.cov, 0.8, 0);
+    CHECK(s.size_of_grains == 0);
+    CHECK(s.nsieve == 0 && s.sieve_d == NULL && s.sieve_pass == NULL);
     CHECK_NEAR(s.mean_deg, 0, 0);
     CHECK_NEAR(s.anisotropy, 1, 0);
     CHECK(!s.has_spectrum);
@@ -214,8 +227,9 @@ static void test_defaults(void)
     CHECK_NEAR(s.alpha, -2, 0);
     CHECK_NEAR(s.beta, -2, 0);
     CHECK_NEAR(s.solid_fraction, 0.65, 0);
-    CHECK(s.imc_error == GP_IMC_E3);
-    CHECK_NEAR(s.imc_threshold, 0.002, 0);
+    CHECK(s.size_law == GP_LAW_LOGNORMAL && s.size_of_grains == 0 && s.nsieve == 0);
+    CHECK(s.imc_error == GP_IMC_AD);
+    CHECK_NEAR(s.imc_threshold, gp_imc_default_threshold(GP_IMC_ERROR_AD), 0);
     CHECK(s.imc_max_steps == 1000000);
     CHECK(s.imc_init == GP_INIT_UNIFORM);
     CHECK(s.contour_points == 128);
@@ -225,14 +239,22 @@ static void test_defaults(void)
 
     json_t *full = gp_spec_with_defaults(j, &p);
     CHECK(full && json_is_object(json_object_get(full, "imc")));
-    CHECK(!strcmp(json_string_value(json_object_get(json_object_get(full, "imc"), "error")), "E3"));
+    CHECK(!strcmp(json_string_value(json_object_get(json_object_get(full, "imc"), "error")), "AD"));
+    CHECK_NEAR(json_number_value(json_object_get(json_object_get(full, "imc"), "threshold")),
+               gp_imc_default_threshold(GP_IMC_ERROR_AD), 0);
+    json_t *size = json_object_get(full, "size");
+    CHECK(!strcmp(json_string_value(json_object_get(size, "law")), "lognormal"));
+    CHECK(!strcmp(json_string_value(json_object_get(size, "of")), "cells"));
+    CHECK_NEAR(json_number_value(json_object_get(size, "cov")), 0.5, 0);
+    CHECK(json_object_get(size, "sieve") == NULL && json_object_get(size, "sieve_units") == NULL);
+    CHECK(json_integer_value(json_object_get(full, "particles")) == 100);
     CHECK(json_object_get(json_object_get(full, "imc"), "classes") == NULL);
     CHECK(json_array_size(json_object_get(json_object_get(full, "container"), "polygon")) == 4);
     json_decref(full);
     json_decref(j);
 
     /* partial objects get their missing members */
-    j = load("{\"kind\": \"fourier-voronoi-2d\", \"imc\": {\"error\": \"E1\", \"classes\": 12},"
+    j = load("{\"kind\": \"fourier-voronoi-2d\", \"particles\": 120, \"imc\": {\"error\": \"E1\", \"classes\": 12},"
              " \"shape\": {\"D2\": 0.3}, \"container\": {\"circle\": {\"center\": [1, 2], \"radius\": 3}},"
              " \"seed\": 5.0}");
     CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
@@ -307,7 +329,7 @@ static void test_bad_2d(void)
     BAD2("/size/cov", "\"abc\"", "/size/cov", 400, "/size/cov: expected a number in [0, 3], got \"abc\"");
     BAD2("/size/cov", "-0.1", "/size/cov", 400, "got -0.1");
     BAD2("/size/cov", "3.5", "/size/cov", 400, NULL);
-    BAD2("/size/mean", "1", "/size/mean", 400, "unknown field \"mean\"; allowed here: cov");
+    BAD2("/size/mean", "1", "/size/mean", 400, "unknown field \"mean\"; allowed here: law, cov, sieve, sieve_units, of");
     BAD2("/size", "0.8", "/size", 400, "expected an object, got 0.8");
     BAD2("/orientation/mean_deg", "91", "/orientation/mean_deg", 400, "[-90, 90]");
     BAD2("/orientation/anisotropy", "0", "/orientation/anisotropy", 400, "expected a number in (0, 1], got 0");
@@ -319,7 +341,7 @@ static void test_bad_2d(void)
     BAD2("/shape/spectrum", "[1, 0.1, 0.2]", "/shape", 400, "expected a shape by descriptors");
     BAD2("/solid_fraction", "0", "/solid_fraction", 400, "expected a number in (0, 1], got 0");
     BAD2("/solid_fraction", "1.2", "/solid_fraction", 400, NULL);
-    BAD2("/imc/error", "\"E4\"", "/imc/error", 400, "expected one of \"E1\", \"E2\", \"E3\", got \"E4\"");
+    BAD2("/imc/error", "\"E4\"", "/imc/error", 400, "expected one of \"AD\", \"E1\", \"E2\", \"E3\", got \"E4\"");
     BAD2("/imc/threshold", "0", "/imc/threshold", 400, "expected a number > 0, got 0");
     BAD2("/imc/max_steps", "-5", "/imc/max_steps", 400, NULL);
     BAD2("/imc/max_steps", "10.5", "/imc/max_steps", 400, NULL);
@@ -375,13 +397,266 @@ static void test_bad_2d(void)
     GOOD2("/container", "{\"circle\": {\"center\": [0.5, -1e3], \"radius\": 2.5}}");
     GOOD2("/container/polygon", "[[0,0],[0,1],[1,1],[1,0]]"); /* clockwise */
     GOOD2("/container/polygon", "[[0,0],[2,0],[2,2],[1,1],[0,2]]"); /* non-convex */
-    GOOD2("/particles", "1");
-    GOOD2("/particles", "7.0");
+    GOOD2("/particles", "500.0");
+    /* any count with the default error AD (E3's 0.002 is below the floor of a few cells) */
+    expect_good(MIN2D, "/particles", "1", __LINE__);
+    expect_good(MIN2D, "/particles", "7.0", __LINE__);
     GOOD2("/imc/classes", "25");
     GOOD2("/outputs", "[\"cells\"]");
     GOOD2("/orientation/mean_deg", "-90");
-    GOOD2("/size/cov", "0");
+    GOOD2("/size/cov", "0.01");
     GOOD2("/imc/max_steps", "0");
+}
+
+/* a sieve-law spec: 10-40 mm grains in the unit square (about two thousand grains) */
+static const char *SV2D =
+    "{\"kind\": \"fourier-voronoi-2d\", \"seed\": 3,"
+    " \"size\": {\"law\": \"sieve\", \"sieve\": [[10, 0], [20, 50], [40, 100]]},"
+    " \"contour_points\": 32}";
+#define BADS(ptr, val, wptr, st, needle) expect_bad(SV2D, ptr, val, wptr, st, needle, __LINE__)
+#define GOODS(ptr, val) expect_good(SV2D, ptr, val, __LINE__)
+
+static void test_size_laws(void)
+{
+    /* cov: at least GP_LAW_COV_MIN for every law, each law's own maximum */
+    BAD2("/size/cov", "0", "/size/cov", 422, "/size/cov: expected at least 0.01, got 0: equal sizes cannot be tessellated exactly; use 0.01");
+    BAD2("/size/cov", "0.009", "/size/cov", 422, "equal sizes");
+    BAD2("/size", "{\"law\": \"normal\", \"cov\": 0.005}", "/size/cov", 422, "at least 0.01");
+    BAD2("/size", "{\"law\": \"uniform\", \"cov\": 0}", "/size/cov", 422, "at least 0.01");
+    BAD2("/size", "{\"law\": \"normal\", \"cov\": 0.61}", "/size/cov", 422, "at most 0.6 for law \"normal\"");
+    GOOD2("/size", "{\"law\": \"normal\"}"); /* the default cov 0.5 is within normal's 0.6 */
+    BAD2("/size", "{\"law\": \"uniform\", \"cov\": 0.578}", "/size/cov", 422, "at most 0.5773 (1/√3) for law \"uniform\"");
+    BAD2("/size", "{\"law\": \"uniform\", \"cov\": 0.8}", "/size/cov", 422, NULL);
+    BAD2("/size/cov", "3.01", "/size/cov", 400, "[0, 3]");
+    BAD2("/size/law", "\"gamma\"", "/size/law", 400, "\"lognormal\", \"normal\", \"uniform\", \"sieve\"");
+    BAD2("/size/of", "\"pores\"", "/size/of", 400, "\"cells\", \"grains\"");
+    GOOD2("/size", "{\"law\": \"normal\", \"cov\": 0.6}");
+    GOOD2("/size", "{\"law\": \"uniform\", \"cov\": 0.5773}");
+    GOOD2("/size", "{\"law\": \"lognormal\", \"cov\": 3}");
+    GOOD2("/size", "{\"law\": \"normal\", \"cov\": 0.01, \"of\": \"grains\"}");
+    /* sieve fields without law "sieve" */
+    BAD2("/size/sieve", "[[1, 0], [2, 100]]", "/size/sieve", 422, "/size/sieve: only allowed with law \"sieve\" (the law here is \"lognormal\")");
+    BAD2("/size/sieve_units", "\"m\"", "/size/sieve_units", 422, "only allowed with law \"sieve\"");
+    BAD2("/size", "{\"law\": \"normal\", \"cov\": 0.2, \"sieve\": [[1, 0], [2, 100]]}", "/size/sieve", 422, "the law here is \"normal\"");
+
+    /* what the parser fills */
+    json_t *j = patched(EX2D, "/size", "{\"law\": \"uniform\", \"cov\": 0.3, \"of\": \"grains\"}");
+    gp_spec2d s;
+    gp_spec_problem p;
+    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(s.size_law == GP_LAW_UNIFORM && s.size_of_grains == 1 && s.particles == 500);
+    CHECK_NEAR(s.cov, 0.3, 0);
+    CHECK(s.nsieve == 0 && s.sieve_d == NULL);
+    gp_spec_2d_free(&s);
+    json_t *full = gp_spec_with_defaults(j, &p);
+    CHECK(full && json_object_get(json_object_get(full, "size"), "sieve_units") == NULL);
+    json_decref(full);
+    json_decref(j);
+}
+
+static void test_sieve_2d(void)
+{
+    json_t *j = load(SV2D);
+    gp_spec_problem p;
+    gp_spec2d s;
+    CHECK(gp_spec_validate(j, &p) == 0);
+    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(s.size_law == GP_LAW_SIEVE);
+    CHECK(s.particles == 0);          /* derived */
+    CHECK(s.size_of_grains == 1);
+    CHECK(s.nsieve == 3);
+    CHECK_NEAR(s.sieve_d[0], 0.010, 1e-15); /* mm -> m */
+    CHECK_NEAR(s.sieve_d[2], 0.040, 1e-15);
+    CHECK_NEAR(s.sieve_pass[1], 50, 0);
+    CHECK_NEAR(s.sieve_pass[2], 100, 0);
+    double area = 0;
+    size_t n = 0;
+    CHECK(gp_spec2d_cell_count(&s, &area, &n, NULL) == GP_OK);
+    CHECK_NEAR(area, 1, 1e-12);
+    CHECK(n > 500 && n < 5000);
+    gp_spec_2d_free(&s);
+    CHECK(s.sieve_d == NULL && s.sieve_pass == NULL);
+
+    /* the effective spec invents neither particles nor cov; the sieve is a law of the grains */
+    json_t *full = gp_spec_with_defaults(j, &p);
+    CHECK(full != NULL);
+    json_t *size = json_object_get(full, "size");
+    CHECK(json_object_get(full, "particles") == NULL);
+    CHECK(json_object_get(size, "cov") == NULL);
+    CHECK(!strcmp(json_string_value(json_object_get(size, "of")), "grains"));
+    CHECK(!strcmp(json_string_value(json_object_get(size, "sieve_units")), "mm"));
+    CHECK(!strcmp(json_string_value(json_object_get(size, "law")), "sieve"));
+    json_decref(full);
+    json_decref(j);
+
+    /* metres */
+    j = patched(SV2D, "/size/sieve_units", "\"m\"");
+    json_object_set_new(json_object_get(j, "size"), "sieve", load("[[0.01, 0], [0.02, 50], [0.04, 100]]"));
+    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK_NEAR(s.sieve_d[1], 0.02, 0);
+    gp_spec_2d_free(&s);
+    json_decref(j);
+
+    /* fields that a sieve law excludes or needs; particles is checked as posted */
+    BADS("/particles", "100", "/particles", 422, "/particles: leave particles out with size.law \"sieve\": the number of grains follows from the container area and solid_fraction");
+    BADS("/particles", "1", "/particles", 422, NULL);
+    BADS("/size/cov", "0.5", "/size/cov", 422, "not allowed with law \"sieve\"");
+    BADS("/size/sieve", NULL, "/size/sieve", 422, "required with law \"sieve\"");
+    BADS("/size/of", "\"cells\"", "/size/of", 422, "a sieve curve is a law of the grains");
+    GOODS("/size/of", "\"grains\"");
+    GOODS("/size/sieve_units", "\"mm\"");
+    GOODS("/container", "{\"circle\": {\"center\": [0, 0], \"radius\": 0.5}}");
+    /* the rows: as spheres-3d's sieve */
+    BADS("/size/sieve", "[[10, 0]]", "/size/sieve", 400, "at least 2");
+    BADS("/size/sieve/1", "[20]", "/size/sieve/1", 400, "exactly 2");
+    BADS("/size/sieve/1/1", "101", "/size/sieve/1/1", 400, "[0, 100]");
+    BADS("/size/sieve/1/0", "0", "/size/sieve/1/0", 400, "> 0");
+    BADS("/size/sieve/1/0", "10", "/size/sieve/1/0", 422, "/size/sieve/1/0: sieve diameters must increase strictly");
+    BADS("/size/sieve/2/1", "40", "/size/sieve/2/1", 422, "must not decrease");
+    BADS("/size/sieve/2/1", "99", "/size/sieve/2/1", 422, "the last sieve row must pass 100 %");
+    BADS("/size/sieve/0/1", "5", "/size/sieve/0/1", 422, "must pass 0 %");
+    BADS("/size/sieve_units", "\"cm\"", "/size/sieve_units", 400, "\"mm\", \"m\"");
+    /* a grain larger than the container: the units are likely wrong */
+    BADS("/size/sieve_units", "\"m\"", "/size/sieve/2/0", 422, "check sieve_units");
+    /* a derived count beyond particles' maximum: 422 too_large */
+    expect_bad_code(SV2D, "/size/sieve", "[[0.01, 0], [0.02, 100]]", "/size/sieve", 422,
+                    "too_large", "over the limit of 1000000", __LINE__);
+    /* a count too large even to compute (fine grains below coarse ones) */
+    expect_bad_code(SV2D, "/size/sieve", "[[1e-9, 0], [10, 100]]", "/size/sieve", 422,
+                    "too_large", "over the limit of 1000000", __LINE__);
+}
+
+/* the number in "use >= X" of a refusal */
+static double suggested(const char *message)
+{
+    const char *u = strstr(message, "use >= ");
+    return u ? strtod(u + 7, NULL) : -1;
+}
+
+static void test_imc_threshold(void)
+{
+    const char *e3 = "{\"kind\": \"fourier-voronoi-2d\", \"particles\": 20, \"imc\": {\"error\": \"E3\"}}";
+    json_t *j = load(e3);
+    gp_spec_problem p;
+    gp_spec2d s;
+    /* E3's default 0.002 is below the integer-count floor of 20 cells */
+    CHECK(gp_spec_validate(j, &p) != 0);
+    CHECK(p.http_status == 422 && !strcmp(p.code, "invalid_spec"));
+    CHECK(!strcmp(p.pointer, "/imc/threshold"));
+    CHECK(strncmp(p.message, "/imc/threshold: 0.002 is below the least error ", 47) == 0);
+    CHECK(strstr(p.message, "20 cells") && strstr(p.message, "the default error AD"));
+    CHECK(gp_spec_parse_2d(j, &s, &p) != 0 && !strcmp(p.pointer, "/imc/threshold"));
+    gp_spec_2d_free(&s);
+    if (g_verbose) fprintf(stderr, "%s\n", p.message);
+    /* the floor itself, as the core computes it */
+    gp_imc_params q;
+    gp_imc_params_default(&q);
+    q.error_kind = 3;
+    q.threshold = 0.002;
+    double floor20 = gp_imc_reachable_threshold(&q, 20);
+    CHECK(floor20 > 0.002);
+    /* the suggested value is accepted, and so is the floor */
+    double use = suggested(p.message);
+    CHECK(use >= floor20 && use < floor20 * 1.01);
+    json_object_set_new(json_object_get(j, "imc"), "threshold", json_real(use));
+    CHECK(gp_spec_validate(j, &p) == 0);
+    json_object_set_new(json_object_get(j, "imc"), "threshold", json_real(floor20));
+    CHECK(gp_spec_validate(j, &p) == 0);
+    json_object_set_new(json_object_get(j, "imc"), "threshold", json_real(floor20 * 0.99));
+    CHECK(gp_spec_validate(j, &p) != 0 && !strcmp(p.pointer, "/imc/threshold"));
+    /* AD has no floor: any threshold > 0, and its default */
+    json_object_set_new(json_object_get(j, "imc"), "error", json_string("AD"));
+    json_object_set_new(json_object_get(j, "imc"), "threshold", json_real(1e-6));
+    CHECK(gp_spec_validate(j, &p) == 0);
+    json_object_del(json_object_get(j, "imc"), "threshold");
+    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(s.imc_error == GP_IMC_AD);
+    CHECK_NEAR(s.imc_threshold, gp_imc_default_threshold(GP_IMC_ERROR_AD), 0);
+    gp_spec_2d_free(&s);
+    json_decref(j);
+
+    /* the threshold default follows the kind, and the effective spec shows it */
+    const char *kinds[] = {"E1", "E2", "E3", "AD"};
+    for (int k = 0; k < 4; k++) {
+        j = load("{\"kind\": \"fourier-voronoi-2d\", \"particles\": 500}");
+        json_object_set_new(j, "imc", json_pack("{s:s}", "error", kinds[k]));
+        json_t *full = gp_spec_with_defaults(j, &p);
+        CHECK(full != NULL);
+        double want = gp_imc_default_threshold(k < 3 ? k + 1 : GP_IMC_ERROR_AD);
+        CHECK_NEAR(json_number_value(json_object_get(json_object_get(full, "imc"), "threshold")), want, 0);
+        CHECK_NEAR(want, k < 3 ? 0.002 : gp_imc_default_threshold(GP_IMC_ERROR_AD), 0);
+        CHECK(gp_spec_parse_2d(j, &s, &p) == 0 && (int)s.imc_error == (k < 3 ? k + 1 : GP_IMC_AD));
+        gp_spec_2d_free(&s);
+        json_decref(full);
+        json_decref(j);
+    }
+    /* the schema's description names the AD default */
+    j = load(gp_schema_text("fourier-voronoi-2d"));
+    const char *d = json_string_value(json_object_get(json_object_get(json_object_get(json_object_get(
+        json_object_get(j, "properties"), "imc"), "properties"), "threshold"), "description"));
+    char want[64];
+    snprintf(want, sizeof want, "%g for AD", gp_imc_default_threshold(GP_IMC_ERROR_AD));
+    CHECK(d && strstr(d, want) && strstr(d, "0.002 for E1-E3"));
+    CHECK(json_object_get(json_object_get(json_object_get(json_object_get(
+        json_object_get(j, "properties"), "imc"), "properties"), "threshold"), "default") == NULL);
+    json_decref(j);
+
+    /* with imc.classes the message names them */
+    BAD2("/imc", "{\"error\": \"E1\", \"classes\": 12, \"threshold\": 0.002}", "/imc/threshold", 422,
+         "500 cells can reach with E1 and 12 size x 12 orientation classes");
+    /* a sieve law: the floor of the derived count (7 classes: a count that 7 does not divide
+     * has a floor > 0) */
+    j = load(SV2D);
+    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    double area;
+    size_t n = 0;
+    CHECK(gp_spec2d_cell_count(&s, &area, &n, NULL) == GP_OK);
+    gp_spec_2d_free(&s);
+    q.error_kind = 2;
+    q.threshold = 1e-9;
+    q.classes_size = q.classes_orient = 7;
+    CHECK(n % 7 != 0 && gp_imc_reachable_threshold(&q, n) > 1e-9);
+    json_object_set_new(j, "imc", load("{\"error\": \"E2\", \"threshold\": 1e-9, \"classes\": 7}"));
+    CHECK(gp_spec_validate(j, &p) != 0 && !strcmp(p.pointer, "/imc/threshold"));
+    char cells[64];
+    snprintf(cells, sizeof cells, "%zu cells can reach with E2 and 7 size x 7", n);
+    CHECK(strstr(p.message, cells) != NULL);
+    json_decref(j);
+}
+
+/* numbers spelled as reals are the integers they denote */
+static void test_real_spelling(void)
+{
+    json_t *j = load("{\"kind\": \"fourier-voronoi-2d\", \"particles\": 1e6, \"contour_points\": 1.28e2}");
+    gp_spec2d s;
+    gp_spec_problem p;
+    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(s.particles == 1000000);
+    CHECK(s.contour_points == 128);
+    gp_spec_2d_free(&s);
+    json_decref(j);
+    BAD2("/particles", "1.0000001e6", "/particles", 400, "[1, 1000000]");
+}
+
+/* the effective spec is itself a valid spec with the same effective spec (the daemon stores
+ * it and the worker parses it again) */
+static void test_effective_idempotent(void)
+{
+    const char *specs[] = {EX2D, SV2D, "{\"kind\": \"fourier-voronoi-2d\"}",
+                           "{\"kind\": \"fourier-voronoi-2d\", \"size\": {\"law\": \"normal\", \"cov\": 0.2}}",
+                           "{\"kind\": \"fourier-voronoi-2d\", \"imc\": {\"error\": \"E2\"}, \"particles\": 400}"};
+    for (size_t i = 0; i < sizeof specs / sizeof *specs; i++) {
+        json_t *j = load(specs[i]);
+        gp_spec_problem p;
+        json_t *a = gp_spec_with_defaults(j, &p);
+        CHECK(a != NULL);
+        json_t *b = a ? gp_spec_with_defaults(a, &p) : NULL;
+        if (a && !b) fprintf(stderr, "spec %zu: effective spec refused: %s\n", i, p.message);
+        CHECK(b != NULL && json_equal(a, b));
+        json_decref(a);
+        json_decref(b);
+        json_decref(j);
+    }
 }
 
 static void test_bad_3d(void)
@@ -468,6 +743,11 @@ int main(int argc, char **argv)
     test_examples();
     test_defaults();
     test_bad_2d();
+    test_size_laws();
+    test_sieve_2d();
+    test_imc_threshold();
+    test_real_spelling();
+    test_effective_idempotent();
     test_bad_3d();
     test_pointer_escaping();
     test_documents();

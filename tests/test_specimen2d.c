@@ -66,55 +66,230 @@ static gp_specimen2d *build(const gp_spec2d *s)
     return r;
 }
 
-static void example(int which)
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* KS distance of v[0..n) to a CDF (v is overwritten with the sorted F(v)) */
+static double ks_of(double *v, size_t n, double (*cdf)(double, const void *), const void *par)
+{
+    for (size_t i = 0; i < n; i++)
+        v[i] = cdf(v[i], par);
+    qsort(v, n, sizeof *v, cmp_double);
+    double d = 0.0;
+    for (size_t i = 0; i < n; i++)
+        d = fmax(d, fmax((i + 1.0) / n - v[i], v[i] - (double)i / n));
+    return d;
+}
+
+typedef struct lognormal { double m, s; } lognormal;
+static lognormal lognormal_of(double mean, double cov)
+{
+    double s2 = log(1 + cov * cov);
+    return (lognormal){log(mean) - 0.5 * s2, sqrt(s2)};
+}
+static double lognormal_cdf(double x, const void *p)
+{
+    const lognormal *l = p;
+    return 0.5 * erfc(-(log(x) - l->m) / l->s / sqrt(2.0));
+}
+
+typedef struct cosine_law { double mean, a; } cosine_law;
+static double cosine_cdf(double th_deg, const void *p)
+{
+    const cosine_law *c = p;
+    double x = fmod(fmod(th_deg - (c->mean - 90), 180) + 180, 180) * M_PI / 180;
+    return ((1 + c->a) / 2 * x - (1 - c->a) / 4 * sin(2 * x)) / ((1 + c->a) * M_PI / 2);
+}
+
+static double ring_area(const gp_vec2 *p, size_t n)
+{
+    double a = 0.0;
+    for (size_t i = 0, j = n - 1; i < n; j = i++)
+        a += p[j].x * p[i].y - p[i].x * p[j].y;
+    return 0.5 * a;
+}
+
+/* The fit report against the same statistics computed here from the geometry itself: cell
+ * areas from the cells' polygons (shoelace), grain areas from the contours. */
+static void check_fit(const gp_specimen2d *r, const gp_spec2d *s)
+{
+    size_t n = r->ncells;
+    double *v = malloc((n > r->ngrains ? n : r->ngrains) * sizeof *v);
+    lognormal cl = lognormal_of(r->container_area / n, s->cov);
+    for (size_t i = 0; i < n; i++) {
+        v[i] = 0.0;
+        for (size_t k = 0; k < r->cells[i].npolygons; k++)
+            v[i] += fabs(ring_area(r->cells[i].polygons[k].pts, r->cells[i].polygons[k].n));
+    }
+    double ks = ks_of(v, n, lognormal_cdf, &cl);
+    CHECK_NEAR(r->fit.cell_area.ks, ks, 1e-9);
+    CHECK_NEAR(r->fit.cell_area.ks_critical, 1.36 / sqrt((double)n), 1e-12);
+    for (size_t i = 0; i < n; i++)
+        v[i] = r->cells[i].orientation_deg;
+    cosine_law cw = {s->mean_deg, s->anisotropy};
+    CHECK_NEAR(r->fit.cell_orientation.ks, ks_of(v, n, cosine_cdf, &cw), 1e-9);
+    if (r->ngrains) {
+        lognormal gl = lognormal_of(s->solid_fraction * r->container_area / n, s->cov);
+        for (size_t i = 0; i < r->ngrains; i++)
+            v[i] = fabs(ring_area(r->grains[i].contour, r->grains[i].ncontour));
+        CHECK_NEAR(r->fit.grain_area.ks, ks_of(v, r->ngrains, lognormal_cdf, &gl), 1e-9);
+    }
+    free(v);
+}
+
+static gp_specimen2d *paper_example(int which, uint64_t seed, unsigned outputs)
 {
     gp_spec2d s;
     gp_spec2d_defaults(&s);
-    s.seed = 2012;
+    s.seed = seed;
     s.particles = 500;
     s.solid_fraction = 0.65;
     s.threads = 2;
-    s.outputs = GP_OUT_GRAINS | GP_OUT_CELLS | GP_OUT_DESCRIPTORS;
+    s.outputs = outputs;
     if (which == 1) { /* large size dispersion, isotropic, irregular grains */
         s.cov = 0.8; s.anisotropy = 1.0;
-        s.D2 = 0.1; s.D3 = 0.05; s.D8 = 0.02;
+        s.D2 = 0.1; s.D3 = 0.06; s.D8 = 0.03;
     } else {          /* small dispersion, mostly horizontal, elongated smooth grains */
         s.cov = 0.2; s.anisotropy = 0.1; s.mean_deg = 0.0;
         s.D2 = 0.2; s.D3 = 0.01; s.D8 = 0.0;
     }
     gp_specimen2d *r = build(&s);
+    if (r && (outputs & GP_OUT_CELLS))
+        check_fit(r, &s);
+    return r;
+}
+
+/* Mollon & Zhao §5: Example 1 reaches a solid fraction of 0.635, Example 2 0.623, at any seed,
+ * with no overlaps, every grain inside its cell, and the grains turned like their cells. */
+static void example(int which, uint64_t seed, int full)
+{
+    unsigned outputs = GP_OUT_GRAINS | (full ? GP_OUT_CELLS | GP_OUT_DESCRIPTORS : 0);
+    gp_specimen2d *r = paper_example(which, seed, outputs);
     CHECK(r != NULL);
     if (!r) return;
-    printf("example %d: imc E3 %.5f (%s, %ld steps), solid fraction %.4f, target met %zu/%zu, "
-           "mean |theta_grain - theta_cell| %.2f deg, elongation %.3f\n", which, r->imc_error,
-           r->imc_stop_reason, r->imc_steps, r->solid_fraction, r->cells_target_met, r->ngrains,
-           r->mean_orientation_gap_deg, r->descriptor_mean.elongation);
+    const gp_fit2d *f = &r->fit;
+    printf("example %d seed %llu: imc %s %.4f (%s, %ld steps), solid fraction %.4f, target met %zu/%zu, "
+           "gap %.2f deg, cell KS %.4f, grain KS %.4f, grain orientation KS %.4f (critical %.4f)\n",
+           which, (unsigned long long)seed, r->imc_error_kind, r->imc_error, r->imc_stop_reason,
+           r->imc_steps, r->solid_fraction, r->cells_target_met, r->ngrains,
+           r->mean_orientation_gap_deg, f->cell_area.ks, f->grain_area.ks, f->grain_orientation.ks,
+           f->grain_orientation.ks_critical);
     CHECK(r->ngrains == 500);
-    CHECK(r->imc_error <= 0.002);
-    CHECK(r->solid_fraction >= 0.62);            /* paper: 0.635 and 0.623 */
+    CHECK(r->imc_error <= r->imc_threshold);
+    CHECK(r->solid_fraction >= (which == 1 ? 0.635 : 0.623));
     CHECK(r->solid_fraction <= 0.65 + 1e-9);     /* never above the target */
-    CHECK(count_overlaps(r) == 0);
-    CHECK(count_inside_cell(r) == r->ngrains);
+    CHECK(f->cell_area.ks <= f->cell_area.ks_critical);
     /* grains follow their cells: a random orientation would give 45 deg on average */
     CHECK(r->mean_orientation_gap_deg < (which == 2 ? 12.0 : 20.0));
-    /* the histograms are normalised */
-    double sum = 0.0;
-    for (size_t k = 0; k < r->grain_orientation_hist.nclasses; k++)
-        sum += r->grain_orientation_hist.achieved[k];
-    CHECK_NEAR(sum, 1.0, 1e-12);
-    if (which == 2) {
-        /* mostly horizontal: the grains' orientation histogram is much closer to the cosine
-         * target than a uniform (isotropic) one would be */
-        const gp_hist *h = &r->grain_orientation_hist;
-        double d_ach = 0.0, d_unif = 0.0;
-        for (size_t k = 0; k < h->nclasses; k++) {
-            d_ach += pow(h->achieved[k] - h->target[k], 2);
-            d_unif += pow(1.0 / h->nclasses - h->target[k], 2);
-        }
-        printf("example 2: grain orientation histogram L2 distance to target %.4f (uniform: %.4f)\n",
-               sqrt(d_ach), sqrt(d_unif));
-        CHECK(sqrt(d_ach) < 0.35 * sqrt(d_unif));
+    CHECK(f->grain_orientation.ks <= f->grain_orientation.ks_critical);
+    if (full) {
+        CHECK(count_overlaps(r) == 0);
+        CHECK(count_inside_cell(r) == r->ngrains);
     }
+    gp_specimen2d_destroy(r);
+}
+
+/* N = 1 .. 150 with the defaults: a valid specimen every time, cells covering the container;
+ * what could not be reached is said in the warnings, never a failure. */
+static void small_n(void)
+{
+    const size_t ns[5] = {1, 5, 20, 60, 150};
+    for (int k = 0; k < 5; k++) {
+        gp_spec2d s;
+        gp_spec2d_defaults(&s);
+        s.particles = ns[k];
+        s.outputs = GP_OUT_GRAINS | GP_OUT_CELLS;
+        s.threads = 2;
+        gp_specimen2d *r = build(&s);
+        CHECK(r != NULL);
+        if (!r) continue;
+        double cover = 0.0;
+        for (size_t i = 0; i < r->ncells; i++)
+            for (size_t q = 0; q < r->cells[i].npolygons; q++)
+                cover += fabs(ring_area(r->cells[i].polygons[q].pts, r->cells[i].polygons[q].n));
+        printf("N %3zu: imc %s %.4f, cells cover %.15f, %zu warnings%s%s\n", ns[k],
+               r->imc_stop_reason, r->imc_error, cover, r->nwarnings, r->nwarnings ? ": " : "",
+               r->nwarnings ? r->warnings[0] : "");
+        CHECK(r->ncells == ns[k] && r->ngrains == ns[k]);
+        CHECK_NEAR(cover, 1.0, 1e-12);
+        CHECK(count_overlaps(r) == 0);
+        CHECK(count_inside_cell(r) == r->ngrains);
+        /* a target not reached is in the warnings */
+        CHECK(r->imc_error <= r->imc_threshold || r->nwarnings > 0);
+        check_fit(r, &s);
+        gp_specimen2d_destroy(r);
+    }
+}
+
+/* "of": "grains": the grains' own areas follow the law (KS computed here from the contours) */
+static void law_on_grains(void)
+{
+    gp_spec2d s;
+    gp_spec2d_defaults(&s);
+    s.particles = 500;
+    s.cov = 0.5;
+    s.size_of_grains = 1;
+    s.threads = 2;
+    s.outputs = GP_OUT_GRAINS | GP_OUT_CELLS;
+    gp_specimen2d *r = build(&s);
+    CHECK(r != NULL);
+    if (!r) return;
+    double *v = malloc(r->ngrains * sizeof *v);
+    for (size_t i = 0; i < r->ngrains; i++)
+        v[i] = fabs(ring_area(r->grains[i].contour, r->grains[i].ncontour));
+    lognormal gl = lognormal_of(s.solid_fraction * r->container_area / 500, 0.5);
+    double ks = ks_of(v, r->ngrains, lognormal_cdf, &gl);
+    printf("of grains: grain-area KS %.4f (critical %.4f), solid fraction %.4f, %zu/500 met\n", ks,
+           1.36 / sqrt(500.0), r->solid_fraction, r->cells_target_met);
+    CHECK(ks <= 1.36 / sqrt(500.0));
+    CHECK_NEAR(r->fit.grain_area.ks, ks, 1e-9);
+    CHECK(count_overlaps(r) == 0);
+    CHECK(count_inside_cell(r) == r->ngrains);
+    free(v);
+    gp_specimen2d_destroy(r);
+}
+
+/* A sieve curve by mass: 0.5-4 mm, 10 / 50 / 90 % passing at 1 / 2 / 3 mm in a 0.1 m square.
+ * Passing by mass recomputed from the grain contours is within 3 points at every sieve. */
+static void sieve_law(void)
+{
+    gp_vec2 sq[4] = {{0, 0}, {0.1, 0}, {0.1, 0.1}, {0, 0.1}};
+    double d[5] = {0.5e-3, 1e-3, 2e-3, 3e-3, 4e-3}, pw[5] = {0, 10, 50, 90, 100};
+    gp_spec2d s;
+    gp_spec2d_defaults(&s);
+    s.outer.pts = sq;
+    s.outer.n = 4;
+    s.size_law = GP_LAW_SIEVE;
+    s.sieve_d = d;
+    s.sieve_pass = pw;
+    s.nsieve = 5;
+    s.particles = 0;
+    s.threads = 2;
+    size_t n = 0;
+    CHECK(gp_spec2d_cell_count(&s, NULL, &n, NULL) == GP_OK && n > 3000 && n < 5000);
+    gp_specimen2d *r = build(&s);
+    CHECK(r != NULL);
+    if (!r) return;
+    double total = 0.0, below[3] = {0, 0, 0};
+    for (size_t i = 0; i < r->ngrains; i++) {
+        double a = fabs(ring_area(r->grains[i].contour, r->grains[i].ncontour));
+        double de = sqrt(4 * a / M_PI);
+        total += a;
+        for (int k = 0; k < 3; k++)
+            below[k] += de < d[k + 1] ? a : 0.0;
+    }
+    printf("sieve: %zu grains (expected %zu), passing by mass", r->ngrains, n);
+    for (int k = 0; k < 3; k++) {
+        double p = 100 * below[k] / total;
+        printf(" %.2f (%.0f)", p, pw[k + 1]);
+        CHECK(fabs(p - pw[k + 1]) <= 3.0);
+        CHECK_NEAR(r->fit.passing.achieved[k + 1], p, 1e-9);
+    }
+    printf(", solid fraction %.4f\n", r->solid_fraction);
+    CHECK(r->ngrains == n);
     gp_specimen2d_destroy(r);
 }
 
@@ -266,6 +441,7 @@ static void cancellation(void)
 {
     gp_spec2d s;
     gp_spec2d_defaults(&s);
+    s.imc_error = GP_IMC_E3;
     s.particles = 301;      /* 301 cells in 10 equal classes cannot match exactly */
     s.imc_threshold = 1e-9; /* below the floor of custom classes: stops with a reason */
     s.imc_classes = 10;
@@ -284,8 +460,13 @@ static void cancellation(void)
 
 int main(void)
 {
-    example(1);
-    example(2);
+    for (uint64_t seed = 1; seed <= 5; seed++) {
+        example(1, seed, seed == 1);
+        example(2, seed, seed == 1);
+    }
+    small_n();
+    law_on_grains();
+    sieve_law();
     d2_trends();
     determinism();
     infeasible_and_nonconvex();

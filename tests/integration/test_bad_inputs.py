@@ -19,6 +19,8 @@ def post_raw(d, raw, headers=None):
 def test_spec_errors(env):
     d = env.daemon(workers=1)
     base = dict(gpd.SMALL_2D)
+    sieve_2d = {k: v for k, v in base.items() if k not in ("particles", "size", "imc")}
+    sieve_2d["size"] = {"law": "sieve", "sieve": [[10, 0], [20, 50], [40, 100]]}
     cases = [
         # (name, raw body, status, code, pointer)
         ("malformed", b'{"kind": "fourier-voronoi-2d", "seed": ', 400, "invalid_json", None),
@@ -37,12 +39,38 @@ def test_spec_errors(env):
         ("bad enum", dict(base, imc={"error": "E9"}), 422, "invalid_spec", "/imc/error"),
         ("result too large", dict(base, particles=1000000, contour_points=512), 422,
          "too_large", "/particles"),
+        # the same count spelled as a real is the same integer (api.md "Limits")
+        ("result too large, 1e6", json.dumps(dict(base, particles="N")).replace(
+            '"N"', "1e6").encode(), 422, "too_large", "/particles"),
+        # size laws (issue #12)
+        ("cov 0", dict(base, size={"cov": 0}), 422, "invalid_spec", "/size/cov"),
+        ("normal cov > 0.6", dict(base, size={"law": "normal", "cov": 0.7}), 422,
+         "invalid_spec", "/size/cov"),
+        ("sieve without its law", dict(base, size={"sieve": [[1, 0], [2, 100]]}), 422,
+         "invalid_spec", "/size/sieve"),
+        ("sieve with particles", dict(sieve_2d, particles=60), 422, "invalid_spec", "/particles"),
+        ("sieve with cov", dict(sieve_2d, size=dict(sieve_2d["size"], cov=0.3)), 422,
+         "invalid_spec", "/size/cov"),
+        ("sieve rows", dict(sieve_2d, size=dict(sieve_2d["size"], sieve=[[20, 0], [10, 100]])),
+         422, "invalid_spec", "/size/sieve/1/0"),
+        # a sieve of 10-20 um grains makes ~4e9 grains in the unit square
+        ("sieve count", dict(sieve_2d, size=dict(sieve_2d["size"], sieve=[[0.01, 0], [0.02, 100]])),
+         422, "too_large", "/size/sieve"),
+        # ~700,000 grains of 1-1.2 mm: within particles' bound, but the result is too large
+        ("sieve result", dict(sieve_2d, contour_points=512, size=dict(
+            sieve_2d["size"], sieve=[[1, 0], [1.2, 100]])), 422, "too_large", "/size/sieve"),
+        # E3's floor at 20 cells is above 0.002: refused at submit, not failed in the queue
+        ("E3 floor", dict(base, particles=20, imc={"error": "E3", "threshold": 0.002}), 422,
+         "invalid_spec", "/imc/threshold"),
     ]
     for name, body, status, code, pointer in cases:
         raw = body if isinstance(body, bytes) else json.dumps(body).encode()
         st, _, j = post_raw(d, raw)
         assert st == status, (name, st, j)
         gpd.check_error_body(st, j, code, pointer)
+        assert j["error"]["message"].startswith(pointer or ""), (name, j)
+    st, _, j = post_raw(d, json.dumps(dict(base, particles=20, imc={"error": "E3"})).encode())
+    assert "the default error AD" in j["error"]["message"], j
     # nothing was queued by any of them
     st, _, j = d.json("GET", "/v1/jobs")
     assert j["jobs"] == [], j
@@ -150,6 +178,27 @@ def test_not_ready_and_finished(env):
     assert d.stop() == 0, d.read_log()
 
 
+def test_sieve_spec_stored(env):
+    """A sieve-law spec is accepted and stored without an invented particles or cov; the
+    threshold stored is the one of its error kind."""
+    d = env.daemon(workers=1)
+    long_id = d.submit(gpd.LONG_2D)  # keeps the next job queued
+    spec = {"kind": "fourier-voronoi-2d", "seed": 1, "contour_points": 32,
+            "size": {"law": "sieve", "sieve": [[40, 0], [60, 50], [80, 100]]}}
+    jid = d.submit(spec)
+    st, _, eff = d.json("GET", "/v1/jobs/%s/spec" % jid)
+    assert st == 200, (st, eff)
+    assert "particles" not in eff and "cov" not in eff["size"], eff
+    assert eff["size"]["of"] == "grains" and eff["size"]["sieve_units"] == "mm", eff
+    assert eff["imc"]["error"] == "AD" and eff["imc"]["threshold"] > 0, eff
+    jid2 = d.submit(dict(gpd.SMALL_2D, imc={"error": "E2"}, particles=400))
+    st, _, eff = d.json("GET", "/v1/jobs/%s/spec" % jid2)
+    assert eff["imc"]["threshold"] == 0.002 and "sieve_units" not in eff["size"], eff
+    for j in (long_id, jid, jid2):
+        d.json("DELETE", "/v1/jobs/" + j)
+    assert d.stop() == 0, d.read_log()
+
+
 if __name__ == "__main__":
     gpd.main([test_spec_errors, test_body_limit, test_unknown_job_and_methods,
-              test_not_ready_and_finished])
+              test_not_ready_and_finished, test_sieve_spec_stored])
