@@ -622,7 +622,7 @@ static gp_imc_stop stop_check(const imc_state *S, const gp_imc_params *p, const 
     if (S->n == 1) return GP_IMC_STOP_SINGLE_CELL;
     if (ro->steps >= p->max_steps) return GP_IMC_STOP_MAX_STEPS;
     if (S->kind == GP_IMC_ERROR_AD) {
-        if (cur->descent < *best * (1.0 - 1e-3)) {
+        if (cur->descent < *best * (1.0 - 1e-2)) {
             *best = cur->descent;
             *best_step = ro->steps;
         } else if (ro->steps - *best_step > gp_imc_stall_window(S->n)) {

@@ -93,11 +93,11 @@ typedef enum gp_imc_stop {
     GP_IMC_STOP_MAX_STEPS,
     GP_IMC_STOP_FLOOR,
     GP_IMC_STOP_CANCELLED,
-    GP_IMC_STOP_STALLED,     /* AD: no gain of 0.1 % in the last gp_imc_stall_window() steps */
+    GP_IMC_STOP_STALLED,     /* AD: no gain of 1 % in the last gp_imc_stall_window() steps */
     GP_IMC_STOP_SINGLE_CELL  /* N = 1: the cell is the container, nothing can move */
 } gp_imc_stop;
 
-/* Steps without a 0.1 % gain of the AD error after which a run stops as "stalled":
+/* Steps without a 1 % gain of the AD error after which a run stops as "stalled":
  * 20,000 + 50 N (a few seconds at most at small N, where the least error of N cells can lie
  * above the threshold; far beyond the gaps between gains of a run that still converges). */
 long gp_imc_stall_window(size_t n);
