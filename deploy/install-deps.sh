@@ -10,7 +10,7 @@ PKGS="build-essential cmake pkg-config \
   libmicrohttpd-dev libjansson-dev libsqlite3-dev libfftw3-dev libgsl-dev \
   python3 curl wrk"
 if [ "${1:-}" = "--test" ]; then
-  PKGS="$PKGS lammps liggghts yade python3-vtk9"
+  PKGS="$PKGS lammps liggghts yade python3-vtk9 nodejs"
 fi
 missing=""
 for p in $PKGS; do

@@ -16,7 +16,7 @@ static json_t *reals(const double *v, size_t n)
     return a;
 }
 
-static json_t *hist(const gp_hist *h)
+static json_t *hist_json(const gp_hist *h)
 {
     if (!h || h->nclasses == 0 || !h->edges) return json_null();
     return json_pack("{s:o, s:o, s:o}", "edges", reals(h->edges, h->nclasses + 1), "target",
@@ -42,13 +42,107 @@ static json_t *descriptors(const gp_descriptors *d)
                      "regularity", gpd_jreal(d->regularity));
 }
 
-static const char *imc_measure(gp_imc_error_kind k)
+/* the measure's name: the core's string, else the spec's kind */
+static const char *imc_measure(const gp_specimen2d *s, gp_imc_error_kind k)
 {
+    if (s->imc_error_kind && *s->imc_error_kind) return s->imc_error_kind;
     switch (k) {
     case GP_IMC_E1: return "E1";
     case GP_IMC_E2: return "E2";
-    default: return "E3";
+    case GP_IMC_E3: return "E3";
+    default: return "AD";
     }
+}
+
+/* ------------------------------------------------------------------ fit (api.md stats.fit) */
+
+static json_t *mean_cov(double mean, double cov)
+{
+    return json_pack("{s:o, s:o}", "mean", gpd_jreal(mean), "cov", gpd_jreal(cov));
+}
+
+static json_t *pair(double a, double b)
+{
+    return json_pack("[o, o]", gpd_jreal(a), gpd_jreal(b));
+}
+
+static json_t *fit_area(const gp_fit_area *a, int with_curves)
+{
+    const char *law = gp_law_name(a->law);
+    json_t *o = json_pack("{s:s, s:o, s:o, s:o, s:o, s:o, s:I}", "law", law ? law : "",
+                          "target", mean_cov(a->target_mean, a->target_cov), "achieved",
+                          mean_cov(a->mean, a->cov), "ks", gpd_jreal(a->ks), "ks_critical",
+                          gpd_jreal(a->ks_critical), "w1", gpd_jreal(a->w1), "n",
+                          (json_int_t)a->n);
+    if (!o) return NULL;
+    json_object_set_new(o, "range", json_pack("{s:o, s:o}", "achieved", pair(a->min, a->max),
+                                              "target_p001_p999", pair(a->q001, a->q999)));
+    if (with_curves && a->ncurve > 0 && a->curve_x && a->curve_target && a->curve_achieved)
+        json_object_set_new(o, "cdf",
+                            json_pack("{s:o, s:o, s:o}", "x", reals(a->curve_x, a->ncurve),
+                                      "target", reals(a->curve_target, a->ncurve), "achieved",
+                                      reals(a->curve_achieved, a->ncurve)));
+    return o;
+}
+
+static json_t *fit_orient(const gp_fit_orient *o)
+{
+    return json_pack("{s:{s:o, s:o}, s:o, s:o, s:I}", "target", "mean_deg",
+                     gpd_jreal(o->target_mean_deg), "anisotropy",
+                     gpd_jreal(o->target_anisotropy), "ks", gpd_jreal(o->ks), "ks_critical",
+                     gpd_jreal(o->ks_critical), "n", (json_int_t)o->n);
+}
+
+static json_t *fit_passing(const gp_fit_passing *p)
+{
+    return json_pack("{s:o, s:o, s:o, s:o}", "diameters", reals(p->diameters, p->n), "target",
+                     reals(p->target, p->n), "achieved", reals(p->achieved, p->n),
+                     "max_error_pp", gpd_jreal(p->max_error_pp));
+}
+
+json_t *gpd_fit_2d(const gp_fit2d *f, int with_curves)
+{
+    json_t *o = json_object();
+    if (!o || !f) return o;
+    if (f->cell_area.present)
+        json_object_set_new(o, "cell_area", fit_area(&f->cell_area, with_curves));
+    if (f->grain_area.present)
+        json_object_set_new(o, "grain_area", fit_area(&f->grain_area, with_curves));
+    if (f->cell_orientation.present)
+        json_object_set_new(o, "cell_orientation", fit_orient(&f->cell_orientation));
+    if (f->grain_orientation.present)
+        json_object_set_new(o, "grain_orientation", fit_orient(&f->grain_orientation));
+    if (f->passing.n > 0) json_object_set_new(o, "passing", fit_passing(&f->passing));
+    return o;
+}
+
+json_t *gpd_warnings_2d(const gp_specimen2d *s)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; a && s->warnings && i < s->nwarnings; i++)
+        if (s->warnings[i]) json_array_append_new(a, json_string(s->warnings[i]));
+    return a;
+}
+
+/* the number of cells asked for: `particles`, or derived from a sieve law */
+static size_t target_particles(const gp_specimen2d *s, const gp_spec2d *spec)
+{
+    if (spec->particles > 0) return spec->particles;
+    double area;
+    size_t n = 0;
+    gp_error err;
+    if (gp_spec2d_cell_count(spec, &area, &n, &err) == GP_OK) return n;
+    return s->fit.cell_area.n;
+}
+
+static json_t *imc_error(const gp_specimen2d *s, const gp_spec2d *spec)
+{
+    double thr = isfinite(s->imc_threshold) && s->imc_threshold > 0 ? s->imc_threshold
+                                                                    : spec->imc_threshold;
+    return json_pack("{s:o, s:o, s:s, s:o, s:s}", "target", gpd_jreal(thr), "achieved",
+                     gpd_jreal(s->imc_error), "measure", imc_measure(s, spec->imc_error),
+                     "floor", gpd_jreal(s->imc_error_floor), "stop_reason",
+                     s->imc_stop_reason ? s->imc_stop_reason : "");
 }
 
 json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_t *spec_json)
@@ -65,15 +159,10 @@ json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_
 
     json_t *st = json_object();
     json_object_set_new(st, "particles",
-                        json_pack("{s:I, s:I}", "target", (json_int_t)spec->particles,
-                                  "achieved", (json_int_t)s->ngrains));
-    json_object_set_new(st, "imc_error",
-                        json_pack("{s:o, s:o, s:s, s:o, s:s}", "target",
-                                  gpd_jreal(spec->imc_threshold), "achieved",
-                                  gpd_jreal(s->imc_error), "measure",
-                                  imc_measure(spec->imc_error), "floor",
-                                  gpd_jreal(s->imc_error_floor), "stop_reason",
-                                  s->imc_stop_reason ? s->imc_stop_reason : ""));
+                        json_pack("{s:I, s:I}", "target",
+                                  (json_int_t)target_particles(s, spec), "achieved",
+                                  (json_int_t)s->ngrains));
+    json_object_set_new(st, "imc_error", imc_error(s, spec));
     json_object_set_new(st, "imc_steps",
                         json_pack("{s:I, s:I}", "max", (json_int_t)spec->imc_max_steps,
                                   "achieved", (json_int_t)s->imc_steps));
@@ -83,16 +172,16 @@ json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_
     json_object_set_new(st, "container_area", gpd_jreal(s->container_area));
     json_object_set_new(st, "cells_target_met", json_integer((json_int_t)s->cells_target_met));
     json_object_set_new(st, "mean_orientation_gap_deg", gpd_jreal(s->mean_orientation_gap_deg));
-    json_object_set_new(st, "size_histogram", hist(&s->size_hist));
-    json_object_set_new(st, "grain_size_histogram", hist(&s->grain_size_hist));
-    json_object_set_new(st, "orientation_histogram", hist(&s->orientation_hist));
+    json_object_set_new(st, "size_histogram", hist_json(&s->size_hist));
+    json_object_set_new(st, "grain_size_histogram", hist_json(&s->grain_size_hist));
+    json_object_set_new(st, "orientation_histogram", hist_json(&s->orientation_hist));
     if (out & GP_OUT_DESCRIPTORS) {
         static const char *names[4] = {"elongation", "roundness", "circularity", "regularity"};
         const double means[4] = {s->descriptor_mean.elongation, s->descriptor_mean.roundness,
                                  s->descriptor_mean.circularity, s->descriptor_mean.regularity};
         json_t *d = json_object();
         for (int k = 0; k < 4; k++) {
-            json_t *h = hist(&s->descriptor_hist[k]);
+            json_t *h = hist_json(&s->descriptor_hist[k]);
             if (!json_is_object(h)) {
                 json_decref(h);
                 h = json_object();
@@ -102,7 +191,9 @@ json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_
         }
         json_object_set_new(st, "descriptors", d);
     }
+    json_object_set_new(st, "fit", gpd_fit_2d(&s->fit, 1));
     json_object_set_new(r, "stats", st);
+    json_object_set_new(r, "warnings", gpd_warnings_2d(s));
 
     json_object_set_new(
         r, "timings",

@@ -4,9 +4,11 @@
  * {"kind": "fourier-voronoi-2d", "seed": 42, "outputs": [...],
  *  "container": <the spec's container, echoed>,
  *  "stats": {
- *    "particles":       {"target": N, "achieved": number of grains},
- *    "imc_error":       {"target": threshold, "achieved": e, "measure": "E3",
- *                        "floor": f, "stop_reason": "threshold|max_steps|floor|..."},
+ *    "particles":       {"target": N (`particles`, or the cell count a sieve law gives),
+ *                        "achieved": number of grains},
+ *    "imc_error":       {"target": the threshold used, "achieved": e,
+ *                        "measure": "AD|E1|E2|E3", "floor": f,
+ *                        "stop_reason": "threshold|max_steps|floor|..."},
  *    "imc_steps":       {"max": max_steps, "achieved": steps},
  *    "solid_fraction":  {"target": F_S, "achieved": grain area / container area},
  *    "container_area":  A,
@@ -17,7 +19,21 @@
  *    "orientation_histogram": {"edges" (deg), "target", "achieved"}
  *    "descriptors": {"elongation": {"mean", "edges", "target", "achieved"}, "roundness": ...,
  *                    "circularity": ..., "regularity": ...}       (with output "descriptors")
+ *    "fit": {                                           (api.md; a block only when measured)
+ *      "cell_area": {"law": "lognormal|normal|uniform|sieve",
+ *                    "target": {"mean", "cov"}, "achieved": {"mean", "cov"},
+ *                    "ks", "ks_critical" (1.36 / sqrt(n)), "w1" (/ target mean), "n",
+ *                    "range": {"achieved": [min, max], "target_p001_p999": [q001, q999]},
+ *                    "cdf": {"x": [k] (area, increasing), "target": [k] F(x),
+ *                            "achieved": [k] empirical CDF at x}},
+ *      "grain_area": the same, against the grains' law (absent when no grains were built),
+ *      "cell_orientation":  {"target": {"mean_deg", "anisotropy"}, "ks", "ks_critical", "n"},
+ *      "grain_orientation": the same,
+ *      "passing": {"diameters": [m], "target": [m] %, "achieved": [m] %, "max_error_pp"}
+ *                 (grains by mass; sieve law only)}
  *  },
+ *  "warnings": ["one line each: a target not reached and how close it came", ...]
+ *              (always there; [] when every target was met),
  *  "timings": {"tessellation", "imc", "fill", "odec", "descriptors", "total"}  (seconds),
  *  "grains": [{"id", "cell", "contour": [[x,y],...], "area", "orientation_deg",
  *              "cell_fraction", "descriptors": {...} (output descriptors),
@@ -57,6 +73,13 @@
 json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_t *spec_json);
 
 json_t *gpd_result_3d(const gp_specimen3d *s, const gp_spec3d *spec, const json_t *spec_json);
+
+/* stats.fit of a specimen (a new object; blocks whose `present` is 0 are left out). Without
+ * with_curves the "cdf" arrays are left out: the compact summary of a job's progress detail. */
+json_t *gpd_fit_2d(const gp_fit2d *f, int with_curves);
+
+/* The specimen's warnings as a JSON array of strings (a new reference; [] when none). */
+json_t *gpd_warnings_2d(const gp_specimen2d *s);
 
 /* A double as JSON: a real, or null when not finite. */
 json_t *gpd_jreal(double x);

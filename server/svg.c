@@ -786,7 +786,9 @@ static frame hist_frame(double x0, double y0, double w, double h, const hist *hs
     return f;
 }
 
-static char *view_size(const json_t *res, int width, size_t *len, int *status, char *eb, size_t el)
+/* the size view as histograms (results without stats.fit) */
+static char *view_size_hist(const json_t *res, int width, size_t *len, int *status, char *eb,
+                            size_t el)
 {
     const json_t *stats = json_object_get(res, "stats");
     hist h;
@@ -836,6 +838,186 @@ static char *view_size(const json_t *res, int width, size_t *len, int *status, c
     doc_end(&s);
     hist_free(&h);
     return finish(&s, len, status, eb, el);
+}
+
+/* --- size view from stats.fit: the target law's CDF against the achieved one, per series --- */
+
+typedef struct cdf_series {
+    const char *name, *color;       /* "cells" / "grains" */
+    const char *law;
+    double *x, *target, *achieved;  /* n points, x increasing */
+    size_t n;
+    double ks, ks_critical, w1, cov, target_cov;
+} cdf_series;
+
+static void cdf_free(cdf_series *c)
+{
+    free(c->x);
+    free(c->target);
+    free(c->achieved);
+    c->x = c->target = c->achieved = NULL;
+    c->n = 0;
+}
+
+/* stats.fit.<key> with its "cdf" curves; 0 ok */
+static int cdf_read(const json_t *fit, const char *key, const char *name, const char *color,
+                    cdf_series *c)
+{
+    memset(c, 0, sizeof *c);
+    const json_t *b = json_object_get(fit, key), *cdf = json_object_get(b, "cdf");
+    size_t nt, na;
+    c->x = jarray(json_object_get(cdf, "x"), &c->n);
+    c->target = jarray(json_object_get(cdf, "target"), &nt);
+    c->achieved = jarray(json_object_get(cdf, "achieved"), &na);
+    if (!c->x || !c->target || !c->achieved || c->n < 2 || nt != c->n || na != c->n) {
+        cdf_free(c);
+        return -1;
+    }
+    c->name = name;
+    c->color = color;
+    c->law = json_string_value(json_object_get(b, "law"));
+    c->ks = jnum(json_object_get(b, "ks"), NAN);
+    c->ks_critical = jnum(json_object_get(b, "ks_critical"), NAN);
+    c->w1 = jnum(json_object_get(b, "w1"), NAN);
+    c->cov = jnum(json_object_get(json_object_get(b, "achieved"), "cov"), NAN);
+    c->target_cov = jnum(json_object_get(json_object_get(b, "target"), "cov"), NAN);
+    return 0;
+}
+
+/* the x range of the curves (positive values only when for_log) */
+static void cdf_range(const cdf_series *c, int n, int for_log, double *lo, double *hi)
+{
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (int k = 0; k < n; k++)
+        for (size_t i = 0; i < c[k].n; i++)
+            if (isfinite(c[k].x[i]) && (!for_log || c[k].x[i] > 0))
+                *lo = fmin(*lo, c[k].x[i]), *hi = fmax(*hi, c[k].x[i]);
+}
+
+/* one curve: the target dashed, the achieved solid (the empirical CDF at the same points: its
+ * jumps fall between them, so it is joined by lines as the target is) */
+static void cdf_path(sb *s, const frame *f, const cdf_series *c, int achieved)
+{
+    const double *y = achieved ? c->achieved : c->target;
+    sb_printf(s, "<path class=\"cdf-%s %s\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s d=\"",
+              achieved ? "achieved" : "target", c->name, c->color,
+              achieved ? "" : " stroke-dasharray=\"6 4\"");
+    int first = 1;
+    for (size_t i = 0; i < c->n; i++) {
+        if (!isfinite(c->x[i]) || !isfinite(y[i]) || (f->xlog && !(c->x[i] > 0))) continue;
+        double px = fx(f, c->x[i]), py = fy(f, fmax(0, fmin(1, y[i])));
+        sb_printf(s, "%s%.1f %.1f", first ? "M" : "L", px, py);
+        first = 0;
+    }
+    sb_puts(s, "\"/>\n");
+}
+
+/* "cells: KS 0.021 (5 % critical 0.061), W1 0.012, COV 0.79 (target 0.8)"; 1 when KS is over */
+static int fit_line(char *buf, size_t n, const cdf_series *c)
+{
+    int over = c->ks > c->ks_critical;
+    if (!isfinite(c->ks) || !isfinite(c->ks_critical)) {
+        snprintf(buf, n, "%s: KS not measured", c->name);
+        return 0;
+    }
+    int k = snprintf(buf, n, "%s: KS %.3g (5 %% critical %.3g)", c->name, c->ks, c->ks_critical);
+    if (k > 0 && (size_t)k < n && isfinite(c->w1))
+        k += snprintf(buf + k, n - (size_t)k, ", W1 %.3g", c->w1);
+    if (k > 0 && (size_t)k < n && isfinite(c->cov) && isfinite(c->target_cov))
+        k += snprintf(buf + k, n - (size_t)k, ", COV %.3g (target %.3g)", c->cov, c->target_cov);
+    if (k > 0 && (size_t)k < n && over)
+        snprintf(buf + k, n - (size_t)k, " -- above its critical value");
+    return over;
+}
+
+/* Draws (s != NULL) or counts the lines of the result's warnings, wrapped at maxch bytes on
+ * spaces (never inside a UTF-8 character), from baseline y, 16 px apart. */
+static int warning_lines(sb *s, const json_t *warnings, double x, double y, size_t maxch)
+{
+    int lines = 0;
+    size_t i;
+    const json_t *w;
+    json_array_foreach(warnings, i, w) {
+        const char *t = json_string_value(w);
+        for (int first = 1; t && *t; first = 0) {
+            size_t len = strlen(t), cut = len;
+            if (len > maxch) {
+                cut = maxch;
+                while (cut > maxch / 2 && t[cut] != ' ') cut--;
+                if (t[cut] != ' ') /* no space: cut a long word, at a character's start */
+                    for (cut = maxch; cut > 1 && ((unsigned char)t[cut] & 0xC0) == 0x80;) cut--;
+            }
+            if (s) {
+                char line[512];
+                snprintf(line, sizeof line, "%s%.*s", first ? "\xe2\x9a\xa0 warning: " : "",
+                         (int)(cut < 400 ? cut : 400), t);
+                text_at(s, first ? x : x + 18, y + 16 * lines, "start",
+                        "class=\"warning\" fill=\"#b35c00\" font-weight=\"bold\"", line);
+            }
+            lines++;
+            t += cut;
+            while (*t == ' ') t++;
+        }
+    }
+    return lines;
+}
+
+static char *view_size_fit(const json_t *res, cdf_series *c, int nc, int width, size_t *len,
+                           int *status, char *eb, size_t el)
+{
+    double lo, hi;
+    cdf_range(c, nc, 1, &lo, &hi);
+    int xlog = hi > 10 * lo && lo > 0;
+    if (!xlog) cdf_range(c, nc, 0, &lo, &hi);
+    if (!(hi > lo)) lo = isfinite(lo) ? lo - 0.5 : 0, hi = lo + 1;
+    const json_t *warnings = json_object_get(res, "warnings");
+    size_t maxch = (size_t)((width - 60) / 8 - 12); /* bold 12 px, after "⚠ warning: " */
+    int nwarn = warning_lines(NULL, warnings, 0, 0, maxch);
+    int plot_h = (int)lround(width * 0.62);
+    int height = plot_h + 10 + 16 * (nc + nwarn);
+    frame f = {80, 40, width - 110.0, plot_h - 110.0, lo, hi, 0, 1, xlog};
+    sb s = {0};
+    doc_begin(&s, width, height, "Size distribution: target law vs achieved (CDF)");
+    axes(&s, &f, xlog ? "area (m², log scale)" : "area (m²)", "cumulative fraction (by number)",
+         1);
+    legend_item it[4];
+    char names[4][64];
+    for (int k = 0; k < nc; k++) {
+        cdf_path(&s, &f, &c[k], 0);
+        cdf_path(&s, &f, &c[k], 1);
+        snprintf(names[2 * k], sizeof names[0], "%s: target (%s)", c[k].name,
+                 c[k].law ? c[k].law : "law");
+        snprintf(names[2 * k + 1], sizeof names[0], "%s: achieved", c[k].name);
+        it[2 * k] = (legend_item){names[2 * k], "dash", c[k].color};
+        it[2 * k + 1] = (legend_item){names[2 * k + 1], "line", c[k].color};
+    }
+    legend(&s, f.x0 + 10, f.y0 + 8, it, 2 * nc);
+    double y = plot_h + 6;
+    for (int k = 0; k < nc; k++, y += 16) {
+        char line[256];
+        int over = fit_line(line, sizeof line, &c[k]);
+        text_at(&s, 20, y, "start",
+                over ? "class=\"fit ks-over\" fill=\"#d62728\"" : "class=\"fit\"", line);
+    }
+    warning_lines(&s, warnings, 20, y, maxch);
+    doc_end(&s);
+    return finish(&s, len, status, eb, el);
+}
+
+/* the size view: CDFs from stats.fit when the result has them, else histograms (results stored
+ * before stats.fit, or without it) */
+static char *view_size(const json_t *res, int width, size_t *len, int *status, char *eb, size_t el)
+{
+    const json_t *fit = json_object_get(json_object_get(res, "stats"), "fit");
+    cdf_series c[2];
+    int nc = 0;
+    if (cdf_read(fit, "cell_area", "cells", "#1f77b4", &c[nc]) == 0) nc++;
+    if (cdf_read(fit, "grain_area", "grains", "#ff7f0e", &c[nc]) == 0) nc++;
+    if (!nc) return view_size_hist(res, width, len, status, eb, el);
+    char *svg = view_size_fit(res, c, nc, width, len, status, eb, el);
+    for (int k = 0; k < nc; k++) cdf_free(&c[k]);
+    return svg;
 }
 
 static char *view_orientation(const json_t *res, int width, size_t *len, int *status, char *eb,

@@ -21,11 +21,19 @@
  *                               "achieved": [k]}
  *     "descriptors": {"elongation":  {"mean": m, "edges": [k+1], "achieved": [k]},
  *                     "roundness":   {...}, "circularity": {...}, "regularity": {...}}
+ *     "fit": {"cell_area":  {"law", "ks", "ks_critical", "w1", "target": {"cov"},
+ *                            "achieved": {"cov"}, "cdf": {"x": [k], "target": [k],
+ *                            "achieved": [k]}},
+ *             "grain_area": the same (optional)}   (server/result_json.h)
  *   }
- *   (These mirror gp_hist in core/gp_specimen2d.h: "target" may be absent or null where there
- *   is no target; "counts" is accepted in place of "achieved".)
+ *   "warnings": ["one line", ...]    (optional; drawn under the size view)
+ *   (The histograms mirror gp_hist in core/gp_specimen2d.h: "target" may be absent or null
+ *   where there is no target; "counts" is accepted in place of "achieved".)
  *   Missing (absent or null) stats histograms are recomputed from grains[] / cells[] where
  *   possible (descriptors from grains[].descriptors).
+ *   The size view draws the CDFs of stats.fit (target law dashed, achieved solid, x in log
+ *   scale when it spans more than a decade, one KS line per series, then the warnings); a
+ *   result without them (stored before stats.fit) gets the histograms.
  *
  * 3D result
  *   "spheres": [[x,y,z,r],...] (m)                                        (api.md)

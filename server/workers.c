@@ -73,7 +73,7 @@ typedef struct run_ctx {
     double last_write;
 } run_ctx;
 
-/* detail: NULL = {} */
+/* detail: NULL = {} (taken) */
 static char *progress_text(const char *phase, double fraction, double eta, json_t *detail)
 {
     if (!detail) detail = json_object();
@@ -133,14 +133,14 @@ static void finish_failed(const char *id, const char *code, const char *msg)
 }
 
 /* Stores a result (takes r) and the export pack (takes pack, may be NULL) together with status
- * succeeded. Reals get 17 significant digits: the geometry reads back bit for bit, as in the
- * exports. */
-__attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r, void *pack,
-                                                     size_t pack_len)
+ * succeeded and the "done" progress (takes detail, NULL = {}). Reals get 17 significant digits:
+ * the geometry reads back bit for bit, as in the exports. */
+__attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r, json_t *detail,
+                                                     void *pack, size_t pack_len)
 {
     char *text = r ? json_dumps(r, JSON_COMPACT | JSON_REAL_PRECISION(17)) : NULL;
     json_decref(r);
-    char *prog = progress_text("done", 1.0, 0.0, NULL);
+    char *prog = progress_text("done", 1.0, 0.0, detail);
     if (!text || !prog) {
         finish_failed(ctx->id, "internal", "out of memory while serialising the result");
     } else {
@@ -173,6 +173,21 @@ __attribute__((unused)) static void finish_not_ok(run_ctx *ctx, gp_status st, co
              extra ? extra : "");
     finish_failed(ctx->id, gp_status_name(st), msg);
 }
+
+#ifdef GPD_HAVE_SPECIMEN2D
+/* The "done" detail of a 2D job: how the IMC ended, the warnings and the fit summary (stats.fit
+ * without its CDF curves), so that a poller of GET /v1/jobs/{id} sees them without the result. */
+__attribute__((unused)) static json_t *done_detail_2d(const char *id, const gp_specimen2d *s)
+{
+    json_t *w = gpd_warnings_2d(s);
+    for (size_t i = 0; i < json_array_size(w); i++)
+        gpd_log(GPD_LOG_WARN, "job %s: %s", id, json_string_value(json_array_get(w, i)));
+    return json_pack("{s:I, s:o, s:s, s:o, s:o}", "steps", (json_int_t)s->imc_steps, "error",
+                     gpd_jreal(s->imc_error), "stop_reason",
+                     s->imc_stop_reason ? s->imc_stop_reason : "", "warnings", w ? w : json_array(),
+                     "fit", gpd_fit_2d(&s->fit, 0));
+}
+#endif
 
 static void unavailable(const char *id, const char *kind)
 {
@@ -209,8 +224,9 @@ static void run_2d(slot *s, const char *id, json_t *spec_json)
             if (gp_export_pack_2d(out, &spec, GP_EXPORT_DEFAULT_DENSITY, &pack, &pack_len, &perr))
                 gpd_log(GPD_LOG_WARN, "job %s: no export pack: %s", id, perr.message);
         }
+        json_t *detail = done_detail_2d(id, out);
         gp_specimen2d_destroy(out);
-        finish_succeeded(&ctx, r, pack, pack_len);
+        finish_succeeded(&ctx, r, detail, pack, pack_len);
     } else {
         if (out) gp_specimen2d_destroy(out);
         finish_not_ok(&ctx, st, &err, NULL);
@@ -250,7 +266,7 @@ static void run_3d(slot *s, const char *id, json_t *spec_json)
                 gpd_log(GPD_LOG_WARN, "job %s: no export pack: %s", id, perr.message);
         }
         gp_specimen3d_destroy(out);
-        finish_succeeded(&ctx, r, pack, pack_len);
+        finish_succeeded(&ctx, r, NULL, pack, pack_len);
     } else {
         char extra[96] = "";
         if (out && out->stats.stop_reason)

@@ -1,6 +1,8 @@
 /* test_svg.c -- the SVG views of a hand-made 2D and 3D result: well-formed XML, one
  * <polygon>/<circle> per grain, cell part, seed or cut sphere, axes and labels, errors for
- * unknown views and missing parts, and a 10,000-grain packing drawn quickly and compactly. */
+ * unknown views and missing parts, and a 10,000-grain packing drawn quickly and compactly.
+ * The size view from stats.fit (CDF curves, KS lines, warnings), and stats.fit / warnings as
+ * server/result_json.c writes them from a specimen, drawn by the size view. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,6 +10,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "../server/result_json.c"
 #include "../server/svg.c"
 #include "gp_test.h"
 
@@ -295,6 +298,215 @@ static void test_3d(void)
     json_decref(r);
 }
 
+/* ---------------------------------------------------------------- size view from stats.fit */
+
+/* a stats.fit area block with a lognormal-like CDF of n points over [lo, hi] (median mid) */
+static json_t *fit_block(double lo, double hi, size_t n, double ks, double crit, int with_cdf)
+{
+    json_t *x = json_array(), *t = json_array(), *a = json_array();
+    double mid = sqrt(lo * hi), sg = log(hi / lo) / 6;
+    for (size_t i = 0; i < n; i++) {
+        double v = lo * pow(hi / lo, (double)i / (n - 1)), z = log(v / mid) / sg;
+        double F = 0.5 * erfc(-z / sqrt(2)), Fa = floor(F * 50 + 0.3) / 50;
+        json_array_append_new(x, json_real(v));
+        json_array_append_new(t, json_real(F));
+        json_array_append_new(a, json_real(Fa > 1 ? 1 : Fa));
+    }
+    json_t *b = json_pack("{s:s, s:{s:f, s:f}, s:{s:f, s:f}, s:f, s:f, s:f, s:i}", "law",
+                          "lognormal", "target", "mean", mid, "cov", 0.8, "achieved", "mean",
+                          mid * 1.01, "cov", 0.79, "ks", ks, "ks_critical", crit, "w1", 0.012,
+                          "n", 500);
+    if (with_cdf)
+        json_object_set_new(b, "cdf", json_pack("{s:o, s:o, s:o}", "x", x, "target", t, "achieved", a));
+    else
+        json_decref(x), json_decref(t), json_decref(a);
+    return b;
+}
+
+/* the d="..." of the first <path> with this class, or NULL */
+static const char *path_d(const char *svg, const char *cls)
+{
+    char key[96];
+    snprintf(key, sizeof key, "class=\"%s\"", cls);
+    const char *p = strstr(svg, key);
+    return p ? strstr(p, " d=\"") : NULL;
+}
+
+static void test_size_fit(void)
+{
+    json_error_t e;
+    json_t *r = json_loads(RESULT_2D, 0, &e);
+    json_t *st = json_object_get(r, "stats");
+    json_object_set_new(st, "fit", json_pack("{s:o, s:o}", "cell_area",
+                                             fit_block(5e-4, 2e-2, 60, 0.021, 0.061, 1),
+                                             "grain_area",
+                                             fit_block(3e-4, 1.3e-2, 60, 0.09, 0.061, 1)));
+    json_object_set_new(r, "warnings",
+                        json_pack("[s, s]", "IMC stopped at max_steps: error 0.31 > threshold 0.05",
+                                  "grain_area: KS 0.09 is above its 5 % critical value 0.061 "
+                                  "(N = 500); the grains do not follow the lognormal law as asked, "
+                                  "see stats.fit.grain_area for the achieved mean and COV"));
+    size_t len;
+    int status;
+    char err[256];
+    char *s = render(r, NULL, "size", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(status == 200);
+    if (!s) return;
+    /* four curves: target (dashed) and achieved for cells and grains, 60 points each */
+    static const char *cls[4] = {"cdf-target cells", "cdf-achieved cells", "cdf-target grains",
+                                 "cdf-achieved grains"};
+    for (int k = 0; k < 4; k++) {
+        const char *d = path_d(s, cls[k]);
+        CHECK(d != NULL);
+        if (!d) continue;
+        const char *end = strchr(d + 4, '"');
+        size_t segs = 0;
+        for (const char *q = d + 4; q < end; q++) segs += *q == 'L';
+        CHECK(segs == 59);
+        /* a CDF rises: the last point is drawn higher (smaller pixel y) than the first */
+        double x0, y0, x1, y1;
+        CHECK(sscanf(d + 5, "%lf %lf", &x0, &y0) == 2);
+        const char *last = end;
+        while (last > d && *last != 'L') last--;
+        CHECK(sscanf(last + 1, "%lf %lf", &x1, &y1) == 2 && x1 > x0 && y1 < y0 - 100);
+    }
+    CHECK(count(s, "stroke-dasharray=\"6 4\"") == 2);
+    /* the legend and the KS lines, the grains' one marked as over its critical value */
+    CHECK(strstr(s, "cells: target (lognormal)") && strstr(s, "grains: achieved"));
+    CHECK(strstr(s, "cells: KS 0.021 (5 % critical 0.061)") != NULL);
+    CHECK(strstr(s, "grains: KS 0.09 (5 % critical 0.061)") != NULL);
+    CHECK(count(s, "ks-over") == 1);
+    CHECK(strstr(s, "COV 0.79 (target 0.8)") != NULL);
+    /* log axis: the areas span more than a decade */
+    CHECK(strstr(s, "area (m², log scale)") != NULL);
+    /* the warnings, the long one wrapped */
+    CHECK(strstr(s, "IMC stopped at max_steps: error 0.31 &gt; threshold 0.05") != NULL);
+    CHECK(count(s, "class=\"warning\"") >= 3);
+    CHECK(strstr(s, "warning: IMC stopped") != NULL);
+    /* the histograms are not drawn */
+    CHECK(strstr(s, "fraction of cells") == NULL);
+    free(s);
+
+    /* no warnings, no grains, a narrow range: no warning line, linear axis, two curves */
+    json_object_set_new(r, "warnings", json_array());
+    json_object_del(json_object_get(st, "fit"), "grain_area");
+    json_object_set_new(json_object_get(st, "fit"), "cell_area", fit_block(1e-3, 4e-3, 30, 0.021, 0.061, 1));
+    s = render(r, NULL, "size", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && !strstr(s, "class=\"warning\"") && !strstr(s, "log scale"));
+    CHECK(s && strstr(s, "class=\"cdf-achieved cells\"") && !strstr(s, "grains"));
+    CHECK(s && strstr(s, "cells: KS 0.021 (5 % critical 0.061)") && !strstr(s, "ks-over"));
+    free(s);
+
+    /* a fit without its curves (or none at all, an old result): the histograms */
+    json_object_set_new(json_object_get(st, "fit"), "cell_area", fit_block(1e-3, 4e-3, 30, 0.021, 0.061, 0));
+    s = render(r, NULL, "size", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && strstr(s, "target (lognormal)") && strstr(s, "fraction of cells") && !strstr(s, "cdf-"));
+    free(s);
+    json_decref(r);
+}
+
+/* ------------------------------------------- stats.fit and warnings as result_json.c writes them */
+
+static const char *const FIT_KEYS[] = {"law", "target", "achieved", "ks", "ks_critical", "w1",
+                                       "n", "range", "cdf"};
+
+static void check_area_block(const json_t *b, int with_cdf)
+{
+    CHECK(json_is_object(b));
+    for (size_t i = 0; i < sizeof FIT_KEYS / sizeof *FIT_KEYS - 1; i++)
+        CHECK(json_object_get(b, FIT_KEYS[i]) != NULL);
+    CHECK(json_object_size(b) == sizeof FIT_KEYS / sizeof *FIT_KEYS - !with_cdf);
+    CHECK(!strcmp(json_string_value(json_object_get(b, "law")), "lognormal"));
+    CHECK_NEAR(json_number_value(json_object_get(json_object_get(b, "target"), "cov")), 0.8, 0);
+    CHECK_NEAR(json_number_value(json_object_get(json_object_get(b, "achieved"), "mean")), 2.02e-3, 0);
+    CHECK_NEAR(json_number_value(json_object_get(b, "ks_critical")), 0.061, 0);
+    CHECK(json_integer_value(json_object_get(b, "n")) == 500);
+    const json_t *rg = json_object_get(b, "range");
+    CHECK(json_array_size(json_object_get(rg, "achieved")) == 2);
+    CHECK_NEAR(json_number_value(json_array_get(json_object_get(rg, "target_p001_p999"), 1)), 9e-3, 0);
+    const json_t *cdf = json_object_get(b, "cdf");
+    if (with_cdf)
+        CHECK(json_array_size(json_object_get(cdf, "x")) == 3 &&
+              json_array_size(json_object_get(cdf, "target")) == 3 &&
+              json_array_size(json_object_get(cdf, "achieved")) == 3);
+}
+
+static void test_result_fit(void)
+{
+    static double x[3] = {1e-3, 2e-3, 4e-3}, ft[3] = {0.2, 0.5, 0.8}, fa[3] = {0.25, 0.5, 0.75};
+    static double d[2] = {0.02, 0.05}, pt[2] = {10, 100}, pa[2] = {13.1, 100};
+    char *warn[1] = {"IMC stopped at max_steps: error 0.31 > threshold 0.05"};
+    gp_specimen2d s;
+    memset(&s, 0, sizeof s);
+    s.fit.cell_area = (gp_fit_area){.present = 1, .law = GP_LAW_LOGNORMAL, .target_mean = 2e-3,
+                                    .target_cov = 0.8, .mean = 2.02e-3, .cov = 0.79, .ks = 0.021,
+                                    .ks_critical = 0.061, .w1 = 0.012, .min = 2e-4, .max = 1.1e-2,
+                                    .q001 = 1e-4, .q999 = 9e-3, .n = 500, .ncurve = 3,
+                                    .curve_x = x, .curve_target = ft, .curve_achieved = fa};
+    s.fit.cell_orientation = (gp_fit_orient){.present = 1, .target_mean_deg = 30,
+                                             .target_anisotropy = 0.5, .ks = 0.03,
+                                             .ks_critical = 0.061, .n = 500};
+    s.fit.grain_area.present = 0; /* e.g. no grains computed: the block is left out */
+    s.warnings = warn;
+    s.nwarnings = 1;
+    s.imc_error_kind = "AD";
+    s.imc_threshold = 0.05;
+    s.imc_error = 0.31;
+    s.imc_stop_reason = "max_steps";
+    gp_spec2d spec;
+    memset(&spec, 0, sizeof spec);
+    spec.particles = 500;
+    spec.imc_error = GP_IMC_E3; /* the core's string wins */
+    json_t *sj = json_object();
+    json_t *r = gpd_result_2d(&s, &spec, sj);
+    CHECK(r != NULL);
+    const json_t *st = json_object_get(r, "stats"), *fit = json_object_get(st, "fit");
+    CHECK(json_is_object(fit) && json_object_size(fit) == 2);
+    check_area_block(json_object_get(fit, "cell_area"), 1);
+    const json_t *o = json_object_get(fit, "cell_orientation");
+    CHECK(json_object_size(o) == 4 && json_object_get(o, "ks") && json_object_get(o, "n"));
+    CHECK_NEAR(json_number_value(json_object_get(json_object_get(o, "target"), "mean_deg")), 30, 0);
+    CHECK_NEAR(json_number_value(json_object_get(json_object_get(o, "target"), "anisotropy")), 0.5, 0);
+    CHECK(!json_object_get(fit, "grain_area") && !json_object_get(fit, "passing"));
+    const json_t *ie = json_object_get(st, "imc_error");
+    CHECK(!strcmp(json_string_value(json_object_get(ie, "measure")), "AD"));
+    CHECK_NEAR(json_number_value(json_object_get(ie, "target")), 0.05, 0);
+    CHECK(!strcmp(json_string_value(json_object_get(ie, "stop_reason")), "max_steps"));
+    const json_t *w = json_object_get(r, "warnings");
+    CHECK(json_array_size(w) == 1 && !strcmp(json_string_value(json_array_get(w, 0)), warn[0]));
+
+    /* drawn by the size view: one series, its KS line and the warning */
+    size_t len;
+    int status;
+    char err[256];
+    char *svg = render(r, NULL, "size", NULL, &len, &status, err);
+    check_common(svg, len);
+    CHECK(svg && strstr(svg, "class=\"cdf-target cells\"") && strstr(svg, "class=\"cdf-achieved cells\""));
+    CHECK(svg && strstr(svg, "cells: KS 0.021 (5 % critical 0.061)") && !strstr(svg, "grains"));
+    CHECK(svg && strstr(svg, "error 0.31 &gt; threshold 0.05"));
+    free(svg);
+    json_decref(r);
+
+    /* the compact summary of a job's progress: no curves; a sieve adds passing; no warnings: [] */
+    s.fit.passing = (gp_fit_passing){.n = 2, .diameters = d, .target = pt, .achieved = pa,
+                                     .max_error_pp = 3.1};
+    json_t *f = gpd_fit_2d(&s.fit, 0);
+    check_area_block(json_object_get(f, "cell_area"), 0);
+    const json_t *p = json_object_get(f, "passing");
+    CHECK(json_object_size(p) == 4 && json_array_size(json_object_get(p, "achieved")) == 2);
+    CHECK_NEAR(json_number_value(json_object_get(p, "max_error_pp")), 3.1, 0);
+    json_decref(f);
+    s.nwarnings = 0;
+    s.warnings = NULL;
+    r = gpd_result_2d(&s, &spec, sj);
+    CHECK(json_is_array(json_object_get(r, "warnings")) && json_array_size(json_object_get(r, "warnings")) == 0);
+    json_decref(r);
+    json_decref(sj);
+}
+
 /* 10,000 grains of 128 points: fast and bounded */
 static void test_large(void)
 {
@@ -333,6 +545,8 @@ static void test_large(void)
 int main(void)
 {
     test_2d();
+    test_size_fit();
+    test_result_fit();
     test_3d();
     test_large();
     return gp_test_summary();
