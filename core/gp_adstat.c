@@ -236,3 +236,119 @@ double gp_adstat_floor(size_t n)
     }
     return -N - sum / N;
 }
+
+/* elements of the tree strictly below (key, id) -- the element id itself excluded -- and the
+ * w-sum of those strictly above */
+static void rank_query(const gp_adstat *s, double key, size_t id, size_t *below, double *above)
+{
+    const node *t = s->t;
+    size_t c = 0, x = s->root;
+    double a = 0.0;
+    while (x != NIL) {
+        size_t l = t[x].left, r = t[x].right;
+        if (x == id && t[x].u == key) {
+            c += l != NIL ? t[l].cnt : 0;
+            a += r != NIL ? t[r].sw : 0.0;
+            break;
+        }
+        if (less(t, x, key, id)) {
+            c += (l != NIL ? t[l].cnt : 0) + 1;
+            x = r;
+        } else {
+            a += t[x].w + (r != NIL ? t[r].sw : 0.0);
+            x = l;
+        }
+    }
+    *below = c;
+    *above = a;
+}
+
+static int key_less(double ua, size_t ia, double ub, size_t ib)
+{
+    return ua < ub || (ua == ub && ia < ib);
+}
+
+/* one side of a change (the k old or the k new values), sorted by key */
+typedef struct side {
+    size_t k;
+    double key[GP_ADSTAT_IF_MAX], w[GP_ADSTAT_IF_MAX], wcum[GP_ADSTAT_IF_MAX + 1];
+    size_t id[GP_ADSTAT_IF_MAX];
+} side;
+
+static void side_sort(side *sd, size_t k, const size_t *ids, const double *key, const double *w)
+{
+    sd->k = k;
+    for (size_t i = 0; i < k; i++) { /* insertion sort: a few dozen at most */
+        size_t j = i;
+        while (j > 0 && key_less(key[i], ids[i], sd->key[j - 1], sd->id[j - 1])) {
+            sd->key[j] = sd->key[j - 1];
+            sd->id[j] = sd->id[j - 1];
+            sd->w[j] = sd->w[j - 1];
+            j--;
+        }
+        sd->key[j] = key[i];
+        sd->id[j] = ids[i];
+        sd->w[j] = w[i];
+    }
+    sd->wcum[0] = 0.0;
+    for (size_t i = 0; i < k; i++) sd->wcum[i + 1] = sd->wcum[i] + sd->w[i];
+}
+
+/* elements of the side strictly below (key, id) */
+static size_t side_below(const side *sd, double key, size_t id)
+{
+    size_t lo = 0, hi = sd->k;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (key_less(sd->key[mid], sd->id[mid], key, id)) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* Sum over one side of count_base_below(z) w_z + wsum_base_above(z), plus the pairs inside the
+ * side (each pair counts the larger one's w), where the base is the tree without the old side:
+ * the tree's counts (rank_query) less the old elements strictly below / above z. */
+static double side_pairs(const gp_adstat *s, const side *sd, const side *old)
+{
+    double p = 0.0;
+    for (size_t i = 0; i < sd->k; i++) {
+        size_t below;
+        double above;
+        rank_query(s, sd->key[i], sd->id[i], &below, &above);
+        size_t ob = side_below(old, sd->key[i], sd->id[i]);
+        size_t oe = ob < old->k && old->key[ob] == sd->key[i] && old->id[ob] == sd->id[i] ? ob + 1 : ob;
+        below -= ob;
+        above -= old->wcum[old->k] - old->wcum[oe];
+        p += (double)below * sd->w[i] + above + (double)i * sd->w[i];
+    }
+    return p;
+}
+
+double gp_adstat_a2_if(const gp_adstat *s, size_t k, const size_t *ids, const double *key,
+                       const double *g, const double *h, const double *extra, double *sum_extra)
+{
+    size_t n = gp_adstat_count(s);
+    if (n == 0) return 0.0;
+    const node *t = s->t, *r = &t[s->root];
+    double ko[GP_ADSTAT_IF_MAX], wo[GP_ADSTAT_IF_MAX], wn[GP_ADSTAT_IF_MAX];
+    if (k > GP_ADSTAT_IF_MAX) return NAN;
+    side so, sn;
+    double dg = 0.0, dh = 0.0, dw = 0.0, dx = 0.0;
+    for (size_t i = 0; i < k; i++) {
+        const node *o = &t[ids[i]];
+        ko[i] = o->u;
+        wo[i] = o->w;
+        wn[i] = g[i] - h[i];
+        dg += g[i] - o->g;
+        dh += h[i] - o->h;
+        dw += wn[i] - o->w;
+        dx += extra[i] - o->x;
+    }
+    side_sort(&so, k, ids, ko, wo);
+    side_sort(&sn, k, ids, key, wn);
+    double dr = dw + side_pairs(s, &sn, &so) - side_pairs(s, &so, &so);
+    if (sum_extra) *sum_extra = r->sx + dx;
+    double N = (double)n;
+    return -N - (2.0 * (r->sr + dr) - (r->sg + dg) + (2.0 * N + 1.0) * (r->sh + dh)) / N;
+}

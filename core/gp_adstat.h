@@ -54,6 +54,18 @@ double gp_adstat_a2(const gp_adstat *s);
 /* Sum of `extra` over the elements present. */
 double gp_adstat_sum_extra(const gp_adstat *s);
 
+/* What A^2 and the sum of extras would be if the k distinct present elements ids[] took the
+ * keys, logs and extras given -- without changing the set. O(k log n + k^2): each element's
+ * count below and w-sum above are read from the tree as it is, and the pairs among the k old
+ * and the k new values are corrected directly. Equals gp_adstat_a2 after the change up to
+ * rounding (the sums are formed in another order). This is how a move is judged before it is
+ * made: most moves are refused, and refusing one then costs no change to the tree.
+ * k <= GP_ADSTAT_IF_MAX, else NAN. */
+#define GP_ADSTAT_IF_MAX 64
+double gp_adstat_a2_if(const gp_adstat *s, size_t k, const size_t *ids, const double *key,
+                       const double *g, const double *h, const double *extra,
+                       double *sum_extra);
+
 /* The least A^2 that n values can have. */
 double gp_adstat_floor(size_t n);
 

@@ -318,16 +318,16 @@ static void hist_errors(const imc_state *s, int kind, double *es, double *et)
  * with this term, 4 % low, which is the COV of the best possible sample of 500 (3.5 % low).
  * Both terms are least at the same specimen (the law's quantiles), so the term guides without
  * changing the goal. */
-static double cov_term(const imc_state *s)
+static double cov_term_of(const imc_state *s, double sum_sq)
 {
-    double n = (double)s->n, var = gp_adstat_sum_extra(s->ads) / n - s->mu * s->mu;
+    double n = (double)s->n, var = sum_sq / n - s->mu * s->mu;
     double c = sqrt(var > 0 ? var : 0) / s->mu, r = c / s->cov_q - 1.0;
     return n * r * r;
 }
 
 static void ad_errors(const imc_state *s, double *es, double *et)
 {
-    *es = gp_adstat_a2(s->ads) - s->ad_floor + cov_term(s);
+    *es = gp_adstat_a2(s->ads) - s->ad_floor + cov_term_of(s, gp_adstat_sum_extra(s->ads));
     *et = gp_adstat_a2(s->adt) - s->ad_floor;
 }
 
@@ -506,9 +506,42 @@ static gp_status check_params(const gp_vec2 *outer, size_t nouter, const gp_vec2
 typedef struct step_buf {
     size_t *nb;
     size_t nbcap;
+    size_t cap;                /* room of the arrays below, in changed cells */
     cell_val *undo;            /* the changed cells' contributions before the move */
-    size_t undocap;
+    cell_val *nv;              /* ... and after it */
+    size_t *ids;               /* gp_adstat_a2_if arguments */
+    double *sk, *sg, *sh, *sx, *tk, *tg, *th, *tx;
 } step_buf;
+
+static void step_buf_free(step_buf *b)
+{
+    free(b->nb);
+    free(b->undo);
+    free(b->nv);
+    free(b->ids);
+    double **d[8] = {&b->sk, &b->sg, &b->sh, &b->sx, &b->tk, &b->tg, &b->th, &b->tx};
+    for (int k = 0; k < 8; k++) free(*d[k]);
+}
+
+static int step_buf_grow(step_buf *b, size_t need)
+{
+    size_t c = need * 2;
+    cell_val *u = realloc(b->undo, c * sizeof *u);
+    if (u) b->undo = u;
+    cell_val *w = realloc(b->nv, c * sizeof *w);
+    if (w) b->nv = w;
+    size_t *id = realloc(b->ids, c * sizeof *id);
+    if (id) b->ids = id;
+    int ok = u && w && id;
+    double **d[8] = {&b->sk, &b->sg, &b->sh, &b->sx, &b->tk, &b->tg, &b->th, &b->tx};
+    for (int k = 0; k < 8; k++) {
+        double *x = realloc(*d[k], c * sizeof *x);
+        if (x) *d[k] = x;
+        ok = ok && x;
+    }
+    if (ok) b->cap = c;
+    return ok ? 0 : -1;
+}
 
 static double u01(void *r) { return gp_rng_uniform((gp_rng *)r); }
 
@@ -570,35 +603,63 @@ static int propose_ad(const gp_voronoi *v, gp_rng *rng, size_t n, step_buf *b, c
     return 0;
 }
 
+/* The objective the run would have with the changed cells' new contributions nv[], judged
+ * without changing the AD trees (gp_adstat_a2_if). */
+static objective evaluate_ad_if(const imc_state *S, const uint32_t *ch, size_t nch, const cell_val *nv,
+                                step_buf *b)
+{
+    for (size_t k = 0; k < nch; k++) {
+        b->ids[k] = ch[k];
+        b->sk[k] = nv[k].sk;
+        b->sg[k] = nv[k].sg;
+        b->sh[k] = nv[k].sh;
+        b->sx[k] = nv[k].sk * nv[k].sk;
+        b->tk[k] = nv[k].tk;
+        b->tg[k] = nv[k].tg;
+        b->th[k] = nv[k].th;
+        b->tx[k] = 0.0;
+    }
+    double sx;
+    double as = gp_adstat_a2_if(S->ads, nch, b->ids, b->sk, b->sg, b->sh, b->sx, &sx);
+    double at = gp_adstat_a2_if(S->adt, nch, b->ids, b->tk, b->tg, b->th, b->tx, NULL);
+    double es = as - S->ad_floor + cov_term_of(S, sx), et = at - S->ad_floor;
+    objective o = {es > et ? es : et, es + et, 0.0};
+    return o;
+}
+
 /* d5: move seed i to q, keep it if the objective does not get worse. Returns 1 accepted,
- * 0 rejected or skipped, -1 out of memory. */
+ * 0 rejected or skipped, -1 out of memory. For AD the move is judged before anything is
+ * changed (most moves are refused); E1-E3 change their integer counts and put them back. */
 static int try_step(imc_state *S, gp_voronoi *v, step_buf *b, size_t i, gp_vec2 q, objective *cur)
 {
     if (gp_voronoi_try_move(v, i, q, NULL) != GP_OK) return 0; /* duplicate / degenerate */
     const uint32_t *ch;
     size_t nch = gp_voronoi_changed(v, &ch);
-    if (nch > b->undocap) {
-        cell_val *t = realloc(b->undo, nch * 2 * sizeof *t);
-        if (!t) {
+    if (nch > b->cap) {
+        if (step_buf_grow(b, nch) != 0) {
             gp_voronoi_rollback(v);
             return -1;
         }
-        b->undo = t;
-        b->undocap = nch * 2;
     }
     for (size_t k = 0; k < nch; k++) {
-        cell_val c;
         cell_get(S, ch[k], &b->undo[k]);
-        cell_eval(S, v, ch[k], &c);
-        cell_put(S, ch[k], &c);
+        cell_eval(S, v, ch[k], &b->nv[k]);
     }
-    objective nw = evaluate(S);
+    int judged = S->kind == GP_IMC_ERROR_AD && nch <= GP_ADSTAT_IF_MAX;
+    objective nw;
+    if (judged) {
+        nw = evaluate_ad_if(S, ch, nch, b->nv, b);
+    } else {
+        for (size_t k = 0; k < nch; k++) cell_put(S, ch[k], &b->nv[k]);
+        nw = evaluate(S);
+    }
     if (not_worse(&nw, cur)) {
+        for (size_t k = 0; judged && k < nch; k++) cell_put(S, ch[k], &b->nv[k]);
         gp_voronoi_commit(v);
-        *cur = nw;
+        *cur = judged ? evaluate(S) : nw; /* the exact value of the trees as they now are */
         return 1;
     }
-    for (size_t k = nch; k-- > 0;) cell_put(S, ch[k], &b->undo[k]);
+    for (size_t k = nch; !judged && k-- > 0;) cell_put(S, ch[k], &b->undo[k]);
     gp_voronoi_rollback(v);
     return 0;
 }
@@ -636,7 +697,10 @@ static gp_status run_loop(imc_state *S, gp_voronoi *v, gp_rng *rng, const gp_imc
                           gp_imc_progress_fn progress, void *user, const volatile int *cancel,
                           objective *cur, run_out *ro, gp_error *err)
 {
-    step_buf b = {malloc(64 * sizeof(size_t)), 64, NULL, 0};
+    step_buf b;
+    memset(&b, 0, sizeof b);
+    b.nb = malloc(64 * sizeof(size_t));
+    b.nbcap = 64;
     gp_status st = b.nb ? GP_OK : gp_error_set(err, GP_ERR_NOMEM, "imc: out of memory");
     double best = cur->descent;
     long best_step = 0;
@@ -663,8 +727,7 @@ static gp_status run_loop(imc_state *S, gp_voronoi *v, gp_rng *rng, const gp_imc
         if (r < 0) st = gp_error_set(err, GP_ERR_NOMEM, "imc: out of memory");
         ro->accepted += r > 0;
     }
-    free(b.nb);
-    free(b.undo);
+    step_buf_free(&b);
     return st;
 }
 

@@ -263,8 +263,55 @@ static void test_ties(void)
     gp_adstat_destroy(s);
 }
 
+/* gp_adstat_a2_if: the A^2 a change would give, judged without making it, equals the A^2
+ * after making it -- for small moves, jumps across the set, unchanged elements in the batch,
+ * and batches of 1 to GP_ADSTAT_IF_MAX elements; the set is left untouched */
+static void test_a2_if(void)
+{
+    const size_t n = 500;
+    gp_adstat *s = gp_adstat_create(n, NULL);
+    mirror m = {n, calloc(n, sizeof(double)), calloc(n, sizeof(double)), calloc(n, sizeof(int))};
+    for (size_t i = 0; i < n; i++) put(s, &m, i, unif(), unif());
+    size_t ids[GP_ADSTAT_IF_MAX];
+    double key[GP_ADSTAT_IF_MAX], g[GP_ADSTAT_IF_MAX], h[GP_ADSTAT_IF_MAX], x[GP_ADSTAT_IF_MAX];
+    for (int round = 0; round < 400; round++) {
+        size_t k = 1 + below(GP_ADSTAT_IF_MAX);
+        for (size_t i = 0; i < k; i++) { /* distinct ids */
+            size_t id;
+            int dup;
+            do {
+                id = below(n);
+                dup = 0;
+                for (size_t j = 0; j < i; j++) dup |= ids[j] == id;
+            } while (dup);
+            ids[i] = id;
+            double u = round % 3 == 0 ? unif() : m.u[id] + 1e-3 * (unif() - 0.5);
+            if (i % 7 == 3) u = m.u[id]; /* unchanged */
+            u = fmin(fmax(u, 1e-9), 1 - 1e-9);
+            key[i] = u;
+            g[i] = log(u);
+            h[i] = log1p(-u);
+            x[i] = unif();
+        }
+        double before = gp_adstat_a2(s), sx = 0.0;
+        double judged = gp_adstat_a2_if(s, k, ids, key, g, h, x, &sx);
+        CHECK(gp_adstat_a2(s) == before);
+        for (size_t i = 0; i < k; i++) put(s, &m, ids[i], key[i], x[i]);
+        double after = gp_adstat_a2(s);
+        CHECK_NEAR(judged, after, 1e-9 * fabs(after) + 1e-10);
+        CHECK_NEAR(sx, gp_adstat_sum_extra(s), 1e-9);
+        check_against(s, &m);
+    }
+    CHECK(isnan(gp_adstat_a2_if(s, GP_ADSTAT_IF_MAX + 1, ids, key, g, h, x, NULL)));
+    free(m.u);
+    free(m.x);
+    free(m.on);
+    gp_adstat_destroy(s);
+}
+
 int main(void)
 {
+    test_a2_if();
     test_random_sets();
     test_bit_exact();
     test_floor();
