@@ -158,17 +158,19 @@ json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_
     if (c) json_object_set(r, "container", c);
 
     json_t *st = json_object();
+    /* achieved: the cells the IMC made (the grains, when they were asked for, are as many) */
     json_object_set_new(st, "particles",
                         json_pack("{s:I, s:I}", "target",
                                   (json_int_t)target_particles(s, spec), "achieved",
-                                  (json_int_t)s->ngrains));
+                                  (json_int_t)s->fit.cell_area.n));
     json_object_set_new(st, "imc_error", imc_error(s, spec));
     json_object_set_new(st, "imc_steps",
                         json_pack("{s:I, s:I}", "max", (json_int_t)spec->imc_max_steps,
                                   "achieved", (json_int_t)s->imc_steps));
+    /* without grains nothing was filled: achieved is null, not 0 */
     json_object_set_new(st, "solid_fraction",
                         json_pack("{s:o, s:o}", "target", gpd_jreal(spec->solid_fraction),
-                                  "achieved", gpd_jreal(s->solid_fraction)));
+                                  "achieved", s->ngrains ? gpd_jreal(s->solid_fraction) : json_null()));
     json_object_set_new(st, "container_area", gpd_jreal(s->container_area));
     json_object_set_new(st, "cells_target_met", json_integer((json_int_t)s->cells_target_met));
     json_object_set_new(st, "mean_orientation_gap_deg", gpd_jreal(s->mean_orientation_gap_deg));
