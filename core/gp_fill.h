@@ -1,20 +1,34 @@
 /* gp_fill.h -- fill one Voronoi cell with a Fourier grain to a target solid fraction
  * (Mollon & Zhao 2012, Sect. 4.1, Eq. 19).
  *
- * The grain is r(theta) = r0 (1 + sum_{n>=1} D_n cos(n theta - delta_n)) about a centre c,
- * sampled at Np equally spaced angles. The amplitudes D_n are the spectrum's; the phases
- * delta_2..delta_7 and r0 (and the centre) are optimised, the other phases are given by the
- * caller (random, from the cell's own reproducible stream).
+ * The grain is r(theta) = r0 (1 + sum_{n>=1} D_n cos(n (theta - phi) - delta_n)) about a
+ * centre c, sampled at Np equally spaced angles: the paper's curve turned by phi. The
+ * amplitudes D_n are the spectrum's; the phases delta_2..delta_7, r0, the centre and phi (a
+ * whole number of rays, so the contour's samples are the curve's own) are optimised; the
+ * other phases are the caller's (random, from the cell's own reproducible stream). Turning
+ * the grain only moves those random phases to delta_n + n phi, so it is the same shape.
  *
- * How the constraint is handled (why not a penalty): for fixed phases and centre, the
- * constraint r_i <= rmax_i at every ray gives the largest feasible r0 in closed form,
- *     r0max = min_i rmax_i / rho_i,   rho_i = 1 + sum_n D_n cos(n theta_i - delta_n),
- * and the grain area is r0^2 A(delta) with A the area of the unit-r0 polygon. So Eq. 19 is
- * solved exactly by maximising the achievable fraction f = r0max^2 A / S over the phases
- * (and the centre) with GSL's Nelder-Mead simplex, stopping as soon as f >= F_S, and then
- * setting r0 = sqrt(F_S S / A) -- no penalty weight to tune and never an infeasible answer.
- * The search starts from the phases of the DFT of the cell's own contour seen from the
- * centre, as the paper suggests, so the grain takes the cell's orientation.
+ * How the constraint is handled (why not a penalty): the grain polygon's area is r0^2 A with
+ * A a constant of the spectrum, so Eq. 19 is solved exactly by maximising the largest
+ * feasible r0 over the phases (stopping as soon as F_S is reachable) and then setting
+ * r0 = sqrt(F_S S / A) -- no penalty weight to tune and never an infeasible answer.
+ * - For fixed phases and centre, the paper's constraint r_i <= rmax_i at every ray gives
+ *   r0max = min_i rmax_i / rho_i, rho_i = 1 + sum_n D_n cos(n theta_i - delta_n).
+ * - In a convex cell (every Voronoi cell of a convex container) the polygon is inside iff
+ *   its vertices are, i.e. iff n_k . c + r0 s_k <= h_k for every edge (normal n_k, offset
+ *   h_k), s_k the grain's support along n_k: linear in (c, r0). So the best centre and r0 for
+ *   a shape are a 3-variable LP, solved exactly at every evaluation.
+ * The search, GSL's Nelder-Mead over the phases: (A) the paper's, from the phases of the DFT
+ * of the cell's contour seen from its centroid, with mode 2's axis on the cell's orientation
+ * (its minimum-caliper axis), so that the grain takes the cell's orientation; centre fixed
+ * there; most cells reach F_S here. Then in convex cells: (B) the same with the
+ * best centre for each shape; (C) the random modes turned under the cell-aligned modes
+ * 2..7 (phi); (D) for cells close to F_S, two random starts seeded from the caller's phases.
+ * A non-convex cell instead moves the centre inside the simplex (rays from it). A grain
+ * smaller than the largest is centred with the largest clearance to the cell's edges.
+ *
+ * What limits the fraction: a cell much longer than the grain can be (D_2 fixes the grain's
+ * elongation) cannot be filled to F_S; such cells get the largest grain found (target_met 0).
  *
  * The sampled-ray constraint alone does not keep a grain inside a non-convex cell (an edge
  * between two rays can cut a reflex corner), so the final polygon is checked for exact
@@ -34,8 +48,9 @@ typedef struct gp_fill_params {
     size_t nmodes;          /* modes used, <= contour_points / 2 */
     size_t contour_points;  /* Np >= 16 */
     double margin;          /* relative clearance from the cell boundary (default 1e-9) */
-    int optimise_centre;    /* also move the centre when the phases alone miss F_S (default 1) */
-    int max_evals;          /* Nelder-Mead evaluations per stage (default 400) */
+    int optimise_centre;    /* non-convex cells: also move the centre when the phases alone miss
+                             * F_S (default 1; convex cells always place the centre best) */
+    int max_evals;          /* Nelder-Mead evaluations per simplex run (default 400) */
 } gp_fill_params;
 
 void gp_fill_params_defaults(gp_fill_params *p);
@@ -50,6 +65,9 @@ typedef struct gp_fill_result {
     gp_vec2 centre;
     double r0;
     double phases[8];       /* delta_0..delta_7 as used (0 and 1 unused when D_1 = 0) */
+    double rotation;        /* phi (radians, a multiple of 2 pi / Np): the grain is the curve of
+                             * centre, r0, phases (and the caller's phases above 7) turned by
+                             * phi about the centre, i.e. its phases are delta_n + n phi */
     double area;            /* area of the grain polygon */
     double cell_area;
     double fraction;        /* area / cell_area */

@@ -1,7 +1,9 @@
 /* test_fill.c -- optimised cell filling (Mollon & Zhao 2012, Sect. 4.1, Eq. 19) against
- * analytic truths: the largest Np-gon of a circle grain inside a square and a hexagon,
- * exact hits of reachable targets, orientation following the cell, containment in a
- * non-convex cell, scale invariance, determinism and bad input. */
+ * analytic truths: the largest Np-gon of a circle grain inside a square, a hexagon, a
+ * triangle (off its centroid) and a 48-edge ellipse (the large-cell LP), exact hits of
+ * reachable targets, orientation following the cell, containment in a non-convex cell, the
+ * reported rotation and phases reproducing the contour, scale invariance, determinism (also
+ * across cells filled with one workspace) and bad input. */
 #include "gp_fill.h"
 #include "gp_geom.h"
 #include "gp_test.h"
@@ -41,6 +43,32 @@ static void phases_fixed(double *ph)
 }
 
 static double np_gon_area(double r) { return 0.5 * NP * r * r * sin(2 * M_PI / NP); }
+
+/* distance from q to the nearest edge line of the convex polygon p */
+static double edge_clearance(const gp_vec2 *p, size_t n, gp_vec2 q)
+{
+    double d = INFINITY;
+    for (size_t k = 0; k < n; k++)
+        d = fmin(d, gp_segment_distance(q, p[k], p[(k + 1) % n]));
+    return d;
+}
+
+/* largest |contour_i - curve_i| / r0 for the curve the result describes: the caller's
+ * phases with res->phases[2..7], turned by res->rotation */
+static double curve_mismatch(const gp_fill_result *r, const double *ph, const gp_vec2 *contour)
+{
+    double worst = 0.0;
+    for (int i = 0; i < NP; i++) {
+        double th = 2 * M_PI * i / NP, rho = 1.0;
+        for (int n = 1; n < NP / 2; n++) {
+            double delta = (n >= 2 && n <= 7) ? r->phases[n] : ph[n];
+            rho += D[n] * cos(n * (th - r->rotation) - delta);
+        }
+        double x = r->centre.x + r->r0 * rho * cos(th), y = r->centre.y + r->r0 * rho * sin(th);
+        worst = fmax(worst, hypot(x - contour[i].x, y - contour[i].y) / r->r0);
+    }
+    return worst;
+}
 
 static void rect(gp_vec2 *p, double w, double h, double ang, double cx, double cy)
 {
@@ -146,7 +174,64 @@ int main(void)
     CHECK(memcmp(contour, c2, sizeof c2) == 0);
     gp_fill_workspace_destroy(ws);
 
-    /* 8. bad input: errors, no crash */
+    /* 8. circle grain in a flat triangle: the largest is centred on the incentre, not the
+     * centroid (r_in = 2 S / perimeter = 0.457 against the centroid's clearance 1/3); an
+     * Np-gon of circumradius R fits only if R cos(pi / Np) <= r_in */
+    gp_vec2 flat[3] = {{0, 0}, {4, 0}, {0.5, 1}};
+    gp_vec2 cen = {1.5, 1.0 / 3};
+    double per = 0, S = gp_poly_area(flat, 3);
+    for (int k = 0; k < 3; k++)
+        per += hypot(flat[(k + 1) % 3].x - flat[k].x, flat[(k + 1) % 3].y - flat[k].y);
+    double rin = 2 * S / per;
+    ws = make(0.99, 0, 0, 0, 1);
+    CHECK(gp_fill_cell(ws, flat, 3, ph, contour, &r, &e) == GP_OK);
+    CHECK(r.fraction >= np_gon_area(rin) / S * (1 - 1e-8));
+    CHECK(r.fraction <= np_gon_area(rin / cos(M_PI / NP)) / S);
+    CHECK(r.fraction > 1.4 * np_gon_area(edge_clearance(flat, 3, cen)) / S);
+    CHECK(gp_poly_inside_poly(contour, NP, flat, 3));
+    gp_fill_workspace_destroy(ws);
+
+    /* 9. a 48-edge polygonised ellipse (semi-axes 2, 1), solved by the large-cell LP: the
+     * largest circle grain is the disc of the centre's clearance, within the strip of width 2 */
+    gp_vec2 ell[48];
+    for (int k = 0; k < 48; k++) {
+        ell[k].x = 5 + 2 * cos(2 * M_PI * k / 48);
+        ell[k].y = 3 + sin(2 * M_PI * k / 48);
+    }
+    double Se = gp_poly_area(ell, 48), dmin = edge_clearance(ell, 48, (gp_vec2){5, 3});
+    ws = make(0.99, 0, 0, 0, 1);
+    CHECK(gp_fill_cell(ws, ell, 48, ph, contour, &r, &e) == GP_OK);
+    CHECK(r.fraction >= np_gon_area(dmin) / Se * (1 - 1e-8));
+    CHECK(r.fraction <= np_gon_area(1 / cos(M_PI / NP)) / Se);
+    CHECK(gp_poly_inside_poly(contour, NP, ell, 48));
+    gp_fill_workspace_destroy(ws);
+
+    /* 10. the result describes the grain: the curve of centre, r0 and the phases (the
+     * optimised ones, the caller's above 7) turned by `rotation` is the contour. Elongated
+     * cells with a rough spectrum miss F_S, so the search also turns the roughness. */
+    ws = make(0.65, 0.1, 0.06, 0.03, 1);
+    int turned = 0;
+    for (int deg = 0; deg < 180; deg += 20) {
+        gp_vec2 rc[4];
+        rect(rc, 2.5, 1, deg * M_PI / 180, 1, 2);
+        CHECK(gp_fill_cell(ws, rc, 4, ph, contour, &r, &e) == GP_OK);
+        CHECK(curve_mismatch(&r, ph, contour) < 1e-9);
+        CHECK(gp_poly_inside_poly(contour, NP, rc, 4));
+        turned += r.rotation != 0.0;
+    }
+    CHECK(turned > 0);
+
+    /* 11. one workspace, several cells: a cell's grain does not depend on the ones before */
+    gp_vec2 first[NP];
+    CHECK(gp_fill_cell(ws, tri, 3, ph, first, &r1, &e) == GP_OK);
+    CHECK(gp_fill_cell(ws, ell, 48, ph, contour, &r, &e) == GP_OK);
+    CHECK(gp_fill_cell(ws, L, 6, ph, contour, &r, &e) == GP_OK);
+    CHECK(gp_fill_cell(ws, tri, 3, ph, contour, &r2, &e) == GP_OK);
+    CHECK(memcmp(first, contour, sizeof first) == 0);
+    CHECK(r1.evals == r2.evals && r1.rotation == r2.rotation);
+    gp_fill_workspace_destroy(ws);
+
+    /* 12. bad input: errors, no crash */
     ws = make(0.65, 0.1, 0.05, 0.02, 1);
     gp_vec2 line[3] = {{0, 0}, {1, 1}, {2, 2}};
     CHECK(gp_fill_cell(ws, line, 3, ph, contour, &r, &e) == GP_ERR_DEGENERATE);
