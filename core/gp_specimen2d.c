@@ -230,6 +230,8 @@ typedef struct fill_job {
     size_t nmodes, np;
     unsigned outputs;
     double fill_fraction;      /* what pass A fills each cell to */
+    const size_t *subset;      /* pass A on these cells only (a refill), or NULL: all */
+    size_t nsubset;
     gp_specimen2d *out;
     gp_vec2 **cell_poly;       /* per cell: the seed's part (owned here) */
     size_t *cell_n;
@@ -269,43 +271,52 @@ static gp_status cell_phases(const fill_job *j, size_t i, double *phases, gp_err
     return st;
 }
 
-/* pass A: the grain of cell i, filled to j->fill_fraction */
-static void fill_one(fill_job *j, gp_fill_workspace *ws, double *phases, size_t i, double *tf)
+/* pass A: the grain of cell i, filled to j->fill_fraction into scratch; kept when it is the
+ * first grain of the cell or larger than the one it has (a refill aims higher, and where it
+ * cannot get there its search may end below the grain already found) */
+static void fill_one(fill_job *j, gp_fill_workspace *ws, double *phases, gp_vec2 *scratch, size_t i,
+                     double *tf)
 {
     gp_error e;
     gp_error_clear(&e);
     gp_grain2d *g = &j->out->grains[i];
-    g->cell = i;
-    g->ncontour = j->np;
-    g->contour = malloc(j->np * sizeof *g->contour);
     if (!g->contour) {
-        gp_error_set(&e, GP_ERR_NOMEM, "out of memory");
-        job_fail(j, i, &e);
-        return;
+        g->cell = i;
+        g->ncontour = j->np;
+        g->contour = malloc(j->np * sizeof *g->contour);
+        if (!g->contour) {
+            gp_error_set(&e, GP_ERR_NOMEM, "out of memory");
+            job_fail(j, i, &e);
+            return;
+        }
+        g->area = -1.0;
     }
     double t0 = now_s();
     gp_fill_result fr;
     gp_status st = cell_phases(j, i, phases, &e);
     if (st == GP_OK)
-        st = gp_fill_cell(ws, j->cell_poly[i], j->cell_n[i], phases, g->contour, &fr, &e);
+        st = gp_fill_cell(ws, j->cell_poly[i], j->cell_n[i], phases, scratch, &fr, &e);
     if (st != GP_OK) {
         gp_error tmp = e;
         gp_error_set(&e, st, "cell %zu: %s", i, tmp.message);
         job_fail(j, i, &e);
         return;
     }
-    double cell_area = gp_voronoi_cell_area(j->vor, i);
-    g->area = fr.area;
-    g->cell_fraction = cell_area > 0.0 ? fr.area / cell_area : 0.0;
-    g->target_met = g->cell_fraction >= j->spec->solid_fraction * (1.0 - 1e-9);
-    double w, ang, len;
-    g->orientation_deg = gp_min_caliper(g->contour, g->ncontour, &w, &ang, &len, NULL) == GP_OK
-                             ? ang * DEG : 0.0;
-    grain_curve *c = &j->curve[i];
-    c->centre = fr.centre;
-    c->r0 = fr.r0;
-    for (size_t k = 2; k < 8; k++)
-        c->phases27[k - 2] = fr.phases[k];
+    if (fr.area > g->area) {
+        memcpy(g->contour, scratch, j->np * sizeof *scratch);
+        double cell_area = gp_voronoi_cell_area(j->vor, i);
+        g->area = fr.area;
+        g->cell_fraction = cell_area > 0.0 ? fr.area / cell_area : 0.0;
+        g->target_met = g->cell_fraction >= j->spec->solid_fraction * (1.0 - 1e-9);
+        double w, ang, len;
+        g->orientation_deg = gp_min_caliper(g->contour, g->ncontour, &w, &ang, &len, NULL) == GP_OK
+                                 ? ang * DEG : 0.0;
+        grain_curve *c = &j->curve[i];
+        c->centre = fr.centre;
+        c->r0 = fr.r0;
+        for (size_t k = 2; k < 8; k++)
+            c->phases27[k - 2] = fr.phases[k];
+    }
     *tf += now_s() - t0;
 }
 
@@ -408,29 +419,33 @@ static void *fill_worker(void *p)
     fp.contour_points = j->np;
     gp_fill_workspace *ws = j->pass == PASS_FILL ? gp_fill_workspace_create(&fp, &a->err) : NULL;
     double *phases = malloc(j->nmodes * sizeof(double));
-    if ((j->pass == PASS_FILL && !ws) || !phases) {
+    gp_vec2 *scratch = malloc(j->np * sizeof *scratch);
+    if ((j->pass == PASS_FILL && !ws) || !phases || !scratch) {
         if (ws || j->pass != PASS_FILL)
             gp_error_set(&a->err, GP_ERR_NOMEM, "out of memory");
         job_fail(j, 0, &a->err);
         gp_fill_workspace_destroy(ws);
         free(phases);
+        free(scratch);
         return NULL;
     }
-    size_t n = j->out->ngrains;
+    size_t n = j->subset ? j->nsubset : j->out->ngrains;
     for (;;) {
         if (atomic_load(&j->stop))
             break;
-        size_t i = atomic_fetch_add(&j->next, 1);
-        if (i >= n)
+        size_t k = atomic_fetch_add(&j->next, 1);
+        if (k >= n)
             break;
+        size_t i = j->subset ? j->subset[k] : k;
         if (j->pass == PASS_FILL)
-            fill_one(j, ws, phases, i, &a->tf);
+            fill_one(j, ws, phases, scratch, i, &a->tf);
         else
             finish_one(j, phases, i, &a->to, &a->td);
         atomic_fetch_add(&j->done, 1);
     }
     gp_fill_workspace_destroy(ws);
     free(phases);
+    free(scratch);
     return NULL;
 }
 
@@ -439,7 +454,7 @@ static void *fill_worker(void *p)
 static gp_status run_pass(fill_job *job, int pass, double f0, double f1, gp_progress_fn progress,
                           void *user, const volatile int *cancel, gp_error *err)
 {
-    size_t n = job->out->ngrains;
+    size_t n = pass == PASS_FILL && job->subset ? job->nsubset : job->out->ngrains;
     job->pass = pass;
     atomic_store(&job->next, 0);
     atomic_store(&job->done, 0);
@@ -922,6 +937,50 @@ static void job_free(fill_job *job, size_t n)
     free((double *)job->D);
 }
 
+/* solid_fraction is the specimen's (api.md: stats.solid_fraction is the whole container's),
+ * and some cells -- mostly slivers -- cannot hold a grain of that fraction (the paper's §5:
+ * Example 1 comes out at 0.635 for 0.65, and it advises asking for a little more). So the
+ * shortfall is handed to the cells that did reach their target: they are refilled, all to one
+ * higher fraction chosen so that the total makes up the difference, at most twice. Measured on
+ * Example 1 (seeds 1-8): 0.616-0.627 after the first fill, 0.650 after the refills, about 1.7x
+ * the fill time. Cells keep the larger of their grains, so a refill never loses area. */
+#define REFILL_PASSES 2
+
+static gp_status refill(build_ctx *b, fill_job *job, gp_error *err)
+{
+    const gp_spec2d *spec = b->spec;
+    size_t n = b->n, *met = malloc(n * sizeof *met);
+    if (!met)
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    double goal = spec->solid_fraction * b->out->container_area * (1.0 - 1e-6);
+    double target = spec->solid_fraction;
+    gp_status st = GP_OK;
+    for (int pass = 0; pass < REFILL_PASSES && st == GP_OK; pass++) {
+        double total = 0.0, met_cells = 0.0, met_grains = 0.0;
+        size_t nmet = 0;
+        for (size_t i = 0; i < n; i++) {
+            const gp_grain2d *g = &b->out->grains[i];
+            double c = gp_voronoi_cell_area(b->vor, i);
+            total += g->area;
+            if (g->area >= target * c * (1.0 - 1e-9)) {
+                met[nmet++] = i;
+                met_cells += c;
+                met_grains += g->area;
+            }
+        }
+        if (total >= goal || nmet == 0)
+            break;
+        target = fmin(1.0, (met_grains + goal - total) / met_cells);
+        job->fill_fraction = target;
+        job->subset = met;
+        job->nsubset = nmet;
+        st = run_pass(job, PASS_FILL, 0.8, 0.9, b->progress, b->user, b->cancel, err);
+    }
+    job->subset = NULL;
+    free(met);
+    return st;
+}
+
 /* Filling (pass A), the grain law's rank matching, then ODEC and descriptors (pass B). */
 static gp_status build_grains(build_ctx *b, gp_error *err)
 {
@@ -931,8 +990,10 @@ static gp_status build_grains(build_ctx *b, gp_error *err)
     double *scale = NULL;
     gp_status st = job_setup(b, &job, err);
     if (st == GP_OK)
-        st = run_pass(&job, PASS_FILL, 0.65, 0.9, b->progress, b->user, b->cancel, err);
+        st = run_pass(&job, PASS_FILL, 0.65, 0.8, b->progress, b->user, b->cancel, err);
     int on_grains = b->spec->size_of_grains || b->spec->size_law == GP_LAW_SIEVE;
+    if (st == GP_OK && !on_grains)
+        st = refill(b, &job, err);
     if (st == GP_OK && on_grains) {
         scale = malloc(b->n * sizeof *scale);
         st = scale ? rank_match(b, scale, err) : gp_error_set(err, GP_ERR_NOMEM, "out of memory");
