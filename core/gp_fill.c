@@ -539,14 +539,16 @@ static void unturn(const gp_fill_workspace *ws, const double *cellph, size_t rot
         ph[j] = remainder(cellph[j] - (double)(FIRST_OPT + j) * phi, 2.0 * M_PI);
 }
 
-/* Turns the roughness (the fixed modes) under the cell-aligned modes 2..7 of dft: the
- * rotation (every other ray) where that shape fits best. Leaves it in ws->rot and ph. */
-static void roughness_scan(gp_fill_workspace *ws, const double *dft, double *ph)
+/* The rotation (every other ray) where the shape fits best; leaves it in ws->rot. With dft,
+ * the roughness (the fixed modes) is turned under the cell-aligned modes 2..7 of dft at each
+ * rotation tried, and ph is left as that shape at the best one. */
+static void best_rotation(gp_fill_workspace *ws, const double *dft, double *ph)
 {
     size_t best_rot = 0;
     double best = -1.0;
     for (size_t r = 0; r < ws->np; r += 2) {
-        unturn(ws, dft, r, ph);
+        if (dft)
+            unturn(ws, dft, r, ph);
         ws->rot = r;
         double f = achievable(ws, ph);
         if (f > best) {
@@ -555,23 +557,8 @@ static void roughness_scan(gp_fill_workspace *ws, const double *dft, double *ph)
         }
     }
     ws->rot = best_rot;
-    unturn(ws, dft, best_rot, ph);
-}
-
-/* Best rotation (every other ray) for the shape ph; leaves it in ws->rot. */
-static void rotation_scan(gp_fill_workspace *ws, const double *ph)
-{
-    size_t best_rot = 0;
-    double best = -1.0;
-    for (size_t r = 0; r < ws->np; r += 2) {
-        ws->rot = r;
-        double f = achievable(ws, ph);
-        if (f > best) {
-            best = f;
-            best_rot = r;
-        }
-    }
-    ws->rot = best_rot;
+    if (dft)
+        unturn(ws, dft, best_rot, ph);
 }
 
 static uint64_t splitmix64(uint64_t *s)
@@ -622,14 +609,14 @@ static double search_convex(gp_fill_workspace *ws, const double *dft, candidate 
         keep_best(best, ph, 0, f);
     }
     if (best->f < target) {
-        roughness_scan(ws, dft, ph);
+        best_rotation(ws, dft, ph);
         f = polish(ws, ph, target, budget, FILL_RESTARTS);
         keep_best(best, ph, ws->rot, f);
     }
     for (int s = 0; s < RANDOM_STARTS && best->f < target && best->f >= CLOSE * target; s++) {
         for (int j = 0; j < NOPT; j++)
             ph[j] = (double)(splitmix64(&rs) >> 11) * 0x1p-53 * 2.0 * M_PI - M_PI;
-        rotation_scan(ws, ph);
+        best_rotation(ws, NULL, ph);
         f = polish(ws, ph, target, budget, FILL_RESTARTS);
         keep_best(best, ph, ws->rot, f);
     }
