@@ -1,9 +1,12 @@
 /* http.c -- libmicrohttpd front: routing, request bodies, JSON errors (see http.h). */
 #include "http.h"
 
+#include <arpa/inet.h>
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <netdb.h>
+#include <stdint.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -47,11 +50,40 @@ typedef struct req {
     char *body;
     size_t len, cap;
     int too_big;
+    int refused;     /* answered before routing (414, 403): its body is discarded */
     int status;      /* the status sent, for the access log */
+    size_t url_len;  /* the request target as sent (path and query), in bytes */
     char method[12];
     char url[128];
+    char acao[256];  /* an accepted Origin, echoed in Access-Control-Allow-Origin */
     double t0;
 } req;
+
+/* *con_cls before the access handler has run: the length of the request target (on_uri) */
+#define URI_LEN_TAGGED(p) (((uintptr_t)(p)) & 1u)
+
+/* Content-Security-Policy of GET / (built at start from the page's inline blocks) and of
+ * everything else (JSON, SVG, exports: nothing runs, nothing frames them) */
+static char csp_dashboard[3072];
+#define CSP_OTHER "default-src 'none'; frame-ancestors 'none'"
+
+/* the headers every response carries */
+static void std_headers(struct MHD_Response *resp, const req *r, const char *ctype)
+{
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, ctype);
+    MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
+    MHD_add_response_header(resp, "X-Frame-Options", "DENY");
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+    int html = !strncmp(ctype, "text/html", 9) && csp_dashboard[0];
+    MHD_add_response_header(resp, "Content-Security-Policy", html ? csp_dashboard : CSP_OTHER);
+    if (html) MHD_add_response_header(resp, "Referrer-Policy", "no-referrer");
+    if (r && r->acao[0]) {
+        MHD_add_response_header(resp, "Access-Control-Allow-Origin", r->acao);
+        MHD_add_response_header(resp, "Access-Control-Expose-Headers",
+                                "Location, Content-Disposition");
+    }
+    MHD_add_response_header(resp, "Vary", "Origin");
+}
 
 /* ------------------------------------------------------------------ responses */
 
@@ -64,9 +96,7 @@ static enum MHD_Result send_buf(struct MHD_Connection *c, req *r, unsigned statu
         if (mode == MHD_RESPMEM_MUST_FREE) free(buf);
         return MHD_NO;
     }
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, ctype);
-    MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+    std_headers(resp, r, ctype);
     if (allow) MHD_add_response_header(resp, MHD_HTTP_HEADER_ALLOW, allow);
     if (r) r->status = (int)status;
     enum MHD_Result ret = MHD_queue_response(c, status, resp);
@@ -99,9 +129,7 @@ static enum MHD_Result send_json_hdr(struct MHD_Connection *c, req *r, unsigned 
         free(text);
         return MHD_NO;
     }
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "application/json");
-    MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+    std_headers(resp, r, "application/json");
     if (hname) MHD_add_response_header(resp, hname, hval);
     if (r) r->status = (int)status;
     enum MHD_Result ret = MHD_queue_response(c, status, resp);
@@ -482,9 +510,7 @@ static enum MHD_Result send_stream(struct MHD_Connection *c, req *r, const char 
         fr(cls);
         return MHD_NO;
     }
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, ctype);
-    MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+    std_headers(resp, r, ctype);
     if (disposition) MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_DISPOSITION, disposition);
     r->status = 200;
     enum MHD_Result ret = MHD_queue_response(c, 200, resp);
@@ -705,6 +731,404 @@ static enum MHD_Result h_export(struct MHD_Connection *c, req *r, const char *id
                        free_export, disp);
 }
 
+/* ------------------------------------------------------------------ origin and host */
+
+/* Names this daemon answers to in a Host header (lower case, IPv6 in brackets); "own" ones are
+ * also its own origin (http://NAME:PORT), the others come from --allow-origin. */
+#define MAX_NAMES 64
+#define MAX_ALLOWED 32
+typedef struct host_name {
+    char name[264];
+    int own;
+} host_name;
+static host_name names[MAX_NAMES];
+static size_t n_names = 0;
+static char allowed[MAX_ALLOWED][300]; /* normalized origins given with --allow-origin */
+static size_t n_allowed = 0;
+static int own_port = 0;
+static int any_ip = 0;          /* listening on 0.0.0.0 / [::]: any IP literal is ours */
+static char own_url[300] = "";  /* http://HOST:PORT, for messages */
+
+static void add_name(const char *name, int own)
+{
+    for (size_t i = 0; i < n_names; i++)
+        if (!strcmp(names[i].name, name)) {
+            names[i].own |= own;
+            return;
+        }
+    if (n_names == MAX_NAMES || strlen(name) >= sizeof names[0].name) return;
+    snprintf(names[n_names].name, sizeof names[0].name, "%s", name);
+    names[n_names++].own = own;
+}
+
+/* "host[:port]" (an authority: a Host header, the end of an origin, --listen) into a lower-case
+ * host (IPv6 canonical, in brackets; a trailing dot dropped) and *port (-1 when absent).
+ * 0, or -1 when malformed. */
+static int parse_authority(const char *s, size_t n, char *host, size_t hostlen, int *port)
+{
+    *port = -1;
+    if (n == 0 || hostlen < 3) return -1;
+    const char *end = s + n, *rest;
+    if (s[0] == '[') {
+        const char *rb = memchr(s, ']', n);
+        if (!rb || rb - s < 3 || rb - s > 64) return -1;
+        char in6[72];
+        memcpy(in6, s + 1, (size_t)(rb - s - 1));
+        in6[rb - s - 1] = '\0';
+        struct in6_addr a6;
+        char canon[INET6_ADDRSTRLEN];
+        if (inet_pton(AF_INET6, in6, &a6) != 1 || !inet_ntop(AF_INET6, &a6, canon, sizeof canon))
+            return -1;
+        if (strlen(canon) + 3 > hostlen) return -1;
+        snprintf(host, hostlen, "[%s]", canon);
+        rest = rb + 1;
+    } else {
+        const char *colon = memchr(s, ':', n);
+        size_t hl = colon ? (size_t)(colon - s) : n;
+        if (hl == 0 || hl >= hostlen) return -1;
+        for (size_t i = 0; i < hl; i++) {
+            unsigned char ch = (unsigned char)s[i];
+            if (!isalnum(ch) && ch != '-' && ch != '.' && ch != '_') return -1;
+            host[i] = (char)tolower(ch);
+        }
+        host[hl] = '\0';
+        if (hl > 1 && host[hl - 1] == '.') host[hl - 1] = '\0';
+        rest = s + hl;
+    }
+    if (rest < end) {
+        if (*rest != ':') return -1;
+        long v = 0;
+        for (const char *q = rest + 1; q < end; q++) {
+            if (!isdigit((unsigned char)*q)) return -1;
+            v = v * 10 + (*q - '0');
+            if (v > 65535) return -1;
+        }
+        if (rest + 1 < end) *port = (int)v; /* "host:" is the default port (RFC 3986) */
+    }
+    return 0;
+}
+
+/* "scheme://host[:port]" into its parts (port: -1 = the scheme's default) and its normalized
+ * form, as a browser sends it: lower case, no default port. 0, or -1 when malformed. */
+static int parse_origin(const char *s, char *scheme, size_t slen, char *host, size_t hostlen,
+                        int *port, char *norm, size_t normlen)
+{
+    const char *sep = strstr(s, "://");
+    size_t sl = sep ? (size_t)(sep - s) : 0;
+    if (!sep || sl == 0 || sl >= slen || !isalpha((unsigned char)s[0])) return -1;
+    for (size_t i = 0; i < sl; i++) {
+        unsigned char ch = (unsigned char)s[i];
+        if (!isalnum(ch) && ch != '+' && ch != '-' && ch != '.') return -1;
+        scheme[i] = (char)tolower(ch);
+    }
+    scheme[sl] = '\0';
+    if (parse_authority(sep + 3, strlen(sep + 3), host, hostlen, port)) return -1;
+    int dflt = !strcmp(scheme, "http") ? 80 : !strcmp(scheme, "https") ? 443 : -1;
+    if (*port == dflt) *port = -1;
+    if (*port > 0)
+        snprintf(norm, normlen, "%s://%s:%d", scheme, host, *port);
+    else
+        snprintf(norm, normlen, "%s://%s", scheme, host);
+    return 0;
+}
+
+int gpd_allow_origins(const char *list)
+{
+    const char *p = list;
+    while (p && *p) {
+        while (*p == ' ' || *p == ',') p++;
+        const char *e = p;
+        while (*e && *e != ',') e++;
+        const char *t = e;
+        while (t > p && t[-1] == ' ') t--;
+        if (t > p && t[-1] == '/') t--; /* "http://lab.example:3000/" is the same origin */
+        if (t > p) {
+            char item[300], scheme[32], host[264], norm[300];
+            int port;
+            size_t il = (size_t)(t - p);
+            if (il >= sizeof item ||
+                (memcpy(item, p, il), item[il] = '\0',
+                 parse_origin(item, scheme, sizeof scheme, host, sizeof host, &port, norm,
+                              sizeof norm))) {
+                fprintf(stderr,
+                        "grainpackd: --allow-origin expects scheme://host[:port] (e.g. "
+                        "http://lab.example:3000), got \"%.*s\"\n",
+                        (int)(il < 200 ? il : 200), p);
+                return -1;
+            }
+            if (n_allowed == MAX_ALLOWED) {
+                fprintf(stderr, "grainpackd: at most %d origins may be allowed\n", MAX_ALLOWED);
+                return -1;
+            }
+            size_t k = 0;
+            while (k < n_allowed && strcmp(allowed[k], norm)) k++;
+            if (k == n_allowed) snprintf(allowed[n_allowed++], sizeof allowed[0], "%s", norm);
+            add_name(host, 0);
+        }
+        p = e;
+    }
+    return 0;
+}
+
+static int is_ip_literal(const char *name)
+{
+    struct in_addr a4;
+    return name[0] == '[' || inet_pton(AF_INET, name, &a4) == 1;
+}
+
+/* the names this daemon answers to: loopback, the --listen host as given and as bound, and on
+ * a wildcard address the machine's host name (any IP literal is accepted there as well) */
+static void setup_names(const gpd_http_config *cfg)
+{
+    char h[264];
+    int port;
+    add_name("localhost", 1);
+    add_name("127.0.0.1", 1);
+    add_name("[::1]", 1);
+    if (cfg->listen && !parse_authority(cfg->listen, strlen(cfg->listen), h, sizeof h, &port))
+        add_name(h, 1);
+    if (cfg->host && !parse_authority(cfg->host, strlen(cfg->host), h, sizeof h, &port)) {
+        add_name(h, 1);
+        any_ip = !strcmp(h, "0.0.0.0") || !strcmp(h, "[::]");
+    }
+    if (any_ip) {
+        char hn[256];
+        if (gethostname(hn, sizeof hn) == 0) {
+            hn[sizeof hn - 1] = '\0';
+            if (!parse_authority(hn, strlen(hn), h, sizeof h, &port) && port < 0) add_name(h, 1);
+        }
+    }
+    own_port = cfg->port;
+    snprintf(own_url, sizeof own_url, "http://%s:%d", cfg->host ? cfg->host : "127.0.0.1",
+             cfg->port);
+}
+
+static int host_accepted(const char *name)
+{
+    for (size_t i = 0; i < n_names; i++)
+        if (!strcmp(names[i].name, name)) return 1;
+    return any_ip && is_ip_literal(name);
+}
+
+/* An Origin is accepted when it was given with --allow-origin, when it is the authority the
+ * request was sent to (same origin: the page came from this daemon, as the browser reached it),
+ * or when it is http://NAME:PORT with NAME one of the daemon's own names and PORT its port
+ * (a page at http://localhost:8080 calling http://127.0.0.1:8080). */
+static int origin_accepted(const char *origin, const char *hname, int hport)
+{
+    char scheme[32], oh[264], norm[300];
+    int op;
+    if (parse_origin(origin, scheme, sizeof scheme, oh, sizeof oh, &op, norm, sizeof norm))
+        return 0;
+    for (size_t i = 0; i < n_allowed; i++)
+        if (!strcmp(norm, allowed[i])) return 1;
+    int http = !strcmp(scheme, "http"), https = !strcmp(scheme, "https");
+    if (!http && !https) return 0;
+    int dflt = https ? 443 : 80;
+    int oport = op > 0 ? op : dflt;
+    if (hname && !strcmp(oh, hname) && oport == (hport > 0 ? hport : dflt)) return 1;
+    if (http && oport == own_port)
+        for (size_t i = 0; i < n_names; i++)
+            if (names[i].own && !strcmp(names[i].name, oh)) return 1;
+    return 0;
+}
+
+/* Checks made before routing: the length of the request target, Host and Origin. Returns 1
+ * when a response has been queued (in *ret), 0 to go on. */
+static int gate(struct MHD_Connection *c, req *r, const char *method, enum MHD_Result *ret)
+{
+    if (r->url_len > GPD_MAX_URL) {
+        *ret = send_error(c, r, 414, "uri_too_long", NULL,
+                          "the request target (path and query) is %zu bytes, over the limit of "
+                          "%d bytes",
+                          r->url_len, GPD_MAX_URL);
+        return 1;
+    }
+    const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
+    char hname[264];
+    int hport = -1, have_host = 0;
+    if (host && *host) {
+        if (parse_authority(host, strlen(host), hname, sizeof hname, &hport) ||
+            !host_accepted(hname)) {
+            *ret = send_error(c, r, 403, "forbidden_host", NULL,
+                              "Host \"%.100s\" is not a name of this server (%s); use "
+                              "localhost, 127.0.0.1 or the address it listens on",
+                              host, own_url);
+            return 1;
+        }
+        have_host = 1;
+    }
+    const char *origin = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Origin");
+    if (origin && *origin) {
+        if (!origin_accepted(origin, have_host ? hname : NULL, hport)) {
+            *ret = send_error(c, r, 403, "forbidden_origin", NULL,
+                              "Origin \"%.100s\" may not call this server: only pages it "
+                              "serves itself (%s) and origins given with --allow-origin may",
+                              origin, own_url);
+            return 1;
+        }
+        if (strlen(origin) < sizeof r->acao) snprintf(r->acao, sizeof r->acao, "%s", origin);
+        /* a CORS preflight of an accepted origin */
+        if (!strcmp(method, "OPTIONS") &&
+            MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Access-Control-Request-Method")) {
+            struct MHD_Response *resp =
+                MHD_create_response_from_buffer(0, (void *)"", MHD_RESPMEM_PERSISTENT);
+            if (!resp) {
+                *ret = MHD_NO;
+                return 1;
+            }
+            std_headers(resp, r, "text/plain");
+            MHD_add_response_header(resp, "Access-Control-Allow-Methods",
+                                    "GET, HEAD, POST, DELETE");
+            MHD_add_response_header(resp, "Access-Control-Allow-Headers", "Content-Type");
+            MHD_add_response_header(resp, "Access-Control-Max-Age", "600");
+            r->status = 204;
+            *ret = MHD_queue_response(c, 204, resp);
+            MHD_destroy_response(resp);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------ dashboard CSP */
+
+/* SHA-256 (FIPS 180-4), for the hashes of the dashboard's inline script and style */
+static const uint32_t sha_k[64] = {
+    0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4,
+    0xab1c5ed5, 0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3, 0x72be5d74, 0x80deb1fe,
+    0x9bdc06a7, 0xc19bf174, 0xe49b69c1, 0xefbe4786, 0x0fc19dc6, 0x240ca1cc, 0x2de92c6f,
+    0x4a7484aa, 0x5cb0a9dc, 0x76f988da, 0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7,
+    0xc6e00bf3, 0xd5a79147, 0x06ca6351, 0x14292967, 0x27b70a85, 0x2e1b2138, 0x4d2c6dfc,
+    0x53380d13, 0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85, 0xa2bfe8a1, 0xa81a664b,
+    0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070, 0x19a4c116,
+    0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a, 0x5b9cca4f, 0x682e6ff3,
+    0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7,
+    0xc67178f2};
+
+#define ROR32(x, n) (((x) >> (n)) | ((x) << (32 - (n))))
+
+static void sha256_block(uint32_t h[8], const unsigned char *p)
+{
+    uint32_t w[64];
+    for (int i = 0; i < 16; i++)
+        w[i] = (uint32_t)p[4 * i] << 24 | (uint32_t)p[4 * i + 1] << 16 |
+               (uint32_t)p[4 * i + 2] << 8 | p[4 * i + 3];
+    for (int i = 16; i < 64; i++) {
+        uint32_t s0 = ROR32(w[i - 15], 7) ^ ROR32(w[i - 15], 18) ^ (w[i - 15] >> 3);
+        uint32_t s1 = ROR32(w[i - 2], 17) ^ ROR32(w[i - 2], 19) ^ (w[i - 2] >> 10);
+        w[i] = w[i - 16] + s0 + w[i - 7] + s1;
+    }
+    uint32_t a = h[0], b = h[1], c = h[2], d = h[3], e = h[4], f = h[5], g = h[6], hh = h[7];
+    for (int i = 0; i < 64; i++) {
+        uint32_t t1 = hh + (ROR32(e, 6) ^ ROR32(e, 11) ^ ROR32(e, 25)) + ((e & f) ^ (~e & g)) +
+                      sha_k[i] + w[i];
+        uint32_t t2 = (ROR32(a, 2) ^ ROR32(a, 13) ^ ROR32(a, 22)) + ((a & b) ^ (a & c) ^ (b & c));
+        hh = g;
+        g = f;
+        f = e;
+        e = d + t1;
+        d = c;
+        c = b;
+        b = a;
+        a = t1 + t2;
+    }
+    h[0] += a, h[1] += b, h[2] += c, h[3] += d, h[4] += e, h[5] += f, h[6] += g, h[7] += hh;
+}
+
+/* 'sha256-BASE64' of n bytes at s, into out (at least 60 bytes) */
+static void csp_hash(const char *s, size_t n, char *out)
+{
+    uint32_t h[8] = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
+                     0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+    const unsigned char *p = (const unsigned char *)s;
+    size_t left = n;
+    for (; left >= 64; left -= 64, p += 64) sha256_block(h, p);
+    unsigned char last[128];
+    memset(last, 0, sizeof last);
+    memcpy(last, p, left);
+    last[left] = 0x80;
+    size_t nb = left + 9 <= 64 ? 64 : 128;
+    uint64_t bits = (uint64_t)n * 8;
+    for (int i = 0; i < 8; i++) last[nb - 1 - i] = (unsigned char)(bits >> (8 * i));
+    sha256_block(h, last);
+    if (nb == 128) sha256_block(h, last + 64);
+    unsigned char dg[33];
+    for (int i = 0; i < 8; i++)
+        for (int j = 0; j < 4; j++) dg[4 * i + j] = (unsigned char)(h[i] >> (24 - 8 * j));
+    dg[32] = 0;
+    static const char b64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    char *o = out + sprintf(out, "'sha256-");
+    for (int i = 0; i < 33; i += 3) {
+        uint32_t v = (uint32_t)dg[i] << 16 | (uint32_t)dg[i + 1] << 8 | dg[i + 2];
+        *o++ = b64[v >> 18 & 63];
+        *o++ = b64[v >> 12 & 63];
+        *o++ = i + 1 < 32 ? b64[v >> 6 & 63] : '=';
+        *o++ = i + 2 < 32 ? b64[v & 63] : '=';
+    }
+    *o++ = '\'';
+    *o = '\0';
+}
+
+/* appends ' item' to a source list, unless it is there already */
+static void csp_add(char *list, size_t cap, const char *item)
+{
+    if (strstr(list, item)) return;
+    size_t n = strlen(list);
+    snprintf(list + n, cap - n, " %s", item);
+}
+
+/* The dashboard is one static page with an inline <script> and <style> and a few style=""
+ * attributes: the policy allows exactly those (by their SHA-256, computed here from the page
+ * served, so it follows any edit of dashboard.html) and nothing from elsewhere. */
+static void build_dashboard_csp(void)
+{
+#ifdef GPD_HAVE_DASHBOARD
+    const char *html = gp_dashboard_html();
+    char scripts[1024] = "", styles[1024] = "", attrs[1024] = "", hash[64];
+    const char *p = html;
+    const char *tag;
+    while ((tag = strchr(p, '<')) != NULL) {
+        const char *gt = strchr(tag, '>');
+        if (!gt) break;
+        int is_script = !strncmp(tag, "<script", 7) &&
+                        (tag[7] == '>' || isspace((unsigned char)tag[7]));
+        int is_style = !strncmp(tag, "<style", 6) &&
+                       (tag[6] == '>' || isspace((unsigned char)tag[6]));
+        /* the style="..." attributes of this tag */
+        for (const char *a = tag; a < gt; a++) {
+            if (isspace((unsigned char)a[0]) && !strncmp(a + 1, "style=\"", 7)) {
+                const char *v = a + 8, *ve = memchr(v, '"', (size_t)(gt - v));
+                if (ve) {
+                    csp_hash(v, (size_t)(ve - v), hash);
+                    csp_add(attrs, sizeof attrs, hash);
+                    a = ve;
+                }
+            }
+        }
+        if (is_script || is_style) {
+            const char *close = strstr(gt + 1, is_script ? "</script>" : "</style>");
+            if (!close) break;
+            csp_hash(gt + 1, (size_t)(close - gt - 1), hash);
+            csp_add(is_script ? scripts : styles, is_script ? sizeof scripts : sizeof styles,
+                    hash);
+            p = close + 2;
+        } else {
+            p = gt + 1;
+        }
+    }
+    if (attrs[0]) {
+        csp_add(styles, sizeof styles, "'unsafe-hashes'");
+        csp_add(styles, sizeof styles, attrs + 1);
+    }
+    snprintf(csp_dashboard, sizeof csp_dashboard,
+             "default-src 'self'; script-src%s; style-src%s; img-src 'self'; "
+             "connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'self'; "
+             "frame-ancestors 'none'",
+             scripts[0] ? scripts : " 'none'", styles[0] ? styles : " 'none'");
+#endif
+}
+
 /* ------------------------------------------------------------------ routing */
 
 static enum MHD_Result method_not_allowed(struct MHD_Connection *c, req *r, const char *method,
@@ -781,13 +1205,23 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
                                   void **con_cls)
 {
     req *r = *con_cls;
-    if (!r) {
+    if (!r || URI_LEN_TAGGED(r)) {
+        /* the length of the request target as sent, from on_uri (the path alone without it) */
+        size_t url_len = r ? (size_t)((uintptr_t)r >> 1) : strlen(url);
         r = calloc(1, sizeof *r);
         if (!r) return MHD_NO;
         r->t0 = gpd_monotonic_s();
+        r->url_len = url_len;
         snprintf(r->method, sizeof r->method, "%s", method);
         snprintf(r->url, sizeof r->url, "%s", url);
         *con_cls = r;
+        /* 414, 403 forbidden_host / forbidden_origin, CORS preflight: before anything else,
+         * so that a refused request creates or reads nothing */
+        enum MHD_Result ret;
+        if (gate(c, r, method, &ret)) {
+            r->refused = 1;
+            return ret;
+        }
         /* refuse an announced oversized body before reading any of it */
         const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
                                                      MHD_HTTP_HEADER_CONTENT_LENGTH);
@@ -806,7 +1240,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     if (*upload_data_size) {
         size_t n = *upload_data_size;
         *upload_data_size = 0;
-        if (r->too_big) return MHD_YES; /* discard */
+        if (r->too_big || r->refused) return MHD_YES; /* discard */
         if (strcmp(method, "POST")) return MHD_YES; /* bodies of other methods are ignored */
         if (r->len + n > max_body) {
             r->too_big = 1;
@@ -828,17 +1262,35 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         r->len += n;
         return MHD_YES;
     }
+    if (r->refused) return MHD_YES; /* answered at the first call */
     if (r->too_big)
         return send_error(c, r, 413, "payload_too_large", NULL,
                           "request body over the limit of %zu bytes", max_body);
     return route(c, r, url, method);
 }
 
+/* Called by libmicrohttpd as soon as the request line is read, with the request target as
+ * sent (path and query, still escaped): its length decides 414 before anything else. It
+ * reaches on_request through *con_cls as an odd integer (a req pointer is even), so that
+ * nothing is allocated before the access handler runs: libmicrohttpd drops some requests it
+ * cannot parse without calling on_completed. */
+static void *on_uri(void *cls, const char *uri, struct MHD_Connection *c)
+{
+    (void)cls;
+    (void)c;
+    size_t n = strlen(uri);
+    if (n > SIZE_MAX / 4) n = SIZE_MAX / 4;
+    return (void *)(((uintptr_t)n << 1) | 1u);
+}
+
 static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
                          enum MHD_RequestTerminationCode toe)
 {
     req *r = *con_cls;
-    if (!r) return;
+    if (!r || URI_LEN_TAGGED(r)) {
+        *con_cls = NULL;
+        return;
+    }
     if (gpd_log_threshold >= GPD_LOG_DEBUG) {
         gpd_log(GPD_LOG_DEBUG, "http %s %s %d %.3f ms%s", r->method, r->url, r->status,
                 1e3 * (gpd_monotonic_s() - r->t0),
@@ -944,13 +1396,19 @@ int gpd_http_start(const gpd_http_config *cfg)
     max_body = cfg->max_body;
     if (cfg->max_result_mb > 0) max_result_mb = cfg->max_result_mb;
     started_at = gpd_monotonic_s();
+    setup_names(cfg);
+    build_dashboard_csp();
     unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_ERROR_LOG | MHD_USE_AUTO | MHD_USE_ITC;
     daemon_ = MHD_start_daemon(
         flags, 0, NULL, NULL, &on_request, NULL, MHD_OPTION_EXTERNAL_LOGGER, &mhd_log, NULL,
         MHD_OPTION_LISTEN_SOCKET, cfg->listen_fd,
         MHD_OPTION_THREAD_POOL_SIZE, cfg->threads, MHD_OPTION_CONNECTION_LIMIT,
         cfg->max_connections, MHD_OPTION_CONNECTION_TIMEOUT, cfg->timeout_s,
-        MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)64 * 1024, MHD_OPTION_NOTIFY_COMPLETED,
+        /* a request line up to this size reaches on_uri, which answers a JSON 414 above
+         * GPD_MAX_URL; past it libmicrohttpd answers 414 itself. The pool is mmap'ed: pages
+         * are used only as far as a client fills them. */
+        MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)GPD_CONN_MEMORY,
+        MHD_OPTION_URI_LOG_CALLBACK, &on_uri, NULL, MHD_OPTION_NOTIFY_COMPLETED,
         &on_completed, NULL, MHD_OPTION_END);
     if (!daemon_) {
         gpd_log(GPD_LOG_ERROR, "cannot start the HTTP server");

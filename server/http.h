@@ -15,6 +15,22 @@
  * HEAD is accepted wherever GET is. Every 4xx/5xx body is
  *   {"error": {"code": "...", "message": "...", "pointer": "/json/pointer"}}
  * (pointer only where a field of the spec or a query parameter is at fault).
+ *
+ * Before routing (api.md, "Limits and origin"):
+ *   414 uri_too_long      the request target (path and query) is over GPD_MAX_URL bytes
+ *   403 forbidden_host    the Host header names a host this daemon does not answer to
+ *                         (DNS rebinding): accepted are localhost, 127.0.0.1, [::1], the
+ *                         --listen host (as given and as bound), the host of each allowed
+ *                         origin, and for a daemon on 0.0.0.0 / [::] also any IP address and
+ *                         the machine's host name. The Host port is not compared.
+ *   403 forbidden_origin  an Origin header other than the daemon's own address (the page's
+ *                         origin equals the Host it sent, or is http://NAME:PORT with NAME one
+ *                         of the daemon's own names above and PORT its port) or an origin given
+ *                         with --allow-origin. No Origin (curl, scripts): no check.
+ * An allowed Origin gets Access-Control-Allow-Origin, and its preflight (OPTIONS with
+ * Access-Control-Request-Method) 204. GET / carries a Content-Security-Policy with the
+ * SHA-256 of its inline script and style; every response has X-Content-Type-Options: nosniff
+ * and X-Frame-Options: DENY.
  */
 #ifndef GPD_HTTP_H
 #define GPD_HTTP_H
@@ -28,7 +44,21 @@ typedef struct gpd_http_config {
     unsigned timeout_s;          /* idle timeout per connection */
     size_t max_body;             /* request body limit in bytes (413 above) */
     double max_result_mb;        /* specs whose estimated result is larger get 422 too_large */
+    const char *listen;          /* the --listen value as given (its host is an accepted Host) */
+    const char *host;            /* the bound host as gpd_listen_socket wrote it */
+    int port;                    /* the bound port */
 } gpd_http_config;
+
+/* request targets longer than this get 414 uri_too_long (JSON); libmicrohttpd itself answers
+ * (with its own HTML body) only past its per-connection buffer of GPD_CONN_MEMORY bytes */
+#define GPD_MAX_URL 8192
+#define GPD_CONN_MEMORY (256u * 1024u)
+
+/* Adds the comma-separated origins of list ("scheme://host[:port]", e.g.
+ * http://lab.example:3000) to those allowed to call the daemon besides its own address.
+ * Returns 0, or -1 with a message on stderr when one is malformed. Call before
+ * gpd_http_start. */
+int gpd_allow_origins(const char *list);
 
 /* Parses "HOST:PORT" ("[v6]:PORT", ":PORT" = 127.0.0.1), binds and listens. Returns the fd
  * and the bound port in *port (the actual one when PORT was 0), -1 with a message on stderr

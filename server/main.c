@@ -33,7 +33,7 @@
 const char *__tsan_default_suppressions(void);
 const char *__tsan_default_suppressions(void)
 {
-    return "race:workers_cancel\nrace:workers_stop\n";
+    return "race:workers_cancel\nrace:workers_stop\nrace:raise_cancel\n";
 }
 #endif
 
@@ -64,6 +64,13 @@ static void usage(FILE *f)
             "  --max-result-mb MB     refuse (422 too_large) a spec whose result would be\n"
             "                         larger, which bounds one job's memory\n"
             "                         [GRAINPACK_MAX_RESULT_MB] (default 1024)\n"
+            "  --job-timeout S        a job whose run lasts longer fails with error code\n"
+            "                         'timeout' (per run attempt; 0 = no limit)\n"
+            "                         [GRAINPACK_JOB_TIMEOUT] (default 3600)\n"
+            "  --allow-origin ORIGIN  also serve pages at ORIGIN (scheme://host[:port], e.g. a\n"
+            "                         lab dashboard served elsewhere); repeatable or comma-\n"
+            "                         separated [GRAINPACK_ALLOW_ORIGIN]. Any other Origin, and\n"
+            "                         a Host naming another server, get 403 (see README)\n"
             "  --version              print the version and exit\n"
             "  --help                 this text\n"
             "\n"
@@ -109,6 +116,9 @@ int main(int argc, char **argv)
     const char *timeout_s = env_or("GRAINPACK_TIMEOUT", "30");
     const char *maxbody_s = env_or("GRAINPACK_MAX_BODY", "1048576");
     const char *maxres_s = env_or("GRAINPACK_MAX_RESULT_MB", "1024");
+    const char *origins_env = env_or("GRAINPACK_ALLOW_ORIGIN", NULL);
+    int origins_flag = 0; /* any --allow-origin replaces GRAINPACK_ALLOW_ORIGIN */
+    const char *jobto_s = env_or("GRAINPACK_JOB_TIMEOUT", "3600");
 
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},       {"db", required_argument, 0, 'd'},
@@ -116,10 +126,12 @@ int main(int argc, char **argv)
         {"http-threads", required_argument, 0, 't'}, {"max-connections", required_argument, 0, 'c'},
         {"timeout", required_argument, 0, 'T'},      {"max-body", required_argument, 0, 'b'},
         {"max-result-mb", required_argument, 0, 'R'},
+        {"job-timeout", required_argument, 0, 'J'},
+        {"allow-origin", required_argument, 0, 1001},
         {"help", no_argument, 0, 'h'},               {"version", no_argument, 0, 'V'},
         {0, 0, 0, 0}};
     int ch;
-    while ((ch = getopt_long(argc, argv, "l:d:w:L:t:c:T:b:R:hV", opts, NULL)) != -1) {
+    while ((ch = getopt_long(argc, argv, "l:d:w:L:t:c:T:b:R:J:hV", opts, NULL)) != -1) {
         switch (ch) {
         case 'l': listen_s = optarg; break;
         case 'd': db = optarg; break;
@@ -130,23 +142,30 @@ int main(int argc, char **argv)
         case 'T': timeout_s = optarg; break;
         case 'b': maxbody_s = optarg; break;
         case 'R': maxres_s = optarg; break;
+        case 'J': jobto_s = optarg; break;
+        case 1001:
+            if (gpd_allow_origins(optarg)) return 2;
+            origins_flag = 1;
+            break;
         case 'h': usage(stdout); return 0;
         case 'V': printf("grainpackd %s\n", GPD_VERSION); return 0;
         default: usage(stderr); return 2;
         }
     }
+    if (!origins_flag && origins_env && gpd_allow_origins(origins_env)) return 2;
     if (optind < argc) {
         fprintf(stderr, "grainpackd: unexpected argument \"%s\"\n", argv[optind]);
         usage(stderr);
         return 2;
     }
-    long nworkers, nthreads, maxconn, timeout, maxbody, maxres;
+    long nworkers, nthreads, maxconn, timeout, maxbody, maxres, jobto;
     if (parse_long("--workers", workers_s, 1, 1024, &nworkers) ||
         parse_long("--http-threads", threads_s, 1, 256, &nthreads) ||
         parse_long("--max-connections", maxconn_s, 1, 1000000, &maxconn) ||
         parse_long("--timeout", timeout_s, 1, 86400, &timeout) ||
         parse_long("--max-body", maxbody_s, 1024, 1L << 30, &maxbody) ||
-        parse_long("--max-result-mb", maxres_s, 1, 1L << 20, &maxres))
+        parse_long("--max-result-mb", maxres_s, 1, 1L << 20, &maxres) ||
+        parse_long("--job-timeout", jobto_s, 0, 31622400, &jobto))
         return 2;
     int level = gpd_log_parse_level(level_s);
     if (level < 0) {
@@ -164,7 +183,16 @@ int main(int argc, char **argv)
     pthread_sigmask(SIG_BLOCK, &set, NULL);
     signal(SIGPIPE, SIG_IGN);
 
-    if (store_open(db) != 0) {
+    /* store_open locks the database first, before recovery touches any job */
+    int open_rc = store_open(db);
+    if (open_rc == STORE_OPEN_LOCKED) {
+        fprintf(stderr,
+                "grainpackd: the job database %s is in use by another grainpackd process (it "
+                "holds the database lock); refusing to start\n",
+                db);
+        return 1;
+    }
+    if (open_rc != 0) {
         fprintf(stderr, "grainpackd: cannot open the job database %s\n", db);
         return 1;
     }
@@ -187,6 +215,7 @@ int main(int argc, char **argv)
         store_close();
         return 1;
     }
+    workers_set_job_timeout(jobto);
     if (workers_start((int)nworkers) != 0) {
         workers_stop();
         store_close();
@@ -197,7 +226,10 @@ int main(int argc, char **argv)
                            .max_connections = (unsigned)maxconn,
                            .timeout_s = (unsigned)timeout,
                            .max_body = (size_t)maxbody,
-                           .max_result_mb = (double)maxres};
+                           .max_result_mb = (double)maxres,
+                           .listen = listen_s,
+                           .host = host,
+                           .port = port};
     if (gpd_http_start(&cfg) != 0) {
         close(fd);
         workers_stop();

@@ -1,4 +1,5 @@
 /* store.c -- SQLite job store (see store.h for the table and the restart rule). */
+#define _GNU_SOURCE /* F_OFD_SETLK: the database lock (store_open) */
 #include "store.h"
 
 #include <errno.h>
@@ -9,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -108,6 +110,14 @@ static char *db_path = NULL;
 static pthread_key_t conn_key;
 static int closed = 0; /* guarded by path_mu */
 static pthread_mutex_t path_mu = PTHREAD_MUTEX_INITIALIZER;
+static int lock_fd = -1; /* holds the database lock from store_open to store_close */
+
+/* Testing hooks (environment, read once by store_open; never needed in production): lower
+ * SQLite's length limit (GRAINPACK_TEST_SQLITE_MAX_LENGTH, bytes: a result over it is
+ * SQLITE_TOOBIG) or the database's page count (GRAINPACK_TEST_SQLITE_MAX_PAGES: a write past it
+ * is SQLITE_FULL, as on a full disk) on every connection, so that the integration tests can
+ * drive the failure paths of the store. 0 = not set. */
+static long test_max_length = 0, test_max_pages = 0;
 
 /* A thread's connection and its prepared statements, cached by SQL text address (every SQL
  * string here is a literal), so that a status poll costs one sqlite3_step. */
@@ -176,6 +186,12 @@ static sqlite3 *conn_open(void)
         sqlite3_close_v2(db);
         return NULL;
     }
+    if (test_max_length > 0) sqlite3_limit(db, SQLITE_LIMIT_LENGTH, (int)test_max_length);
+    if (test_max_pages > 0) {
+        char pragma[64];
+        snprintf(pragma, sizeof pragma, "PRAGMA max_page_count=%ld", test_max_pages);
+        sqlite3_exec(db, pragma, NULL, NULL, NULL);
+    }
     return db;
 }
 
@@ -201,12 +217,75 @@ static sqlite3 *conn(void)
     return c ? c->db : NULL;
 }
 
+static long env_long(const char *name)
+{
+    const char *v = getenv(name);
+    long n = v ? strtol(v, NULL, 10) : 0;
+    return n > 0 ? n : 0;
+}
+
+/* The database lock: an open-file-description write lock (F_OFD_SETLK) on one byte of the
+ * database file itself, far from the bytes SQLite locks (its lock page starts at 1 GiB, 512
+ * bytes). Being on the file's inode it holds whatever path names the file (a symlink, a hard
+ * link, "./x" and "x"); being an OFD lock it is not dropped when SQLite closes one of its own
+ * descriptors of the file, as a classic POSIX lock would be; it goes when the daemon closes
+ * the store or dies (kill -9 included). Where OFD locks are missing, flock() on the same file.
+ * Returns 0 when taken, 1 when another process holds it, -1 on an error (logged). */
+#define STORE_LOCK_OFFSET (0x40000000LL + 0x10000LL)
+static int lock_take(const char *path)
+{
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        gpd_log(GPD_LOG_ERROR, "cannot open %s to lock it: %s", path, strerror(errno));
+        return -1;
+    }
+    int r = -1, use_flock = 1;
+#ifdef F_OFD_SETLK
+    struct flock fl;
+    memset(&fl, 0, sizeof fl);
+    fl.l_type = F_WRLCK;
+    fl.l_whence = SEEK_SET;
+    fl.l_start = (off_t)STORE_LOCK_OFFSET;
+    fl.l_len = 1;
+    use_flock = 0;
+    if (fcntl(fd, F_OFD_SETLK, &fl) == 0) {
+        r = 0;
+    } else if (errno == EAGAIN || errno == EACCES) {
+        r = 1;
+    } else if (errno == EINVAL) {
+        use_flock = 1; /* a kernel without OFD locks */
+    } else {
+        gpd_log(GPD_LOG_ERROR, "cannot lock %s: %s", path, strerror(errno));
+    }
+#endif
+    if (use_flock) {
+        if (flock(fd, LOCK_EX | LOCK_NB) == 0)
+            r = 0;
+        else if (errno == EWOULDBLOCK)
+            r = 1;
+        else
+            gpd_log(GPD_LOG_ERROR, "cannot lock %s: %s", path, strerror(errno));
+    }
+    if (r == 0)
+        lock_fd = fd;
+    else
+        close(fd);
+    return r;
+}
+
 int store_open(const char *path)
 {
     static int key_made = 0; /* store_open is called once, from main, before any thread */
     if (!key_made) {
         if (pthread_key_create(&conn_key, conn_destroy) != 0) return -1;
         key_made = 1;
+    }
+    test_max_length = env_long("GRAINPACK_TEST_SQLITE_MAX_LENGTH");
+    test_max_pages = env_long("GRAINPACK_TEST_SQLITE_MAX_PAGES");
+    /* the lock first: nothing may read or change the jobs of another daemon's database */
+    if (lock_fd < 0) {
+        int l = lock_take(path);
+        if (l) return l > 0 ? STORE_OPEN_LOCKED : -1;
     }
     pthread_mutex_lock(&path_mu);
     free(db_path);
@@ -244,6 +323,10 @@ void store_close(void)
     free(db_path);
     db_path = NULL;
     pthread_mutex_unlock(&path_mu);
+    if (lock_fd >= 0) { /* the last: the database is released once this daemon is done */
+        close(lock_fd);
+        lock_fd = -1;
+    }
 }
 
 /* ------------------------------------------------------------------ helpers */
@@ -283,12 +366,12 @@ static void done(sqlite3_stmt *st)
     sqlite3_finalize(st);
 }
 
-static void bind_text(sqlite3_stmt *st, int i, const char *s)
+/* Returns SQLite's code: SQLITE_OK, or e.g. SQLITE_TOOBIG (the parameter is then NULL, so a
+ * write must not go on). */
+static int bind_text(sqlite3_stmt *st, int i, const char *s)
 {
-    if (s)
-        sqlite3_bind_text(st, i, s, -1, SQLITE_TRANSIENT);
-    else
-        sqlite3_bind_null(st, i);
+    if (s) return sqlite3_bind_text(st, i, s, -1, SQLITE_TRANSIENT);
+    return sqlite3_bind_null(st, i);
 }
 
 static int step_done(sqlite3 *db, sqlite3_stmt *st)
@@ -371,7 +454,12 @@ int store_recover(int *requeued, int *failed)
     }
     done(a);
     done(b);
-    sqlite3_exec(db, rc == 0 ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL);
+    if (sqlite3_exec(db, rc == 0 ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite recover %s: %s", rc == 0 ? "commit" : "rollback",
+                sqlite3_errmsg(db));
+        if (!sqlite3_get_autocommit(db)) sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL);
+        rc = -1;
+    }
     return rc;
 }
 
@@ -385,11 +473,12 @@ store_rc store_insert(const char *kind, const char *spec_json, char id_out[33])
     sqlite3_stmt *st = prep(db, "INSERT INTO jobs(id, kind, spec, status, created_at) "
                                 "VALUES (?1, ?2, ?3, 'queued', ?4)");
     if (!st) return STORE_ERROR;
-    bind_text(st, 1, id_out);
-    bind_text(st, 2, kind);
-    bind_text(st, 3, spec_json);
-    bind_text(st, 4, now);
-    int rc = step_done(db, st);
+    int rc = -1;
+    if (bind_text(st, 1, id_out) == SQLITE_OK && bind_text(st, 2, kind) == SQLITE_OK &&
+        bind_text(st, 3, spec_json) == SQLITE_OK && bind_text(st, 4, now) == SQLITE_OK)
+        rc = step_done(db, st);
+    else
+        gpd_log(GPD_LOG_ERROR, "sqlite insert: %s", sqlite3_errmsg(db));
     done(st);
     return rc == 0 ? STORE_OK : STORE_ERROR;
 }
@@ -579,12 +668,16 @@ static store_rc update_running(const char *sql, const char *id, const char *a, c
     if (!db) return STORE_ERROR;
     sqlite3_stmt *st = prep(db, sql);
     if (!st) return STORE_ERROR;
-    bind_text(st, 1, id);
     int np = sqlite3_bind_parameter_count(st);
-    if (np >= 2) bind_text(st, 2, a);
-    if (np >= 3) bind_text(st, 3, b);
-    if (np >= 4) bind_text(st, 4, c);
-    int rc = step_done(db, st);
+    int b_rc = bind_text(st, 1, id);
+    if (b_rc == SQLITE_OK && np >= 2) b_rc = bind_text(st, 2, a);
+    if (b_rc == SQLITE_OK && np >= 3) b_rc = bind_text(st, 3, b);
+    if (b_rc == SQLITE_OK && np >= 4) b_rc = bind_text(st, 4, c);
+    int rc = -1;
+    if (b_rc == SQLITE_OK)
+        rc = step_done(db, st);
+    else
+        gpd_log(GPD_LOG_ERROR, "sqlite bind: %s", sqlite3_errstr(b_rc));
     done(st);
     if (rc) return STORE_ERROR;
     return sqlite3_changes(db) > 0 ? STORE_OK : STORE_CONFLICT;
@@ -597,45 +690,101 @@ store_rc store_progress(const char *id, const char *progress_json)
 }
 
 store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
-                       const void *pack, size_t pack_len)
+                       const void *pack, size_t pack_len, char *why, size_t why_len)
 {
+    char dummy[8];
+    if (!why || !why_len) {
+        why = dummy;
+        why_len = sizeof dummy;
+    }
+    why[0] = '\0';
+    if (!result_json) {
+        snprintf(why, why_len, "there is no result to store");
+        return STORE_ERROR;
+    }
     sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
+    if (!db) {
+        snprintf(why, why_len, "no connection to the database");
+        return STORE_ERROR;
+    }
+    size_t rlen = strlen(result_json);
+    /* A value over SQLite's length limit (1e9 bytes by default) cannot be stored at all:
+     * say so with the sizes, without trying (binding it would leave the column NULL). */
+    long long lim = sqlite3_limit(db, SQLITE_LIMIT_LENGTH, -1);
+    if ((long long)rlen > lim || (pack && (long long)pack_len > lim)) {
+        int is_pack = (long long)rlen <= lim;
+        snprintf(why, why_len,
+                 "the %s is %zu bytes, more than the job database can store in one value "
+                 "(%lld bytes)",
+                 is_pack ? "export pack" : "result", is_pack ? pack_len : rlen, lim);
+        return STORE_TOOBIG;
+    }
     char now[40];
     gpd_now_rfc3339(now, sizeof now);
     /* The result, the pack and the status change commit together: a job never shows
-     * succeeded without its files. */
-    if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) {
-        gpd_log(GPD_LOG_ERROR, "sqlite begin: %s", sqlite3_errmsg(db));
-        return STORE_ERROR;
-    }
+     * succeeded without its files. Every SQLite code is checked: a failure anywhere rolls the
+     * whole transaction back, so the job stays running for the caller to retry or fail. */
+    int src = sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL);
     store_rc rc = STORE_ERROR;
-    sqlite3_stmt *u = prep(db, "UPDATE jobs SET status='succeeded', result=?2, progress=?3, "
-                               "finished_at=?4, error=NULL WHERE id=?1 AND status='running'");
-    if (u) {
-        bind_text(u, 1, id);
-        bind_text(u, 2, result_json);
-        bind_text(u, 3, progress_json);
-        bind_text(u, 4, now);
-        if (step_done(db, u) == 0) rc = sqlite3_changes(db) > 0 ? STORE_OK : STORE_CONFLICT;
-        done(u);
+    if (src == SQLITE_OK) {
+        sqlite3_stmt *u = prep(db, "UPDATE jobs SET status='succeeded', result=?2, progress=?3, "
+                                   "finished_at=?4, error=NULL WHERE id=?1 AND status='running'");
+        if (!u) {
+            src = sqlite3_errcode(db);
+        } else {
+            src = bind_text(u, 1, id);
+            /* no copy of a result that may be hundreds of MB: it outlives the statement */
+            if (src == SQLITE_OK)
+                src = sqlite3_bind_text64(u, 2, result_json, (sqlite3_uint64)rlen, SQLITE_STATIC,
+                                          SQLITE_UTF8);
+            if (src == SQLITE_OK) src = bind_text(u, 3, progress_json);
+            if (src == SQLITE_OK) src = bind_text(u, 4, now);
+            if (src == SQLITE_OK) {
+                src = sqlite3_step(u);
+                if (src == SQLITE_DONE) {
+                    src = SQLITE_OK;
+                    rc = sqlite3_changes(db) > 0 ? STORE_OK : STORE_CONFLICT;
+                }
+            }
+            done(u);
+        }
     }
     if (rc == STORE_OK && pack) {
+        rc = STORE_ERROR;
         sqlite3_stmt *x = prep(db, "INSERT OR REPLACE INTO exports(seq, pack) "
                                    "SELECT seq, ?2 FROM jobs WHERE id=?1");
-        rc = STORE_ERROR;
-        if (x) {
-            bind_text(x, 1, id);
-            sqlite3_bind_blob64(x, 2, pack, pack_len, SQLITE_STATIC);
-            if (step_done(db, x) == 0) rc = STORE_OK;
+        if (!x) {
+            src = sqlite3_errcode(db);
+        } else {
+            src = bind_text(x, 1, id);
+            if (src == SQLITE_OK)
+                src = sqlite3_bind_blob64(x, 2, pack, (sqlite3_uint64)pack_len, SQLITE_STATIC);
+            if (src == SQLITE_OK) {
+                src = sqlite3_step(x);
+                if (src == SQLITE_DONE) {
+                    src = SQLITE_OK;
+                    rc = sqlite3_changes(db) == 1 ? STORE_OK : STORE_ERROR;
+                }
+            }
             done(x);
         }
     }
-    if (sqlite3_exec(db, rc == STORE_OK ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK) {
-        gpd_log(GPD_LOG_ERROR, "sqlite commit: %s", sqlite3_errmsg(db));
-        sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL);
-        return STORE_ERROR;
+    if (rc == STORE_OK) {
+        src = sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
+        if (src != SQLITE_OK) rc = STORE_ERROR;
     }
+    if (rc == STORE_ERROR) {
+        /* the reason before ROLLBACK replaces SQLite's message */
+        if (src == SQLITE_OK) src = sqlite3_errcode(db);
+        const char *em = sqlite3_errmsg(db);
+        if ((src & 0xff) == SQLITE_TOOBIG) rc = STORE_TOOBIG;
+        snprintf(why, why_len, "%s%s%s", sqlite3_errstr(src),
+                 em && strcmp(em, sqlite3_errstr(src)) ? ": " : "",
+                 em && strcmp(em, sqlite3_errstr(src)) ? em : "");
+        gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result: %s", id, why);
+    }
+    if (!sqlite3_get_autocommit(db) && sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK)
+        gpd_log(GPD_LOG_ERROR, "sqlite rollback: %s", sqlite3_errmsg(db));
     return rc;
 }
 
@@ -760,8 +909,11 @@ store_rc store_fail(const char *id, const char *code, const char *message)
     char now[40];
     gpd_now_rfc3339(now, sizeof now);
     json_t *e = json_pack("{s:s, s:s}", "code", code, "message", message ? message : "");
+    if (!e) /* a message that is not UTF-8: keep the code at least */
+        e = json_pack("{s:s, s:s}", "code", code, "message", "(message not representable)");
     char *et = e ? json_dumps(e, JSON_COMPACT) : NULL;
     json_decref(e);
+    if (!et) return STORE_ERROR;
     store_rc rc = update_running("UPDATE jobs SET status='failed', error=?2, finished_at=?3 "
                                  "WHERE id=?1 AND status='running'",
                                  id, et, now, NULL);

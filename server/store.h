@@ -53,11 +53,25 @@ int gpd_id_is_plausible(const char *s);
 /* ---- the store ---- */
 #define STORE_MAX_ATTEMPTS 3
 
-typedef enum { STORE_OK = 0, STORE_NOT_FOUND = 1, STORE_CONFLICT = 2, STORE_ERROR = -1 } store_rc;
+/* STORE_TOOBIG: a value larger than the database can hold (SQLITE_TOOBIG); retrying is futile. */
+typedef enum {
+    STORE_OK = 0,
+    STORE_NOT_FOUND = 1,
+    STORE_CONFLICT = 2,
+    STORE_TOOBIG = 3,
+    STORE_ERROR = -1
+} store_rc;
 
-/* Opens (creates) the database at path, sets WAL and creates the table. 0 on success. */
+/* Opens (creates) the database at path, sets WAL and creates the table. 0 on success,
+ * STORE_OPEN_LOCKED when another process (another grainpackd) holds the database, -1 on any
+ * other error (logged).
+ * First of all it takes an exclusive advisory lock on the database file, held until
+ * store_close() or the end of the process (a kill -9 releases it too): an open-file-description
+ * fcntl lock on one byte past SQLite's own lock bytes, so it follows the file whatever path
+ * names it and leaves SQLite's locking alone. So two daemons never share one file. */
+#define STORE_OPEN_LOCKED 1
 int store_open(const char *path);
-/* Closes the calling thread's connection and forbids new ones. */
+/* Closes the calling thread's connection, forbids new ones and releases the database lock. */
 void store_close(void);
 /* Closes the calling thread's connection (the next call opens a new one). */
 void store_thread_done(void);
@@ -92,9 +106,15 @@ store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts);
 store_rc store_progress(const char *id, const char *progress_json);
 
 /* Final transitions of a running job (no-ops returning STORE_CONFLICT when it is no longer
- * running, e.g. cancelled by DELETE). */
+ * running, e.g. cancelled by DELETE).
+ * store_succeed commits the result (non-NULL), the pack (may be NULL) and status 'succeeded'
+ * in one transaction, or nothing: every SQLite code is checked and a failure rolls it all
+ * back, leaving the job running. STORE_TOOBIG: the result or the pack is larger than the
+ * database can store (SQLite's length limit, 1e9 bytes by default), so it never will be;
+ * STORE_ERROR: anything else (disk full, I/O error, a failed commit...), which may pass on a
+ * retry. On both, why (may be NULL) gets a sentence saying what went wrong. */
 store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
-                       const void *pack, size_t pack_len);
+                       const void *pack, size_t pack_len, char *why, size_t why_len);
 store_rc store_fail(const char *id, const char *code, const char *message);
 /* Back to queued (graceful shutdown): the attempt is not counted. */
 store_rc store_requeue(const char *id);

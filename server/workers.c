@@ -20,12 +20,20 @@
 #include "gp_specimen3d.h"
 
 #define PROGRESS_MIN_INTERVAL_S 0.25 /* <= 4 Hz per job */
+#define STORE_RETRY_PAUSE_S 0.5      /* before the one retry of a failed final write */
+
+/* Why a slot's cancel flag was raised: the first reason wins (compare-and-swap), so that a
+ * job that overran its time limit fails with "timeout" even when a shutdown follows, and one
+ * that a DELETE cancelled stays cancelled. */
+enum { REASON_NONE = 0, REASON_DELETE, REASON_SHUTDOWN, REASON_TIMEOUT };
 
 typedef struct slot {
     pthread_t thread;
     int index;
     char id[33];          /* job being run ("" when idle); guarded by reg_mu */
+    double deadline;      /* monotonic time the run must end by, 0 = none; guarded by reg_mu */
     volatile int cancel;  /* read by the core; written with __atomic_store_n */
+    int reason;           /* REASON_*, atomic */
 } slot;
 
 static slot *slots = NULL;
@@ -37,8 +45,36 @@ static pthread_cond_t wake_cv;
 static unsigned long wake_gen = 0; /* guarded by wake_mu */
 static int stopping = 0;           /* atomic */
 static int busy = 0;               /* atomic */
+static long job_timeout_s = 3600;  /* set before workers_start; 0 = no limit */
+
+/* the watchdog: raises the cancel flag of a job whose run passed its deadline */
+static pthread_t wd_thread;
+static int wd_running = 0;
+static pthread_mutex_t wd_mu = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t wd_cv;
+static unsigned long wd_gen = 0; /* guarded by wd_mu */
 
 int workers_total(void) { return nslots; }
+
+void workers_set_job_timeout(long seconds) { job_timeout_s = seconds > 0 ? seconds : 0; }
+
+/* Raises s's cancel flag for reason r unless another reason came first; 1 when r won. */
+static int raise_cancel(slot *s, int r)
+{
+    int none = REASON_NONE;
+    int won = __atomic_compare_exchange_n(&s->reason, &none, r, 0, __ATOMIC_RELAXED,
+                                          __ATOMIC_RELAXED);
+    __atomic_store_n(&s->cancel, 1, __ATOMIC_RELAXED);
+    return won;
+}
+
+static void wd_kick(void)
+{
+    pthread_mutex_lock(&wd_mu);
+    wd_gen++;
+    pthread_cond_broadcast(&wd_cv);
+    pthread_mutex_unlock(&wd_mu);
+}
 int workers_busy(void) { return __atomic_load_n(&busy, __ATOMIC_RELAXED); }
 
 void workers_notify(void)
@@ -56,7 +92,7 @@ store_rc workers_cancel(const char *id, char status_out[16])
     store_rc rc = store_cancel(id, &was_running, status_out);
     if (rc == STORE_OK && was_running) {
         for (int i = 0; i < nslots; i++)
-            if (!strcmp(slots[i].id, id)) __atomic_store_n(&slots[i].cancel, 1, __ATOMIC_RELAXED);
+            if (!strcmp(slots[i].id, id)) raise_cancel(&slots[i], REASON_DELETE);
     }
     pthread_mutex_unlock(&reg_mu);
     if (rc == STORE_OK) gpd_log(GPD_LOG_INFO, "job %s cancelled (was %s)", id,
@@ -71,6 +107,7 @@ typedef struct run_ctx {
     const char *id;
     double t0;
     double last_write;
+    char phase[32]; /* the last phase the core reported ("starting" before the first) */
 } run_ctx;
 
 /* detail: NULL = {} (taken) */
@@ -90,6 +127,8 @@ __attribute__((unused)) static int report(run_ctx *c, const char *phase, double 
                                           double error, int is3d, double porosity,
                                           double stability)
 {
+    if (phase && strncmp(c->phase, phase, sizeof c->phase - 1))
+        snprintf(c->phase, sizeof c->phase, "%s", phase);
     if (__atomic_load_n(&c->s->cancel, __ATOMIC_RELAXED)) return 1;
     double now = gpd_monotonic_s();
     if (now - c->last_write < PROGRESS_MIN_INTERVAL_S) return 0;
@@ -126,10 +165,105 @@ static int on_progress3d(void *user, const gp_progress3d *p)
 
 /* ------------------------------------------------------------------ one job */
 
+static void pause_s(double s)
+{
+    struct timespec ts = {.tv_sec = (time_t)s, .tv_nsec = (long)((s - (double)(time_t)s) * 1e9)};
+    while (nanosleep(&ts, &ts) != 0) {
+    }
+}
+
+/* Final states that could not be written (the database refused every try): kept here and
+ * written by the next worker that comes by (each idle second at least, and at shutdown), so
+ * that no job stays 'running' silently while the daemon lives. Guarded by pend_mu. */
+typedef struct pending {
+    struct pending *next;
+    char id[33];
+    char code[32];
+    char *msg;
+} pending;
+static pending *pend_head = NULL;
+static int pend_count = 0; /* atomic; guarded by pend_mu for writes */
+static pthread_mutex_t pend_mu = PTHREAD_MUTEX_INITIALIZER;
+
+static void pending_add(const char *id, const char *code, const char *msg)
+{
+    pending *p = calloc(1, sizeof *p);
+    if (p) p->msg = strdup(msg ? msg : "");
+    if (!p || !p->msg) {
+        free(p);
+        gpd_log(GPD_LOG_ERROR, "job %s stays running in the database (out of memory); it is "
+                               "requeued at the next start", id);
+        return;
+    }
+    snprintf(p->id, sizeof p->id, "%s", id);
+    snprintf(p->code, sizeof p->code, "%s", code);
+    pthread_mutex_lock(&pend_mu);
+    p->next = pend_head;
+    pend_head = p;
+    __atomic_add_fetch(&pend_count, 1, __ATOMIC_RELAXED);
+    pthread_mutex_unlock(&pend_mu);
+}
+
+/* Tries to write every pending final state once; `last`: at shutdown, say what is left. */
+static void pending_drain(int last)
+{
+    if (!__atomic_load_n(&pend_count, __ATOMIC_RELAXED)) return;
+    if (last)
+        pthread_mutex_lock(&pend_mu);
+    else if (pthread_mutex_trylock(&pend_mu) != 0)
+        return; /* another worker is at it */
+    pending **pp = &pend_head;
+    while (*pp) {
+        pending *p = *pp;
+        store_rc rc = store_fail(p->id, p->code, p->msg);
+        if (rc == STORE_ERROR && !last) {
+            pp = &p->next;
+            continue;
+        }
+        if (rc == STORE_ERROR) /* the daemon is stopping: the restart rule takes it over */
+            gpd_log(GPD_LOG_ERROR, "job %s stays running in the database (it cannot be marked "
+                                   "failed: %s: %s); it is requeued at the next start",
+                    p->id, p->code, p->msg);
+        else if (rc == STORE_OK)
+            gpd_log(GPD_LOG_INFO, "job %s failed: %s: %s (written late)", p->id, p->code,
+                    p->msg);
+        *pp = p->next;
+        free(p->msg);
+        free(p);
+        __atomic_sub_fetch(&pend_count, 1, __ATOMIC_RELAXED);
+    }
+    pthread_mutex_unlock(&pend_mu);
+}
+
+/* Marks a running job failed. A write the database refuses is tried again after a pause, then
+ * left to pending_drain, and said in the log at level error: never silently running. */
 static void finish_failed(const char *id, const char *code, const char *msg)
 {
-    if (store_fail(id, code, msg) == STORE_OK)
+    store_rc rc = store_fail(id, code, msg);
+    if (rc == STORE_ERROR) {
+        pause_s(STORE_RETRY_PAUSE_S);
+        rc = store_fail(id, code, msg);
+    }
+    if (rc == STORE_OK) {
         gpd_log(GPD_LOG_INFO, "job %s failed: %s: %s", id, code, msg);
+    } else if (rc == STORE_ERROR) {
+        gpd_log(GPD_LOG_ERROR, "job %s: cannot mark it failed (%s: %s); it shows running until "
+                               "a retry succeeds",
+                id, code, msg);
+        pending_add(id, code, msg);
+    }
+    /* STORE_CONFLICT: no longer running (cancelled meanwhile); nothing to write */
+}
+
+/* The run passed --job-timeout (the watchdog raised the flag): the job fails with "timeout". */
+static void finish_timeout(run_ctx *ctx, const char *phase)
+{
+    char msg[200];
+    snprintf(msg, sizeof msg,
+             "stopped after running longer than the job time limit of %ld s (--job-timeout), "
+             "in phase \"%s\"",
+             job_timeout_s, phase);
+    finish_failed(ctx->id, "timeout", msg);
 }
 
 /* Stores a result (takes r) and the export pack (takes pack, may be NULL) together with status
@@ -141,15 +275,32 @@ __attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r, js
     char *text = r ? json_dumps(r, JSON_COMPACT | JSON_REAL_PRECISION(17)) : NULL;
     json_decref(r);
     char *prog = progress_text("done", 1.0, 0.0, detail);
-    if (!text || !prog) {
+    if (__atomic_load_n(&ctx->s->reason, __ATOMIC_RELAXED) == REASON_TIMEOUT) {
+        /* the limit passed while the result was being built */
+        finish_timeout(ctx, "result");
+    } else if (!text || !prog) {
         finish_failed(ctx->id, "internal", "out of memory while serialising the result");
     } else {
-        store_rc rc = store_succeed(ctx->id, text, prog, pack, pack_len);
-        if (rc == STORE_OK)
+        char why[400];
+        store_rc rc = store_succeed(ctx->id, text, prog, pack, pack_len, why, sizeof why);
+        if (rc == STORE_ERROR) { /* maybe passing (busy, I/O): once more after a pause */
+            gpd_log(GPD_LOG_WARN, "job %s: storing the result failed (%s); retrying once",
+                    ctx->id, why);
+            pause_s(STORE_RETRY_PAUSE_S);
+            rc = store_succeed(ctx->id, text, prog, pack, pack_len, why, sizeof why);
+        }
+        char msg[600];
+        if (rc == STORE_OK) {
             gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%zu bytes)", ctx->id,
                     gpd_monotonic_s() - ctx->t0, strlen(text));
-        else if (rc == STORE_ERROR)
-            gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result", ctx->id);
+        } else if (rc == STORE_TOOBIG) {
+            snprintf(msg, sizeof msg, "the result cannot be stored: %s", why);
+            finish_failed(ctx->id, "too_large", msg);
+        } else if (rc == STORE_ERROR) {
+            snprintf(msg, sizeof msg, "the result could not be stored (tried twice): %s", why);
+            finish_failed(ctx->id, "store_error", msg);
+        }
+        /* STORE_CONFLICT: cancelled by a DELETE meanwhile */
     }
     free(text);
     free(prog);
@@ -160,6 +311,10 @@ __attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r, js
 __attribute__((unused)) static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err,
                                                   const char *extra)
 {
+    if (__atomic_load_n(&ctx->s->reason, __ATOMIC_RELAXED) == REASON_TIMEOUT) {
+        finish_timeout(ctx, ctx->phase);
+        return;
+    }
     if (st == GP_ERR_CANCELLED || __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED)) {
         if (__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
             if (store_requeue(ctx->id) == STORE_OK)
@@ -208,7 +363,8 @@ static void run_2d(slot *s, const char *id, json_t *spec_json)
         return;
     }
     spec.threads = 1;
-    run_ctx ctx = {.s = s, .id = id, .t0 = gpd_monotonic_s(), .last_write = 0};
+    run_ctx ctx = {.s = s, .id = id, .t0 = gpd_monotonic_s(), .last_write = 0,
+                   .phase = "starting"};
     gp_specimen2d *out = NULL;
     gp_error err;
     gp_error_clear(&err);
@@ -251,7 +407,8 @@ static void run_3d(slot *s, const char *id, json_t *spec_json)
         return;
     }
     spec.threads = 1;
-    run_ctx ctx = {.s = s, .id = id, .t0 = gpd_monotonic_s(), .last_write = 0};
+    run_ctx ctx = {.s = s, .id = id, .t0 = gpd_monotonic_s(), .last_write = 0,
+                   .phase = "starting"};
     gp_specimen3d *out = NULL;
     gp_error err;
     gp_error_clear(&err);
@@ -309,6 +466,8 @@ static void *worker_main(void *arg)
         unsigned long gen = wake_gen;
         pthread_mutex_unlock(&wake_mu);
 
+        pending_drain(0);
+
         char id[33];
         char *kind = NULL, *spec = NULL;
         int attempts = 0;
@@ -319,11 +478,15 @@ static void *worker_main(void *arg)
             if (rc == STORE_OK) {
                 snprintf(s->id, sizeof s->id, "%s", id);
                 __atomic_store_n(&s->cancel, 0, __ATOMIC_RELAXED);
+                __atomic_store_n(&s->reason, REASON_NONE, __ATOMIC_RELAXED);
+                /* the limit is per run attempt: a job requeued by a restart starts afresh */
+                s->deadline = job_timeout_s > 0 ? gpd_monotonic_s() + (double)job_timeout_s : 0;
             }
         }
         pthread_mutex_unlock(&reg_mu);
 
         if (rc == STORE_OK) {
+            if (job_timeout_s > 0) wd_kick();
             __atomic_add_fetch(&busy, 1, __ATOMIC_RELAXED);
             gpd_log(GPD_LOG_INFO, "job %s started on worker %d (attempt %d)", id, s->index,
                     attempts);
@@ -337,6 +500,7 @@ static void *worker_main(void *arg)
 #endif
             pthread_mutex_lock(&reg_mu);
             s->id[0] = '\0';
+            s->deadline = 0;
             pthread_mutex_unlock(&reg_mu);
             __atomic_sub_fetch(&busy, 1, __ATOMIC_RELAXED);
             continue;
@@ -356,16 +520,74 @@ static void *worker_main(void *arg)
     return NULL;
 }
 
+/* One thread for all the slots: it sleeps until the earliest deadline of a running job (or a
+ * claim, or the stop), then raises the cancel flag of every job past its deadline. The core
+ * polls the flag in every phase, so the job stops there and its worker fails it with
+ * "timeout" (finish_timeout). */
+static void *watchdog_main(void *arg)
+{
+    (void)arg;
+    while (!__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
+        pthread_mutex_lock(&wd_mu);
+        unsigned long gen = wd_gen;
+        pthread_mutex_unlock(&wd_mu);
+
+        double now = gpd_monotonic_s(), next = 0;
+        pthread_mutex_lock(&reg_mu);
+        for (int i = 0; i < nslots; i++) {
+            slot *s = &slots[i];
+            if (!s->id[0] || s->deadline <= 0 ||
+                __atomic_load_n(&s->reason, __ATOMIC_RELAXED) != REASON_NONE)
+                continue;
+            if (now >= s->deadline) {
+                if (raise_cancel(s, REASON_TIMEOUT))
+                    gpd_log(GPD_LOG_INFO, "job %s: over the job time limit (%ld s), stopping it",
+                            s->id, job_timeout_s);
+            } else if (next == 0 || s->deadline < next) {
+                next = s->deadline;
+            }
+        }
+        pthread_mutex_unlock(&reg_mu);
+
+        struct timespec dl;
+        if (next > 0) {
+            double t = next + 0.001; /* past it, so that the next pass sees it due */
+            dl.tv_sec = (time_t)t;
+            dl.tv_nsec = (long)((t - (double)dl.tv_sec) * 1e9);
+            if (dl.tv_nsec >= 1000000000L) dl.tv_nsec = 999999999L;
+        }
+        pthread_mutex_lock(&wd_mu);
+        while (wd_gen == gen && !__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
+            if (next > 0) {
+                if (pthread_cond_timedwait(&wd_cv, &wd_mu, &dl) != 0) break;
+            } else {
+                pthread_cond_wait(&wd_cv, &wd_mu);
+            }
+        }
+        pthread_mutex_unlock(&wd_mu);
+    }
+    return NULL;
+}
+
 int workers_start(int n)
 {
     pthread_condattr_t ca;
     pthread_condattr_init(&ca);
     pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
     pthread_cond_init(&wake_cv, &ca);
+    pthread_cond_init(&wd_cv, &ca);
     pthread_condattr_destroy(&ca);
     slots = calloc((size_t)n, sizeof *slots);
     if (!slots) return -1;
     nslots = n;
+    if (job_timeout_s > 0) {
+        if (pthread_create(&wd_thread, NULL, watchdog_main, NULL) != 0) {
+            gpd_log(GPD_LOG_ERROR, "cannot start the job-timeout watchdog");
+            nslots = 0;
+            return -1;
+        }
+        wd_running = 1;
+    }
     for (int i = 0; i < n; i++) {
         slots[i].index = i;
         if (pthread_create(&slots[i].thread, NULL, worker_main, &slots[i]) != 0) {
@@ -384,13 +606,20 @@ void workers_stop(void)
     __atomic_store_n(&stopping, 1, __ATOMIC_RELAXED);
     pthread_mutex_lock(&reg_mu);
     for (int i = 0; i < nslots; i++)
-        if (slots[i].id[0]) __atomic_store_n(&slots[i].cancel, 1, __ATOMIC_RELAXED);
+        if (slots[i].id[0]) raise_cancel(&slots[i], REASON_SHUTDOWN);
     pthread_mutex_unlock(&reg_mu);
     workers_notify();
+    if (wd_running) {
+        wd_kick();
+        pthread_join(wd_thread, NULL);
+        wd_running = 0;
+    }
     for (int i = 0; i < nslots; i++) pthread_join(slots[i].thread, NULL);
+    pending_drain(1);
     free(slots);
     slots = NULL;
     nslots = 0;
     pthread_cond_destroy(&wake_cv);
+    pthread_cond_destroy(&wd_cv);
     started = 0;
 }

@@ -8,12 +8,25 @@
  * job cancelled in the store and raises the cancel flag the core polls, so a running job stops
  * within its next poll (well under a second). Shutdown raises every flag and puts the running
  * jobs back in the queue (store_requeue), so they resume on the next start.
+ *
+ * Time limit (--job-timeout): a watchdog thread raises the cancel flag of a job whose run has
+ * lasted longer than the limit; the job then fails with error code "timeout" and a message
+ * naming the limit and the phase it was stopped in. The limit applies to each run attempt:
+ * a job requeued by a restart gets the whole limit again. A DELETE wins over a timeout that
+ * comes after it (the job stays cancelled), a timeout over a shutdown that comes after it
+ * (the job fails instead of being requeued).
+ * Final writes: a result or a failure the database refuses is retried once; a result that can
+ * never be stored (too big) fails the job with code "too_large", one that still cannot be
+ * stored with code "store_error"; a failure that cannot be written is kept and written later,
+ * and logged at level error, so that no job stays running silently.
  */
 #ifndef GPD_WORKERS_H
 #define GPD_WORKERS_H
 
 #include "store.h"
 
+/* The per-run time limit in seconds (0 = none; default 3600); call before workers_start. */
+void workers_set_job_timeout(long seconds);
 int workers_start(int n);
 /* A job was queued: wake an idle worker. */
 void workers_notify(void);

@@ -60,10 +60,12 @@ JOB_KEYS = {"id", "kind", "status", "created_at", "started_at", "finished_at", "
 
 
 class Daemon:
-    """One grainpackd process on 127.0.0.1:0."""
+    """One grainpackd process on 127.0.0.1:0 (or listen="HOST:0"; requests then still go to
+    127.0.0.1 when HOST is 0.0.0.0)."""
 
-    def __init__(self, binary, db, workers=2, extra=(), env=None, tag="d"):
+    def __init__(self, binary, db, workers=2, extra=(), env=None, tag="d", listen="127.0.0.1:0"):
         self.binary = binary
+        self.listen = listen
         self.db = db
         self.workers = workers
         self.extra = list(extra)
@@ -77,7 +79,7 @@ class Daemon:
 
     def start(self, timeout=20):
         self.log = open(self.log_path, "ab")
-        cmd = [self.binary, "--listen", "127.0.0.1:0", "--db", self.db,
+        cmd = [self.binary, "--listen", self.listen, "--db", self.db,
                "--workers", str(self.workers)] + self.extra
         self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.log, env=self.env)
         deadline = time.time() + timeout
@@ -94,8 +96,9 @@ class Daemon:
                     continue
                 line += ch
         text = line.decode().strip()
-        assert text.startswith("listening on http://127.0.0.1:"), text
-        self.url = text[len("listening on "):]
+        expect = "127.0.0.1:" if self.listen.startswith("127.0.0.1:") else ""
+        assert text.startswith("listening on http://" + expect), text
+        self.url = text[len("listening on "):].replace("//0.0.0.0:", "//127.0.0.1:")
         return self
 
     def read_log(self):

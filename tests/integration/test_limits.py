@@ -1,0 +1,197 @@
+"""Limits of grainpackd against the real daemon: --job-timeout (a job that runs too long fails
+with error code "timeout"; a DELETE stays "cancelled"), the exclusive lock on the SQLite file (a
+second daemon on the same database refuses to start, the first keeps working), and a result
+the database cannot store (too big, or the disk full) fails its job with a reason instead of
+committing "succeeded" without a result or staying "running"."""
+import datetime
+import os
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gpd  # noqa: E402
+
+# IMC that runs for many seconds: the AD error cannot fall to 1e-9, and at N = 2000 it keeps
+# gaining more than 1 % per stall window (120,000 steps) for longer than these tests wait.
+ENDLESS_2D = {
+    "kind": "fourier-voronoi-2d",
+    "seed": 3,
+    "particles": 2000,
+    "imc": {"error": "AD", "threshold": 1e-9, "max_steps": 1000000000},
+    "contour_points": 32,
+    "outputs": ["grains"],
+}
+
+LOCK_MESSAGE = "is in use by another grainpackd"
+
+
+def ts(s):
+    return datetime.datetime.strptime(s, "%Y-%m-%dT%H:%M:%S.%fZ")
+
+
+def health_latency(d):
+    t0 = time.time()
+    st, _, h = d.json("GET", "/v1/health", timeout=5)
+    assert st == 200, (st, h)
+    return time.time() - t0, h
+
+
+def test_job_timeout(env):
+    d = env.daemon(workers=1, extra=["--job-timeout", "2"])
+    jid = d.submit(ENDLESS_2D)
+    d.wait(jid, states=("running",), timeout=10, interval=0.01)
+    t_run = time.time()
+    worst = 0.0
+    while True:
+        lat, _ = health_latency(d)
+        worst = max(worst, lat)
+        j = d.job(jid)
+        if j["status"] in gpd.FINAL:
+            break
+        assert time.time() - t_run < 10 * gpd.TIME_SCALE, j
+        time.sleep(0.05)
+    seen = time.time() - t_run
+    gpd.check_job_object(j)
+    assert j["status"] == "failed", j
+    e = j["error"]
+    assert e["code"] == "timeout", e
+    assert "2 s" in e["message"] and "--job-timeout" in e["message"], e
+    assert 'in phase "' in e["message"], e
+    ran = (ts(j["finished_at"]) - ts(j["started_at"])).total_seconds()
+    print("  timeout: ran %.3f s (started_at..finished_at), seen failed %.2f s after running; "
+          "%s; health worst %.1f ms" % (ran, seen, e["message"], worst * 1e3))
+    assert 2.0 <= ran <= 3.0 * gpd.TIME_SCALE, ran
+    assert seen <= 4.0 * gpd.TIME_SCALE, seen
+    # the daemon keeps serving, the worker is free again and a short job still succeeds
+    lat, h = health_latency(d)
+    assert lat < 0.1 * gpd.TIME_SCALE, lat
+    assert h["workers_busy"] == 0 and h["running"] == 0, h
+    assert worst < 0.5 * gpd.TIME_SCALE, worst
+    st, _, j2 = d.json("DELETE", "/v1/jobs/" + jid)
+    assert st == 409, (st, j2)
+    assert d.wait(d.submit(gpd.SMALL_2D))["status"] == "succeeded"
+    assert d.stop() == 0, d.read_log()
+
+
+def test_delete_is_cancelled_not_timeout(env):
+    d = env.daemon(workers=1, extra=["--job-timeout", "2"])
+    jid = d.submit(ENDLESS_2D)
+    d.wait(jid, states=("running",), timeout=10, interval=0.01)
+    time.sleep(1.0)
+    st, _, j = d.json("DELETE", "/v1/jobs/" + jid)
+    assert st == 200 and j["status"] == "cancelled", (st, j)
+    # past the limit: still cancelled, never turned into a timeout
+    time.sleep(2.0)
+    j = d.job(jid)
+    assert j["status"] == "cancelled" and j["error"]["code"] == "cancelled", j
+    _, h = health_latency(d)
+    assert h["workers_busy"] == 0, h
+    assert "over the job time limit" not in d.read_log(), d.read_log()
+    assert d.stop() == 0, d.read_log()
+
+
+def test_timeout_from_environment_and_zero(env):
+    # GRAINPACK_JOB_TIMEOUT sets it; a flag wins over it; 0 = no limit
+    d = env.daemon(workers=1, env={"GRAINPACK_JOB_TIMEOUT": "1"})
+    jid = d.submit(ENDLESS_2D)
+    j = d.wait(jid, timeout=10 * gpd.TIME_SCALE)
+    assert j["status"] == "failed" and j["error"]["code"] == "timeout", j
+    assert "1 s" in j["error"]["message"], j
+    assert d.stop() == 0, d.read_log()
+    d = env.daemon(workers=1, env={"GRAINPACK_JOB_TIMEOUT": "1"}, extra=["--job-timeout", "0"])
+    jid = d.submit(ENDLESS_2D)
+    d.wait(jid, states=("running",), timeout=10, interval=0.01)
+    time.sleep(2.0)
+    assert d.job(jid)["status"] == "running"
+    assert d.json("DELETE", "/v1/jobs/" + jid)[0] == 200
+    assert d.stop() == 0, d.read_log()
+    r = subprocess.run([env.binary, "--job-timeout", "-1"], capture_output=True, timeout=10)
+    assert r.returncode == 2 and b"--job-timeout" in r.stderr, r
+    r = subprocess.run([env.binary, "--help"], capture_output=True, timeout=10)
+    assert b"--job-timeout" in r.stdout and b"GRAINPACK_JOB_TIMEOUT" in r.stdout, r.stdout
+
+
+def second_daemon(env, db):
+    """Starts a daemon on db expecting a refusal: (exit status, stderr, seconds)."""
+    t0 = time.time()
+    r = subprocess.run([env.binary, "--listen", "127.0.0.1:0", "--db", db, "--workers", "1"],
+                       capture_output=True, timeout=20)
+    return r.returncode, r.stdout.decode(errors="replace"), r.stderr.decode(errors="replace"), \
+        time.time() - t0
+
+
+def test_second_daemon_refused(env):
+    d = env.daemon(workers=2, extra=["--job-timeout", "0"])
+    long_id = d.submit(ENDLESS_2D)
+    d.wait(long_id, states=("running",), timeout=10, interval=0.01)
+    started = d.job(long_id)["started_at"]
+    # the same file by its path, by another spelling of it and through a symlink
+    link = os.path.join(env.dir, "link.db")
+    os.symlink(env.db, link)
+    for db in (env.db, os.path.join(env.dir, ".", "jobs.db"), link):
+        rc, out, err, secs = second_daemon(env, db)
+        print("  second daemon on %s: exit %d in %.3f s: %s" % (db, rc, secs, err.strip()))
+        assert rc != 0, (rc, out, err)
+        assert LOCK_MESSAGE in err and db in err, err
+        assert "listening on" not in out, out
+    # the first daemon's job was not touched (not requeued, not restarted) and it keeps working
+    j = d.job(long_id)
+    assert j["status"] == "running" and j["started_at"] == started, j
+    lat, h = health_latency(d)
+    assert lat < 0.1 * gpd.TIME_SCALE and h["running"] == 1, (lat, h)
+    assert d.wait(d.submit(gpd.SMALL_2D))["status"] == "succeeded"
+    assert d.json("DELETE", "/v1/jobs/" + long_id)[0] == 200
+    # the lock goes with the daemon: after a clean stop, and after kill -9
+    assert d.stop() == 0, d.read_log()
+    d2 = env.daemon(workers=1)
+    assert d2.job(long_id)["status"] == "cancelled"
+    d2.kill9()
+    d3 = env.daemon(workers=1)
+    assert d3.json("GET", "/v1/health")[0] == 200
+    assert d3.stop() == 0, d3.read_log()
+
+
+def test_result_too_big_fails(env):
+    # SQLite's length limit lowered to 20 kB (a testing hook): SMALL_2D's result is larger, so
+    # it cannot be stored -- the job fails saying so, it never shows succeeded without a result
+    d = env.daemon(workers=1, env={"GRAINPACK_TEST_SQLITE_MAX_LENGTH": "20000"})
+    jid = d.submit(gpd.SMALL_2D)
+    j = d.wait(jid, timeout=60)
+    gpd.check_job_object(j)
+    assert j["status"] == "failed", j
+    e = j["error"]
+    assert e["code"] == "too_large", e
+    assert "result" in e["message"] and "20000 bytes" in e["message"], e
+    print("  too big: %s" % e["message"])
+    st, _, b = d.json("GET", "/v1/jobs/%s/result" % jid)
+    assert st == 409, (st, b)
+    _, h = health_latency(d)
+    assert h["running"] == 0 and h["workers_busy"] == 0, h
+    assert d.stop() == 0, d.read_log()
+
+
+def test_disk_full_fails_visibly(env):
+    # the database capped at a few pages (a testing hook; SQLite answers SQLITE_FULL as on a
+    # full disk): the job is small, its result is not; the commit is tried twice, then the job
+    # fails with code store_error -- not left running
+    d = env.daemon(workers=1, env={"GRAINPACK_TEST_SQLITE_MAX_PAGES": "10"})
+    jid = d.submit(gpd.SMALL_2D)
+    j = d.wait(jid, timeout=60)
+    gpd.check_job_object(j)
+    assert j["status"] == "failed", j
+    e = j["error"]
+    assert e["code"] == "store_error", e
+    assert "full" in e["message"] and "tried twice" in e["message"], e
+    print("  disk full: %s" % e["message"])
+    assert "retrying once" in d.read_log(), d.read_log()
+    assert d.json("GET", "/v1/jobs/%s/result" % jid)[0] == 409
+    _, h = health_latency(d)
+    assert h["running"] == 0 and h["workers_busy"] == 0, h
+    assert d.stop() == 0, d.read_log()
+
+
+if __name__ == "__main__":
+    gpd.main([test_job_timeout, test_delete_is_cancelled_not_timeout,
+              test_timeout_from_environment_and_zero, test_second_daemon_refused,
+              test_result_too_big_fails, test_disk_full_fails_visibly])
