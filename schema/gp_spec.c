@@ -2,14 +2,18 @@
  * the parsers from JSON to the core's spec structs. See gp_spec.h. */
 #include "gp_spec.h"
 
+#include "gp_geom.h"
 #include "gp_imc.h"
+#include "gp_sieve.h"
 
 #include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 extern const unsigned char gp_schema_text_fourier_voronoi_2d[];
 extern const unsigned char gp_schema_text_spheres_3d[];
@@ -20,6 +24,8 @@ static const char *const g_kinds[NKINDS + 1] = {"fourier-voronoi-2d", "spheres-3
 static json_t *g_schema[NKINDS];
 static int g_schema_ok = 0;
 static pthread_once_t g_once = PTHREAD_ONCE_INIT;
+
+static void compile_all(const json_t *root, const json_t *v);
 
 static void load_schemas(void)
 {
@@ -35,6 +41,7 @@ static void load_schemas(void)
             g_schema_ok = 0;
         }
     }
+    for (int k = 0; k < NKINDS && g_schema_ok; k++) compile_all(g_schema[k], g_schema[k]);
 }
 
 const char *const *gp_spec_kinds(void) { return g_kinds; }
@@ -95,9 +102,14 @@ static size_t ptr_push(ptrbuf *b, const char *tok)
 
 static size_t ptr_push_index(ptrbuf *b, size_t i)
 {
-    char t[32];
-    snprintf(t, sizeof t, "%zu", i);
-    return ptr_push(b, t);
+    /* every item of every array comes here: digits without printf */
+    char t[32], *q = t + sizeof t - 1;
+    *q = 0;
+    do {
+        *--q = (char)('0' + i % 10);
+        i /= 10;
+    } while (i);
+    return ptr_push(b, q);
 }
 
 static void ptr_pop(ptrbuf *b, size_t old)
@@ -300,16 +312,133 @@ static int is_integral(const json_t *v)
     return isfinite(d) && d == floor(d) && fabs(d) < 9.2e18;
 }
 
-static int type_matches(const char *type, const json_t *v)
+/* Compiled schema nodes: the keywords of each schema object of the embedded documents, read
+ * once (with the schemas, under pthread_once) and found by the object's address, so that
+ * validate() looks nothing up by name for each instance value -- a 1 MB body is ~100,000
+ * polygon points, each an array of two numbers. */
+enum {
+    T_OBJECT = 1, T_ARRAY = 2, T_STRING = 4, T_NUMBER = 8, T_INTEGER = 16, T_BOOLEAN = 32,
+    T_NULL = 64, T_UNKNOWN = 128
+};
+enum { L_MIN, L_MAX, L_XMIN, L_XMAX, L_MINLEN, L_MAXLEN, L_MINITEMS, L_MAXITEMS, L_COUNT };
+static const char *const g_limit_names[L_COUNT] = {
+    "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum",
+    "minLength", "maxLength", "minItems", "maxItems"};
+
+typedef struct cnode {
+    const json_t *key;          /* the schema as written (with its $ref); NULL: a free slot */
+    const json_t *s;            /* the schema it resolves to; NULL: a broken reference */
+    const json_t *konst, *enm, *prefix, *items, *props, *required, *addl, *oneof;
+    unsigned types;             /* T_* of the type keyword; 0 when there is none */
+    unsigned char has[L_COUNT];
+    double lim[L_COUNT];
+    size_t nprefix;
+    int unique, objkw;
+} cnode;
+
+#define CNODE_CAP 4096 /* power of two; the two schemas have a few hundred objects */
+static cnode g_cnodes[CNODE_CAP];
+static size_t g_ncnodes;
+
+static unsigned type_bit(const char *t)
 {
-    if (!strcmp(type, "object")) return json_is_object(v);
-    if (!strcmp(type, "array")) return json_is_array(v);
-    if (!strcmp(type, "string")) return json_is_string(v);
-    if (!strcmp(type, "number")) return json_is_number(v) && isfinite(json_number_value(v));
-    if (!strcmp(type, "integer")) return is_integral(v);
-    if (!strcmp(type, "boolean")) return json_is_boolean(v);
-    if (!strcmp(type, "null")) return json_is_null(v);
-    return 0;
+    if (!strcmp(t, "object")) return T_OBJECT;
+    if (!strcmp(t, "array")) return T_ARRAY;
+    if (!strcmp(t, "string")) return T_STRING;
+    if (!strcmp(t, "number")) return T_NUMBER;
+    if (!strcmp(t, "integer")) return T_INTEGER;
+    if (!strcmp(t, "boolean")) return T_BOOLEAN;
+    if (!strcmp(t, "null")) return T_NULL;
+    return T_UNKNOWN;
+}
+
+/* the T_* an instance satisfies ("number": finite; "integer": a number with no fraction) */
+static unsigned types_of(const json_t *v)
+{
+    switch (json_typeof(v)) {
+    case JSON_OBJECT: return T_OBJECT;
+    case JSON_ARRAY: return T_ARRAY;
+    case JSON_STRING: return T_STRING;
+    case JSON_INTEGER: return T_NUMBER | T_INTEGER;
+    case JSON_REAL:
+        if (!isfinite(json_real_value(v))) return 0;
+        return T_NUMBER | (is_integral(v) ? T_INTEGER : 0);
+    case JSON_TRUE:
+    case JSON_FALSE: return T_BOOLEAN;
+    case JSON_NULL: return T_NULL;
+    default: return 0;
+    }
+}
+
+static void compile_node(const json_t *root, const json_t *schema, cnode *n)
+{
+    memset(n, 0, sizeof *n);
+    n->key = schema;
+    const json_t *s = resolve_ref(root, schema);
+    n->s = s;
+    if (!s || !json_is_object(s)) return;
+    n->konst = json_object_get(s, "const");
+    n->enm = json_object_get(s, "enum");
+    const json_t *type = json_object_get(s, "type");
+    if (json_is_string(type)) {
+        n->types = type_bit(json_string_value(type));
+    } else if (type) {
+        n->types = T_UNKNOWN; /* a type keyword that lists nothing known matches nothing */
+        size_t i;
+        const json_t *t;
+        json_array_foreach(type, i, t) {
+            if (json_is_string(t)) n->types |= type_bit(json_string_value(t));
+        }
+    }
+    for (int l = 0; l < L_COUNT; l++) n->has[l] = (unsigned char)get_num(s, g_limit_names[l], &n->lim[l]);
+    n->prefix = json_object_get(s, "prefixItems");
+    n->nprefix = json_array_size(n->prefix);
+    n->items = json_object_get(s, "items");
+    n->unique = json_is_true(json_object_get(s, "uniqueItems"));
+    n->props = json_object_get(s, "properties");
+    n->required = json_object_get(s, "required");
+    n->addl = json_object_get(s, "additionalProperties");
+    n->objkw = n->props || n->required || n->addl;
+    n->oneof = json_object_get(s, "oneOf");
+}
+
+static size_t cnode_slot(const json_t *key)
+{
+    uintptr_t h = (uintptr_t)key;
+    h ^= h >> 17;
+    h *= (uintptr_t)0x9E3779B97F4A7C15ull;
+    return (size_t)(h >> 7) & (CNODE_CAP - 1);
+}
+
+/* compiles every object of a schema document (at load time) */
+static void compile_all(const json_t *root, const json_t *v)
+{
+    if (json_is_object(v)) {
+        size_t i = cnode_slot(v);
+        while (g_cnodes[i].key && g_cnodes[i].key != v) i = (i + 1) & (CNODE_CAP - 1);
+        if (!g_cnodes[i].key && g_ncnodes < CNODE_CAP / 2) {
+            compile_node(root, v, &g_cnodes[i]);
+            g_ncnodes++;
+        }
+        const char *k;
+        json_t *x;
+        json_object_foreach((json_t *)v, k, x) compile_all(root, x);
+    } else if (json_is_array(v)) {
+        size_t i;
+        json_t *x;
+        json_array_foreach(v, i, x) compile_all(root, x);
+    }
+}
+
+/* the compiled node of schema: from the table, or compiled into *local */
+static const cnode *node_of(const json_t *root, const json_t *schema, cnode *local)
+{
+    if (schema) {
+        for (size_t i = cnode_slot(schema); g_cnodes[i].key; i = (i + 1) & (CNODE_CAP - 1))
+            if (g_cnodes[i].key == schema) return &g_cnodes[i];
+    }
+    compile_node(root, schema, local);
+    return local;
 }
 
 static int fail_expected(vctx *c, const json_t *schema, const json_t *v)
@@ -387,10 +516,10 @@ static int validate_oneof(vctx *c, const json_t *schema, const json_t *branches,
     return fail_expected(c, schema, v);
 }
 
-static int validate_object(vctx *c, const json_t *schema, const json_t *v)
+static int validate_object(vctx *c, const cnode *n, const json_t *v)
 {
-    const json_t *props = json_object_get(schema, "properties");
-    const json_t *addl = json_object_get(schema, "additionalProperties");
+    const json_t *props = n->props;
+    const json_t *addl = n->addl;
     const char *key;
     const json_t *val;
     json_object_foreach((json_t *)v, key, val) {
@@ -419,10 +548,9 @@ static int validate_object(vctx *c, const json_t *schema, const json_t *v)
         ptr_pop(&c->ptr, old);
         if (rc) return rc;
     }
-    const json_t *req = json_object_get(schema, "required");
     size_t i;
     const json_t *r;
-    json_array_foreach(req, i, r) {
+    json_array_foreach(n->required, i, r) {
         const char *name = json_string_value(r);
         if (name && !json_object_get(v, name)) {
             size_t old = ptr_push(&c->ptr, name);
@@ -436,12 +564,11 @@ static int validate_object(vctx *c, const json_t *schema, const json_t *v)
     return 0;
 }
 
-static int validate_array(vctx *c, const json_t *schema, const json_t *v)
+static int validate_array(vctx *c, const cnode *nd, const json_t *v)
 {
     size_t n = json_array_size(v);
-    double lo = -1, hi = -1;
-    get_num(schema, "minItems", &lo);
-    get_num(schema, "maxItems", &hi);
+    double lo = nd->has[L_MINITEMS] ? nd->lim[L_MINITEMS] : -1;
+    double hi = nd->has[L_MAXITEMS] ? nd->lim[L_MAXITEMS] : -1;
     if ((lo >= 0 && (double)n < lo) || (hi >= 0 && (double)n > hi)) {
         const char *how = lo == hi ? "exactly" : (double)n < lo ? "at least" : "at most";
         double want = (double)n < lo ? lo : hi;
@@ -449,9 +576,9 @@ static int validate_array(vctx *c, const json_t *schema, const json_t *v)
                     want, want == 1 ? "" : "s", n);
         return -1;
     }
-    const json_t *prefix = json_object_get(schema, "prefixItems");
-    const json_t *items = json_object_get(schema, "items");
-    size_t np = json_array_size(prefix);
+    const json_t *prefix = nd->prefix;
+    const json_t *items = nd->items;
+    size_t np = nd->nprefix;
     for (size_t i = 0; i < n; i++) {
         const json_t *is = i < np ? json_array_get(prefix, i) : items;
         if (!is || json_is_true(is)) continue;
@@ -466,7 +593,7 @@ static int validate_array(vctx *c, const json_t *schema, const json_t *v)
         ptr_pop(&c->ptr, old);
         if (rc) return rc;
     }
-    if (json_is_true(json_object_get(schema, "uniqueItems"))) {
+    if (nd->unique) {
         for (size_t i = 1; i < n; i++)
             for (size_t j = 0; j < i; j++)
                 if (json_equal(json_array_get(v, i), json_array_get(v, j))) {
@@ -485,7 +612,9 @@ static int validate_array(vctx *c, const json_t *schema, const json_t *v)
 
 static int validate(vctx *c, const json_t *schema, const json_t *v)
 {
-    schema = resolve_ref(c->root, schema);
+    cnode local;
+    const cnode *n = node_of(c->root, schema, &local);
+    schema = n->s;
     if (!schema) {
         set_problem(c->p, 500, c->ptr.s, "broken schema reference");
         return -1;
@@ -495,59 +624,63 @@ static int validate(vctx *c, const json_t *schema, const json_t *v)
         set_problem(c->p, 400, c->ptr.s, "no value is allowed here");
         return -1;
     }
-    const json_t *k;
-    if ((k = json_object_get(schema, "const")) && !json_equal(k, (json_t *)v))
-        return fail_expected(c, schema, v);
-    if ((k = json_object_get(schema, "enum"))) {
+    if (n->konst && !json_equal(n->konst, (json_t *)v)) return fail_expected(c, schema, v);
+    if (n->enm) {
         int found = 0;
         size_t i;
         const json_t *e;
-        json_array_foreach(k, i, e) {
+        json_array_foreach(n->enm, i, e) {
             if (json_equal(e, (json_t *)v)) found = 1;
         }
         if (!found) return fail_expected(c, schema, v);
     }
-    const json_t *type = json_object_get(schema, "type");
-    if (type) {
-        int ok = 0;
-        if (json_is_string(type)) ok = type_matches(json_string_value(type), v);
-        else {
-            size_t i;
-            const json_t *t;
-            json_array_foreach(type, i, t) {
-                if (json_is_string(t) && type_matches(json_string_value(t), v)) ok = 1;
-            }
-        }
-        if (!ok) return fail_expected(c, schema, v);
-    }
+    if (n->types && !(n->types & types_of(v))) return fail_expected(c, schema, v);
     if (json_is_number(v)) {
-        double x = json_number_value(v), b;
+        double x = json_number_value(v);
         if (!isfinite(x)) return fail_expected(c, schema, v);
-        if ((get_num(schema, "minimum", &b) && !(x >= b)) ||
-            (get_num(schema, "maximum", &b) && !(x <= b)) ||
-            (get_num(schema, "exclusiveMinimum", &b) && !(x > b)) ||
-            (get_num(schema, "exclusiveMaximum", &b) && !(x < b)))
+        if ((n->has[L_MIN] && !(x >= n->lim[L_MIN])) || (n->has[L_MAX] && !(x <= n->lim[L_MAX])) ||
+            (n->has[L_XMIN] && !(x > n->lim[L_XMIN])) ||
+            (n->has[L_XMAX] && !(x < n->lim[L_XMAX])))
             return fail_expected(c, schema, v);
     }
     if (json_is_string(v)) {
-        double b;
         size_t len = json_string_length(v);
-        if ((get_num(schema, "minLength", &b) && (double)len < b) ||
-            (get_num(schema, "maxLength", &b) && (double)len > b))
+        if ((n->has[L_MINLEN] && (double)len < n->lim[L_MINLEN]) ||
+            (n->has[L_MAXLEN] && (double)len > n->lim[L_MAXLEN]))
             return fail_expected(c, schema, v);
     }
-    if (json_is_array(v) && validate_array(c, schema, v)) return -1;
-    if (json_is_object(v) && (json_object_get(schema, "properties") ||
-                              json_object_get(schema, "required") ||
-                              json_object_get(schema, "additionalProperties")) &&
-        validate_object(c, schema, v))
-        return -1;
-    if ((k = json_object_get(schema, "oneOf")) && validate_oneof(c, schema, k, v)) return -1;
+    if (json_is_array(v) && validate_array(c, n, v)) return -1;
+    if (json_is_object(v) && n->objkw && validate_object(c, n, v)) return -1;
+    if (n->oneof && validate_oneof(c, schema, n->oneof, v)) return -1;
     return 0;
 }
 
 /* ------------------------------------------------------------------------------------------ */
 /* defaults */
+
+/* an object branch could validate v: v has every field the branch requires, and no field
+ * it does not know when it allows no others (a non-object branch or instance: maybe) */
+static int branch_fits(const json_t *root, const json_t *branch, const json_t *v)
+{
+    const json_t *b = resolve_ref(root, branch);
+    if (!json_is_object(b) || !json_is_object(v)) return 1;
+    const char *type = json_string_value(json_object_get(b, "type"));
+    if (type && strcmp(type, "object") != 0) return 0;
+    size_t i;
+    const json_t *r;
+    json_array_foreach(json_object_get(b, "required"), i, r) {
+        if (!json_object_get(v, json_string_value(r))) return 0;
+    }
+    if (json_is_false(json_object_get(b, "additionalProperties"))) {
+        const json_t *props = json_object_get(b, "properties");
+        const char *key;
+        const json_t *val;
+        json_object_foreach((json_t *)v, key, val) {
+            if (!json_object_get(props, key)) return 0;
+        }
+    }
+    return 1;
+}
 
 static void apply_defaults(const json_t *root, const json_t *schema, json_t *v)
 {
@@ -555,12 +688,22 @@ static void apply_defaults(const json_t *root, const json_t *schema, json_t *v)
     if (!schema || !json_is_object(schema)) return;
     const json_t *one = json_object_get(schema, "oneOf");
     if (one) {
-        size_t i;
-        const json_t *b;
+        /* the instance is valid, so exactly one branch validates it; a branch that does has
+         * every field it requires and knows every field when it allows no others: when only
+         * one branch fits that way it is the one, without validating (again) a large polygon */
+        size_t i, nfit = 0;
+        const json_t *b, *fit = NULL;
         json_array_foreach(one, i, b) {
+            if (branch_fits(root, b, v)) {
+                fit = b;
+                nfit++;
+            }
+        }
+        json_array_foreach(one, i, b) {
+            if (nfit == 1 && b != fit) continue;
             gp_spec_problem tmp;
             vctx sub = {.root = root, .p = &tmp};
-            if (validate(&sub, b, v) == 0) {
+            if (nfit == 1 || validate(&sub, b, v) == 0) {
                 apply_defaults(root, b, v);
                 break;
             }
@@ -616,9 +759,29 @@ static int schema_validate(const json_t *spec, gp_spec_problem *p)
     return k;
 }
 
+/* A copy of the objects of v; arrays and scalars are shared (new references), since defaults
+ * only ever add fields to objects: copying the 100,000 points of a large polygon cost as much
+ * as validating them. NULL out of memory. */
+static json_t *copy_objects(const json_t *v)
+{
+    if (!json_is_object(v)) return json_incref((json_t *)v);
+    json_t *o = json_object();
+    if (!o) return NULL;
+    const char *key;
+    const json_t *val;
+    json_object_foreach((json_t *)v, key, val) {
+        json_t *c = copy_objects(val);
+        if (!c || json_object_set_new(o, key, c)) {
+            json_decref(o);
+            return NULL;
+        }
+    }
+    return o;
+}
+
 static json_t *with_defaults_k(const json_t *spec, int k)
 {
-    json_t *copy = json_deep_copy(spec);
+    json_t *copy = copy_objects(spec);
     if (copy) apply_defaults(schema_of(k), schema_of(k), copy);
     return copy;
 }
@@ -722,7 +885,15 @@ int gp_spec_validate(const json_t *spec, gp_spec_problem *p)
 }
 
 /* ------------------------------------------------------------------------------------------ */
-/* polygon checks */
+/* polygon checks
+ *
+ * The rings of a container (the outer ring and its holes) must be simple, apart from one
+ * another, and every hole must lie in the outer ring and in no other hole. A request body of
+ * 1 MB holds about 100,000 vertices, so the test is a plane sweep (Shamos & Hoey 1976) in
+ * O(E log E) for E edges whatever the layout -- no pair of edges is tested unless the two are
+ * neighbours on the sweep line -- and every decision is exact (gp_orient2d), so that touching
+ * counts as crossing and nothing else does. The same sweep finds, at the leftmost vertex of each
+ * ring, the edge right below it, which tells which ring (if any) contains that ring. */
 
 typedef struct pt {
     double x, y;
@@ -733,27 +904,6 @@ static double orient(pt a, pt b, pt c)
     return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
 }
 
-static int sgn(double v) { return (v > 0) - (v < 0); }
-
-static int on_segment(pt a, pt b, pt q)
-{
-    return fmin(a.x, b.x) <= q.x && q.x <= fmax(a.x, b.x) && fmin(a.y, b.y) <= q.y &&
-           q.y <= fmax(a.y, b.y);
-}
-
-/* closed segments [a,b] and [c,d] share a point */
-static int seg_intersect(pt a, pt b, pt c, pt d)
-{
-    int o1 = sgn(orient(a, b, c)), o2 = sgn(orient(a, b, d));
-    int o3 = sgn(orient(c, d, a)), o4 = sgn(orient(c, d, b));
-    if (o1 != o2 && o3 != o4) return 1;
-    if (o1 == 0 && on_segment(a, b, c)) return 1;
-    if (o2 == 0 && on_segment(a, b, d)) return 1;
-    if (o3 == 0 && on_segment(c, d, a)) return 1;
-    if (o4 == 0 && on_segment(c, d, b)) return 1;
-    return 0;
-}
-
 static double ring_area(const gp_vec2 *p, size_t n)
 {
     double s = 0;
@@ -762,33 +912,313 @@ static double ring_area(const gp_vec2 *p, size_t n)
     return 0.5 * s;
 }
 
-static int point_in_ring(const gp_vec2 *p, size_t n, gp_vec2 q)
-{
-    int in = 0;
-    for (size_t i = 0, j = n - 1; i < n; j = i++) {
-        if ((p[i].y > q.y) != (p[j].y > q.y)) {
-            double x = p[j].x + (q.y - p[j].y) * (p[i].x - p[j].x) / (p[i].y - p[j].y);
-            if (q.x < x) in = !in;
-        }
-    }
-    return in;
-}
-
-typedef struct edge {
-    size_t ring, i;  /* ring index (0 = outer, 1.. = holes), edge from vertex i to i+1 */
-    double xmin, xmax;
-} edge;
-
-static int edge_cmp(const void *a, const void *b)
-{
-    double x = ((const edge *)a)->xmin, y = ((const edge *)b)->xmin;
-    return (x > y) - (x < y);
-}
-
 static void ring_pointer(char *buf, size_t n, size_t ring)
 {
     if (ring == 0) snprintf(buf, n, "/container/polygon");
     else snprintf(buf, n, "/container/holes/%zu", ring - 1);
+}
+
+#define SW_NIL UINT32_MAX
+
+/* a < b in the sweep order: by x, then by y */
+static int lex_less(gp_vec2 a, gp_vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); }
+static int same_point(gp_vec2 a, gp_vec2 b) { return a.x == b.x && a.y == b.y; }
+
+typedef struct sw_edge {
+    gp_vec2 l, r;               /* endpoints, l before r in the sweep order */
+    uint32_t ring, i;           /* ring index, edge from vertex i to vertex i + 1 of that ring */
+    uint32_t lc, rc, up, prio;  /* the sweep line's status: a treap ordered bottom to top */
+} sw_edge;
+
+typedef struct sw_vertex {
+    double x, y;
+    uint32_t edge;              /* the edge that starts at this vertex (global index) */
+} sw_vertex;
+
+typedef struct sweep {
+    const gp_ring *rings;
+    const size_t *first;        /* global index of each ring's edge 0 */
+    sw_edge *e;
+    uint32_t root;
+    uint32_t bad_a, bad_b;      /* the first pair that shares a point it must not */
+} sweep;
+
+static int vertex_before(const sw_vertex *u, const sw_vertex *v)
+{
+    return u->x < v->x || (u->x == v->x && u->y < v->y);
+}
+
+/* sorts v[0..n) into the sweep order (a bottom-up merge sort, tmp of n items: qsort's calls
+ * through a pointer were a fifth of the whole validation) */
+static void sort_vertices(sw_vertex *v, sw_vertex *tmp, size_t n)
+{
+    sw_vertex *a = v, *b = tmp;
+    for (size_t w = 1; w < n; w *= 2) {
+        for (size_t lo = 0; lo < n; lo += 2 * w) {
+            size_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
+            size_t i = lo, j = mid, k = lo;
+            while (i < mid && j < hi) b[k++] = vertex_before(&a[j], &a[i]) ? a[j++] : a[i++];
+            while (i < mid) b[k++] = a[i++];
+            while (j < hi) b[k++] = a[j++];
+        }
+        sw_vertex *t = a;
+        a = b;
+        b = t;
+    }
+    if (a != v) memcpy(v, a, n * sizeof *v);
+}
+
+/* the vertices of a ring edge: from a to b */
+static gp_vec2 edge_from(const sweep *s, uint32_t g)
+{
+    return s->rings[s->e[g].ring].pts[s->e[g].i];
+}
+
+static gp_vec2 edge_to(const sweep *s, uint32_t g)
+{
+    const gp_ring *r = &s->rings[s->e[g].ring];
+    return r->pts[(s->e[g].i + 1) % r->n];
+}
+
+/* g then h are consecutive edges of one ring (h starts where g ends) */
+static int follows(const sweep *s, uint32_t g, uint32_t h)
+{
+    const sw_edge *a = &s->e[g], *b = &s->e[h];
+    return a->ring == b->ring && (a->i + 1) % s->rings[a->ring].n == b->i;
+}
+
+/* sign of each coordinate of q - v: exact, since a difference of doubles rounds to zero only
+ * when it is zero */
+static int same_direction(gp_vec2 v, gp_vec2 a, gp_vec2 b)
+{
+    double ax = a.x - v.x, ay = a.y - v.y, bx = b.x - v.x, by = b.y - v.y;
+    if (ax != 0) return (ax > 0) == (bx > 0) && bx != 0;
+    return (ay > 0) == (by > 0) && by != 0;
+}
+
+/* edges g and h share a point they must not: consecutive edges (which share their common
+ * vertex) only when they fold back onto each other (collinear and overlapping); any other two
+ * when the closed segments meet */
+static int pair_bad(const sweep *s, uint32_t g, uint32_t h)
+{
+    if (follows(s, h, g)) {
+        uint32_t t = g;
+        g = h;
+        h = t;
+    }
+    if (follows(s, g, h)) {
+        gp_vec2 v = edge_to(s, g), a = edge_from(s, g), b = edge_to(s, h);
+        return gp_orient2d(v, a, b) == 0 && same_direction(v, a, b);
+    }
+    return gp_segments_intersect(s->e[g].l, s->e[g].r, s->e[h].l, s->e[h].r);
+}
+
+static int sw_check(sweep *s, uint32_t g, uint32_t h)
+{
+    if (g == SW_NIL || h == SW_NIL || !pair_bad(s, g, h)) return 0;
+    s->bad_a = g;
+    s->bad_b = h;
+    return 1;
+}
+
+/* b, being inserted at its left end, lies above t (in the tree) on the sweep line. When b starts
+ * on t (the common vertex of consecutive edges, or a touch that the neighbour test reports), b
+ * goes by its direction. */
+static int sw_above(const sweep *s, uint32_t b, uint32_t t)
+{
+    const sw_edge *B = &s->e[b], *T = &s->e[t];
+    int o = gp_orient2d(T->l, T->r, B->l);
+    if (o == 0) o = gp_orient2d(T->l, T->r, B->r);
+    return o >= 0;
+}
+
+static void sw_set_child(sweep *s, uint32_t parent, uint32_t old, uint32_t child)
+{
+    if (parent == SW_NIL) s->root = child;
+    else if (s->e[parent].lc == old) s->e[parent].lc = child;
+    else s->e[parent].rc = child;
+    if (child != SW_NIL) s->e[child].up = parent;
+}
+
+/* rotates x above its parent */
+static void sw_rotate_up(sweep *s, uint32_t x)
+{
+    sw_edge *e = s->e;
+    uint32_t p = e[x].up, g = e[p].up;
+    if (e[p].lc == x) {
+        e[p].lc = e[x].rc;
+        if (e[x].rc != SW_NIL) e[e[x].rc].up = p;
+        e[x].rc = p;
+    } else {
+        e[p].rc = e[x].lc;
+        if (e[x].lc != SW_NIL) e[e[x].lc].up = p;
+        e[x].lc = p;
+    }
+    e[p].up = x;
+    sw_set_child(s, g, p, x);
+}
+
+static void sw_insert(sweep *s, uint32_t b)
+{
+    sw_edge *e = s->e;
+    e[b].lc = e[b].rc = SW_NIL;
+    uint32_t cur = s->root, parent = SW_NIL;
+    int right = 0;
+    while (cur != SW_NIL) {
+        parent = cur;
+        right = sw_above(s, b, cur);
+        cur = right ? e[cur].rc : e[cur].lc;
+    }
+    e[b].up = parent;
+    if (parent == SW_NIL) s->root = b;
+    else if (right) e[parent].rc = b;
+    else e[parent].lc = b;
+    while (e[b].up != SW_NIL && e[e[b].up].prio < e[b].prio) sw_rotate_up(s, b);
+}
+
+static void sw_remove(sweep *s, uint32_t b)
+{
+    sw_edge *e = s->e;
+    while (e[b].lc != SW_NIL && e[b].rc != SW_NIL) {
+        uint32_t c = e[e[b].lc].prio > e[e[b].rc].prio ? e[b].lc : e[b].rc;
+        sw_rotate_up(s, c);
+    }
+    sw_set_child(s, e[b].up, b, e[b].lc != SW_NIL ? e[b].lc : e[b].rc);
+}
+
+/* the next edge below (dir 0) or above (dir 1) b on the sweep line, or SW_NIL */
+static uint32_t sw_next(const sweep *s, uint32_t b, int dir)
+{
+    const sw_edge *e = s->e;
+    uint32_t c = dir ? e[b].rc : e[b].lc;
+    if (c != SW_NIL) {
+        while ((dir ? e[c].lc : e[c].rc) != SW_NIL) c = dir ? e[c].lc : e[c].rc;
+        return c;
+    }
+    while (e[b].up != SW_NIL && (dir ? e[e[b].up].rc : e[e[b].up].lc) == b) b = e[b].up;
+    return e[b].up;
+}
+
+/* the ring whose interior is right above edge g (its own ring, or that ring's parent) */
+static long ring_above(const sweep *s, uint32_t g, const signed char *ccw, const long *parent)
+{
+    uint32_t r = s->e[g].ring;
+    int rightward = lex_less(edge_from(s, g), edge_to(s, g));
+    /* a counter-clockwise ring has its interior left of each edge: above a rightward one */
+    return (ccw[r] > 0) == rightward ? (long)r : parent[r];
+}
+
+/* the first pair of edges found meeting where they must not: (ring, edge) of each, the lower
+ * ring (or the lower edge of one ring) first; fold: 1 when edge i1 is followed by edge i2 and
+ * they fold back onto each other, 2 the other way round, 0 when they cross or touch */
+typedef struct sw_bad {
+    size_t r1, i1, r2, i2;
+    int fold;
+} sw_bad;
+
+/* The sweep over all edges of the rings: 1 with *bad at the first pair of edges that meet where
+ * they must not, else 0 with parent[r] = the innermost ring containing ring r (-1: none).
+ * -1 out of memory. */
+static int sweep_rings(const gp_ring *rings, size_t nr, long *parent, sw_bad *bad_pair)
+{
+    size_t ne = 0;
+    for (size_t r = 0; r < nr; r++) ne += rings[r].n;
+    if (ne >= SW_NIL) return -1;
+    size_t *first = malloc(nr * sizeof *first);
+    size_t *minv = malloc(nr * sizeof *minv);
+    signed char *ccw = malloc(nr);
+    sw_edge *e = malloc(ne * sizeof *e);
+    sw_vertex *v = malloc(2 * ne * sizeof *v);
+    if (!first || !minv || !ccw || !e || !v) {
+        free(first); free(minv); free(ccw); free(e); free(v);
+        return -1;
+    }
+    /* treap priorities from a generator seeded per call, so that no input can steer the tree's
+     * shape (its depth); the verdict and the pair reported depend only on the order of the
+     * edges on the sweep line, not on the shape */
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    uint64_t rng = ((uint64_t)ts.tv_nsec * 0x9E3779B97F4A7C15ull) ^ (uint64_t)(uintptr_t)e;
+    rng |= 1;
+    size_t k = 0;
+    for (size_t r = 0; r < nr; r++) {
+        const gp_ring *g = &rings[r];
+        first[r] = k;
+        minv[r] = 0;
+        for (size_t i = 0; i < g->n; i++, k++) {
+            gp_vec2 a = g->pts[i], b = g->pts[(i + 1) % g->n];
+            int fwd = lex_less(a, b);
+            e[k].l = fwd ? a : b;
+            e[k].r = fwd ? b : a;
+            e[k].ring = (uint32_t)r;
+            e[k].i = (uint32_t)i;
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            e[k].prio = (uint32_t)(rng >> 32);
+            v[k].x = a.x;
+            v[k].y = a.y;
+            v[k].edge = (uint32_t)k;
+            if (lex_less(a, g->pts[minv[r]])) minv[r] = i;
+        }
+        /* the orientation at the leftmost vertex (collinear with both neighbours only when the
+         * edges there fold back, which the sweep reports) */
+        size_t m = minv[r];
+        ccw[r] = (signed char)gp_orient2d(g->pts[(m + g->n - 1) % g->n], g->pts[m],
+                                          g->pts[(m + 1) % g->n]);
+        parent[r] = -1;
+    }
+    sort_vertices(v, v + ne, ne);
+    sweep s = {rings, first, e, SW_NIL, SW_NIL, SW_NIL};
+    int bad = 0;
+    for (size_t q = 0; q < ne && !bad; q++) {
+        gp_vec2 at = {v[q].x, v[q].y};
+        uint32_t out = v[q].edge;
+        const gp_ring *g = &rings[e[out].ring];
+        uint32_t in = (uint32_t)(first[e[out].ring] + (e[out].i + g->n - 1) % g->n);
+        if (q + 1 < ne && v[q + 1].x == at.x && v[q + 1].y == at.y) {
+            /* two vertices at one point: the edges that start there touch */
+            s.bad_a = out;
+            s.bad_b = v[q + 1].edge;
+            bad = 1;
+            break;
+        }
+        /* the edges that start here go in (against the edges that end here, still in), then
+         * the edges that end here go out */
+        int leftmost = e[out].i == minv[e[out].ring];
+        uint32_t both[2] = {in, out};
+        for (int t = 0; t < 2 && !bad; t++) {
+            uint32_t b = both[t];
+            if (!same_point(e[b].l, at)) continue;
+            sw_insert(&s, b);
+            uint32_t below = sw_next(&s, b, 0);
+            if (leftmost && t == 0) /* a ring's first edge: what lies right below the ring */
+                parent[e[b].ring] = below == SW_NIL ? -1 : ring_above(&s, below, ccw, parent);
+            bad = sw_check(&s, b, below) || sw_check(&s, b, sw_next(&s, b, 1));
+        }
+        for (int t = 0; t < 2 && !bad; t++) {
+            uint32_t b = both[t];
+            if (!same_point(e[b].r, at)) continue;
+            uint32_t below = sw_next(&s, b, 0), above = sw_next(&s, b, 1);
+            sw_remove(&s, b);
+            bad = sw_check(&s, below, above);
+        }
+    }
+    if (bad) {
+        uint32_t a = s.bad_a, b = s.bad_b;
+        if (e[a].ring > e[b].ring || (e[a].ring == e[b].ring && e[a].i > e[b].i)) {
+            uint32_t t = a;
+            a = b;
+            b = t;
+        }
+        bad_pair->r1 = e[a].ring;
+        bad_pair->i1 = e[a].i;
+        bad_pair->r2 = e[b].ring;
+        bad_pair->i2 = e[b].i;
+        bad_pair->fold = follows(&s, a, b) ? 1 : follows(&s, b, a) ? 2 : 0;
+    }
+    free(first); free(minv); free(ccw); free(e); free(v);
+    return bad;
 }
 
 /* rings[0] is the outer ring; checks area, simplicity, and that holes lie inside the outer ring
@@ -796,7 +1226,6 @@ static void ring_pointer(char *buf, size_t n, size_t ring)
 static int check_rings(const gp_ring *rings, size_t nr, gp_spec_problem *p)
 {
     char ptr[64];
-    size_t ne = 0;
     for (size_t r = 0; r < nr; r++) {
         const gp_ring *g = &rings[r];
         double minx = INFINITY, maxx = -INFINITY, miny = INFINITY, maxy = -INFINITY;
@@ -823,74 +1252,36 @@ static int check_rings(const gp_ring *rings, size_t nr, gp_spec_problem *p)
             set_problem(p, 422, ptr, "the polygon has no area (its points are collinear or repeated)");
             return -1;
         }
-        ne += g->n;
     }
-    edge *e = malloc(ne * sizeof *e);
-    if (!e) return -2;
-    size_t k = 0;
-    for (size_t r = 0; r < nr; r++)
-        for (size_t i = 0; i < rings[r].n; i++) {
-            gp_vec2 a = rings[r].pts[i], b = rings[r].pts[(i + 1) % rings[r].n];
-            e[k].ring = r;
-            e[k].i = i;
-            e[k].xmin = fmin(a.x, b.x);
-            e[k].xmax = fmax(a.x, b.x);
-            k++;
-        }
-    qsort(e, ne, sizeof *e, edge_cmp);
-    int rc = 0;
-    for (size_t u = 0; u < ne && !rc; u++) {
-        const gp_ring *ru = &rings[e[u].ring];
-        pt a = {ru->pts[e[u].i].x, ru->pts[e[u].i].y};
-        pt b = {ru->pts[(e[u].i + 1) % ru->n].x, ru->pts[(e[u].i + 1) % ru->n].y};
-        for (size_t w = u + 1; w < ne && e[w].xmin <= e[u].xmax; w++) {
-            const gp_ring *rw = &rings[e[w].ring];
-            pt c = {rw->pts[e[w].i].x, rw->pts[e[w].i].y};
-            pt d = {rw->pts[(e[w].i + 1) % rw->n].x, rw->pts[(e[w].i + 1) % rw->n].y};
-            size_t i = e[u].i, j = e[w].i, n = ru->n;
-            if (e[u].ring == e[w].ring) {
-                /* adjacent edges share a vertex: only a fold back (collinear overlap) is bad */
-                int next = (i + 1) % n == j, prev = (j + 1) % n == i;
-                if (next || prev) {
-                    pt p0 = next ? a : c, p1 = next ? b : d, p2 = next ? d : b;
-                    if (orient(p0, p1, p2) == 0 &&
-                        (p1.x - p0.x) * (p2.x - p1.x) + (p1.y - p0.y) * (p2.y - p1.y) < 0) {
-                        ring_pointer(ptr, sizeof ptr, e[u].ring);
-                        set_problem(p, 422, ptr,
-                                    "the polygon is not simple: edges %zu and %zu fold back onto "
-                                    "each other", next ? i : j, next ? j : i);
-                        rc = -1;
-                        break;
-                    }
-                    continue;
-                }
-            }
-            if (seg_intersect(a, b, c, d)) {
-                size_t r1 = e[u].ring < e[w].ring ? e[u].ring : e[w].ring;
-                size_t r2 = e[u].ring < e[w].ring ? e[w].ring : e[u].ring;
-                /* (r1, e1) is the edge of the lower ring (or the lower edge of one ring) */
-                int swap = e[u].ring > e[w].ring || (e[u].ring == e[w].ring && i > j);
-                size_t e1 = swap ? j : i, e2 = swap ? i : j;
-                if (r1 == r2) {
-                    ring_pointer(ptr, sizeof ptr, r1);
-                    set_problem(p, 422, ptr,
-                                "the polygon is not simple: edge %zu (from point %zu) crosses or "
-                                "touches edge %zu (from point %zu)", e1, e1, e2, e2);
-                } else {
-                    char other[64];
-                    ring_pointer(ptr, sizeof ptr, r2);
-                    ring_pointer(other, sizeof other, r1);
-                    set_problem(p, 422, ptr,
-                                "edge %zu of this hole crosses or touches edge %zu of %s", e2, e1,
-                                other);
-                }
-                rc = -1;
-                break;
-            }
-        }
+    long *parent = malloc(nr * sizeof *parent);
+    if (!parent) return -2;
+    sw_bad b;
+    int rc = sweep_rings(rings, nr, parent, &b);
+    if (rc < 0) {
+        free(parent);
+        return -2;
     }
-    free(e);
-    if (rc) return rc;
+    if (rc > 0) {
+        free(parent);
+        if (b.fold) {
+            ring_pointer(ptr, sizeof ptr, b.r1);
+            set_problem(p, 422, ptr,
+                        "the polygon is not simple: edges %zu and %zu fold back onto each other",
+                        b.fold == 1 ? b.i1 : b.i2, b.fold == 1 ? b.i2 : b.i1);
+        } else if (b.r1 == b.r2) {
+            ring_pointer(ptr, sizeof ptr, b.r1);
+            set_problem(p, 422, ptr,
+                        "the polygon is not simple: edge %zu (from point %zu) crosses or touches "
+                        "edge %zu (from point %zu)", b.i1, b.i1, b.i2, b.i2);
+        } else {
+            char other[64];
+            ring_pointer(ptr, sizeof ptr, b.r2);
+            ring_pointer(other, sizeof other, b.r1);
+            set_problem(p, 422, ptr, "edge %zu of this hole crosses or touches edge %zu of %s",
+                        b.i2, b.i1, other);
+        }
+        return -1;
+    }
     for (size_t r = 0; r < nr; r++) {
         double scale = 0;
         for (size_t i = 1; i < rings[r].n; i++)
@@ -899,22 +1290,28 @@ static int check_rings(const gp_ring *rings, size_t nr, gp_spec_problem *p)
         if (!(fabs(ring_area(rings[r].pts, rings[r].n)) > 1e-12 * scale * scale)) {
             ring_pointer(ptr, sizeof ptr, r);
             set_problem(p, 422, ptr, "the polygon has no area");
+            free(parent);
             return -1;
         }
     }
-    /* no crossings: a hole is inside the outer ring iff one of its vertices is */
+    /* no two rings meet: a hole lies in the rings of its chain of parents, and must lie in the
+     * outer ring and in no other hole (at most 1000 holes: the chains are short work) */
     for (size_t r = 1; r < nr; r++) {
-        ring_pointer(ptr, sizeof ptr, r);
-        if (!point_in_ring(rings[0].pts, rings[0].n, rings[r].pts[0])) {
-            set_problem(p, 422, ptr, "the hole is not inside the container polygon");
-            return -1;
+        int in_outer = 0;
+        long in_hole = -1;
+        size_t guard = 0;
+        for (long c = parent[r]; c >= 0 && guard <= nr; c = parent[c], guard++) {
+            if (c == 0) in_outer = 1;
+            else if (in_hole < 0 || c < in_hole) in_hole = c;
         }
-        for (size_t s = 1; s < nr; s++)
-            if (s != r && point_in_ring(rings[s].pts, rings[s].n, rings[r].pts[0])) {
-                set_problem(p, 422, ptr, "the hole lies inside hole %zu", s - 1);
-                return -1;
-            }
+        if (in_outer && in_hole < 0) continue;
+        ring_pointer(ptr, sizeof ptr, r);
+        if (!in_outer) set_problem(p, 422, ptr, "the hole is not inside the container polygon");
+        else set_problem(p, 422, ptr, "the hole lies inside hole %ld", in_hole - 1);
+        free(parent);
+        return -1;
     }
+    free(parent);
     return 0;
 }
 
@@ -1034,8 +1431,9 @@ static int parse_circle_2d(const json_t *circle, gp_spec2d *out, gp_spec_problem
     return 0;
 }
 
-/* container: a circle, or a polygon with its holes (simple, holes inside and apart) */
-static int parse_container_2d(const json_t *cont, gp_spec2d *out, gp_spec_problem *p)
+/* container: a circle, or a polygon with its holes (simple, holes inside and apart: checked
+ * when check is set) */
+static int parse_container_2d(const json_t *cont, gp_spec2d *out, gp_spec_problem *p, int check)
 {
     const json_t *circle = json_object_get(cont, "circle");
     if (circle) return parse_circle_2d(circle, out, p);
@@ -1059,7 +1457,7 @@ static int parse_container_2d(const json_t *cont, gp_spec2d *out, gp_spec_proble
     }
     if (!bad) {
         /* check_rings wants one array: outer then holes, as rings is */
-        int rc = check_rings(rings, nh + 1, p);
+        int rc = check ? check_rings(rings, nh + 1, p) : 0;
         free(rings);
         return rc == -2 ? no_memory(p) : rc;
     }
@@ -1306,9 +1704,14 @@ static int check_threshold_2d(const gp_spec2d *s, size_t n, gp_spec_problem *p)
     return -1;
 }
 
-/* fills out from a valid spec with defaults applied (settle_defaults_2d); semantic checks;
- * 0 / -1 */
-static int parse_2d_full(const json_t *full, gp_spec2d *out, gp_spec_problem *p)
+static void bounds_2d(const gp_spec2d *s, size_t n, gp_spec_bounds_t *b);
+static int over_budget(const gp_spec_bounds_t *b, const char *what, gp_spec_problem *p);
+
+/* fills out from a valid spec with defaults applied (settle_defaults_2d); *n the cell count.
+ * checks: the semantic checks (container geometry, the threshold's floor, the work budget);
+ * without them only what parsing and the cell count need. 0 / -1 */
+static int parse_2d_full(const json_t *full, gp_spec2d *out, gp_spec_problem *p, int checks,
+                         size_t *ncells)
 {
     memset(out, 0, sizeof *out);
     out->seed = (uint64_t)json_number_value(json_object_get(full, "seed"));
@@ -1321,19 +1724,31 @@ static int parse_2d_full(const json_t *full, gp_spec2d *out, gp_spec_problem *p)
     parse_imc_2d(json_object_get(full, "imc"), out);
     out->outputs = parse_outputs_2d(json_object_get(full, "outputs"));
     out->threads = 0;
-    if (parse_container_2d(json_object_get(full, "container"), out, p) ||
+    if (parse_container_2d(json_object_get(full, "container"), out, p, checks) ||
         parse_size_2d(json_object_get(full, "size"), out, p) ||
         parse_shape_2d(json_object_get(full, "shape"), out, p))
         return -1;
     size_t n = 0;
     if (cell_count_2d(out, &n, p)) return -1;
-    return check_threshold_2d(out, n, p);
+    if (ncells) *ncells = n;
+    if (!checks) return 0;
+    if (check_threshold_2d(out, n, p)) return -1;
+    gp_spec_bounds_t b;
+    bounds_2d(out, n, &b);
+    char what[200];
+    size_t edges = out->outer.n;
+    for (size_t h = 0; h < out->nholes; h++) edges += out->holes[h].n;
+    char where[64] = "a circle";
+    if (edges) snprintf(where, sizeof where, "a container of %zu edges", edges);
+    snprintf(what, sizeof what, "%.3g IMC moves at most (imc.max_steps) on %zu cells in %s, then "
+             "%zu grains of %zu contour points", b.steps, n, where, n, out->contour_points);
+    return over_budget(&b, what, p);
 }
 
 static int semantic_2d(const json_t *full, gp_spec_problem *p)
 {
     gp_spec2d tmp;
-    int rc = parse_2d_full(full, &tmp, p);
+    int rc = parse_2d_full(full, &tmp, p, 1, NULL);
     gp_spec_2d_free(&tmp);
     return rc;
 }
@@ -1351,10 +1766,230 @@ int gp_spec_parse_2d(const json_t *spec, gp_spec2d *out, gp_spec_problem *p)
     if (k != 0)
         set_problem(p, 400, "/kind", "expected \"%s\" here, got \"%s\"", g_kinds[0], g_kinds[k]);
     else
-        rc = parse_2d_full(full, out, p);
+        rc = parse_2d_full(full, out, p, 1, NULL);
     json_decref(full);
     if (rc) gp_spec_2d_free(out);
     return rc;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* work and result bounds (gp_spec.h) */
+
+/* Costs per unit, from the benchmarks on one core (bench/bench_imc, bench_specimen2d,
+ * bench_spheres3d); estimates within a factor of a few, which is all a budget needs. */
+#define COST_IMC_MOVE_S 6e-5      /* one IMC move at 1,000 cells (~17,000 moves/s) ... */
+#define COST_IMC_PER_DECADE 0.6   /* ... and 60 % more per tenfold more cells (6,400/s at 1e5) */
+/* ... plus the container's edges that the recomputed cells meet: the tessellation bins them
+ * with about 2 seeds a bin, and a move clips a dozen cells against the edges of their bins, at
+ * about 0.5 us x (edges per bin)^1.5 (measured: a 10,000-edge zigzag with 100 cells, 200 edges
+ * a bin, 480 moves/s; with 10 cells, 2,000 a bin, 39 moves/s) */
+#define COST_IMC_EDGE_S 0.5e-6
+#define COST_FILL_S 2.5e-3        /* filling one grain of 128 contour points (~400-600 grains/s) */
+#define COST_ODEC_S 0.5e-3        /* its ODEC discs, at 128 points */
+#define COST_DESC_S 0.5e-3        /* its descriptors, at 128 points */
+#define DEM_SPHERE_STEPS_PER_S 4e6 /* the 3D DEM, sphere-steps per second (3.9e6 measured) */
+/* The 3D protocol (core/gp_specimen3d.c): its constants, which its header does not export */
+#define DEM_MAX_SAMPLE 400000.0   /* MAX_SAMPLE_SPHERES: spheres of the sample at most */
+#define DEM_MAX_TILED 20000000.0  /* MAX_TILED_SPHERES: spheres after the tiling at most */
+#define DEM_DT_SAFETY 0.3         /* DT_SAFETY, of sqrt(m / 2 E R) */
+#define DEM_SCALED_RATIO 3.5      /* MAX_SCALED_RATIO: density-scaling radius >= rmax / this */
+#define DEM_GRAVITY 9.81
+/* The protocol's durations are multiples of T = sqrt(d50 / g): growth 1.75 T, settling 1.2 T,
+ * compaction windows of 0.35-3.5 T, relaxation; the paper's example takes 16 T (13,610 steps
+ * at 860 steps per T) and a 1-20 mm sieve 14-22 T. 50 T is the estimate, with room for a slow
+ * compaction; the protocol's own cap (500 T) bounds a run that does not converge. */
+#define DEM_PROTOCOL_T 50.0
+
+/* result bytes of one 2D grain, by outputs (as server/http.c has estimated them) */
+static double bytes_per_grain(unsigned outputs, double np)
+{
+    double per = 400; /* stats, ids, areas, descriptors */
+    if (outputs & GP_OUT_GRAINS) per += 40 * np;
+    if (outputs & GP_OUT_ODEC) per += 40 * np + 60 * 16;
+    if (outputs & GP_OUT_DESCRIPTORS) per += 40 * np + 120;
+    if (outputs & GP_OUT_CELLS) per += 40 * 12 + 100;
+    return per;
+}
+
+static void bounds_2d(const gp_spec2d *s, size_t n, gp_spec_bounds_t *b)
+{
+    memset(b, 0, sizeof *b);
+    double cells = (double)n, np = (double)s->contour_points;
+    int sieve = s->size_law == GP_LAW_SIEVE;
+    b->cells = b->items = cells;
+    b->steps = (double)s->imc_max_steps;
+    double edges = 0;
+    if (s->container == GP_CONTAINER_POLYGON) {
+        edges = (double)s->outer.n;
+        for (size_t h = 0; h < s->nholes; h++) edges += (double)s->holes[h].n;
+    }
+    double per_bin = edges / fmax(1, cells / 2);
+    double imc = b->steps * COST_IMC_MOVE_S *
+                 (1 + COST_IMC_PER_DECADE * log10(fmax(cells, 1000) / 1000));
+    double imc_edges = b->steps * COST_IMC_EDGE_S * per_bin * sqrt(per_bin);
+    double per = COST_FILL_S;
+    if (s->outputs & GP_OUT_ODEC) per += COST_ODEC_S;
+    if (s->outputs & GP_OUT_DESCRIPTORS) per += COST_DESC_S;
+    double grains = cells * per * np / 128;
+    b->work_s = imc + imc_edges + grains;
+    b->work_pointer = imc_edges > imc && imc_edges > grains ? "/container"
+                      : imc > grains                       ? "/imc/max_steps"
+                      : sieve                              ? "/size/sieve"
+                                                           : "/particles";
+    b->result_bytes = cells * bytes_per_grain(s->outputs, np);
+    b->result_pointer = sieve ? "/size/sieve" : "/particles";
+}
+
+/* where the percent curve pc (by weight or by number) of rows d crosses q, linearly */
+static double sieve_quantile(const double *d, const double *pc, size_t n, double q)
+{
+    for (size_t k = 1; k < n; k++)
+        if (pc[k] >= q && pc[k] > pc[k - 1])
+            return d[k - 1] + (d[k] - d[k - 1]) * fmax(0, q - pc[k - 1]) / (pc[k] - pc[k - 1]);
+    return n ? d[n - 1] : 0;
+}
+
+/* 3D bounds of a schema-valid spec with defaults whose sieve rows are checked (sieve_rows);
+ * 0, or -1 out of memory */
+static int bounds_3d(const json_t *full, gp_spec_bounds_t *b, gp_spec_problem *p)
+{
+    memset(b, 0, sizeof *b);
+    const json_t *sieve = json_object_get(full, "sieve");
+    size_t ns = json_array_size(sieve);
+    double scale = sieve_scale(json_string_value(json_object_get(full, "sieve_units")));
+    double *d = malloc((ns ? ns : 1) * 3 * sizeof *d);
+    if (!d) return no_memory(p);
+    double *pw = d + ns, *pn = d + 2 * ns;
+    for (size_t k = 0; k < ns; k++) {
+        const json_t *row = json_array_get(sieve, k);
+        d[k] = json_number_value(json_array_get(row, 0)) * scale;
+        pw[k] = json_number_value(json_array_get(row, 1));
+    }
+    const json_t *box = json_object_get(full, "box");
+    double V = 1;
+    for (size_t i = 0; i < 3; i++) V *= json_number_value(json_array_get(box, i));
+    double porosity = num(full, "porosity");
+    const json_t *m = json_object_get(full, "material");
+    double young = num(m, "young"), density = num(m, "density");
+    double n = ns >= 2 ? gp_sieve_expected_count(d, pw, ns, (1 - porosity) * V) : 0;
+    /* the time step: the density-scaling radius is the median radius by number, at least
+     * rmax / 3.5 (rmax: where the curve reaches 100 %) */
+    double dmax = sieve_quantile(d, pw, ns, 100);
+    double dmed = dmax;
+    if (ns >= 2 && gp_sieve_weight_to_number(d, pw, ns, GP_SIEVE_UNIFORM, pn, NULL) == GP_OK)
+        dmed = sieve_quantile(d, pn, ns, 50);
+    double rs = fmax(0.5 * dmed, 0.5 * dmax / DEM_SCALED_RATIO);
+    double d50 = sieve_quantile(d, pw, ns, 50);
+    free(d);
+    b->dt = DEM_DT_SAFETY * rs * sqrt(2 * M_PI * density / (3 * young));
+    double per_t = sqrt(d50 / DEM_GRAVITY) / b->dt; /* steps per time unit */
+    b->steps = DEM_PROTOCOL_T * per_t;
+    b->cells = n;
+    double tiles = 1;
+    const json_t *tiling = json_object_get(full, "tiling");
+    for (size_t i = 0; tiling && i < 3; i++) tiles *= json_number_value(json_array_get(tiling, i));
+    b->items = n * tiles;
+    b->work_s = n * b->steps / DEM_SPHERE_STEPS_PER_S;
+    /* what drives the work: the material when the paper's material would be within budget */
+    double ref = b->work_s / sqrt((young / density) / (15e6 / 2600));
+    if (b->work_s > GP_SPEC_WORK_BUDGET_S && ref <= GP_SPEC_WORK_BUDGET_S)
+        b->work_pointer = young / 15e6 >= 2600 / density ? "/material/young" : "/material/density";
+    else
+        b->work_pointer = "/box";
+    double per = 0;
+    size_t i;
+    const json_t *o;
+    json_array_foreach(json_object_get(full, "outputs"), i, o) {
+        const char *w = json_string_value(o);
+        if (!strcmp(w, "spheres")) per += 90;           /* [x, y, z, r] at 17 digits */
+        else if (!strcmp(w, "contacts")) per += 2.6 * 210; /* 2.6 contacts per sphere */
+    }
+    b->result_bytes = 20000 + b->items * per;
+    b->result_pointer = tiles > 1 ? "/tiling" : "/box";
+    return 0;
+}
+
+static int too_large(gp_spec_problem *p, const char *pointer, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static int too_large(gp_spec_problem *p, const char *pointer, const char *fmt, ...)
+{
+    char body[480];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(body, sizeof body, fmt, ap);
+    va_end(ap);
+    set_problem(p, 422, pointer, "%s", body);
+    snprintf(p->code, sizeof p->code, "too_large");
+    return -1;
+}
+
+/* 422 too_large when the work is over the budget; what: the work in words */
+static int over_budget(const gp_spec_bounds_t *b, const char *what, gp_spec_problem *p)
+{
+    if (b->work_s <= GP_SPEC_WORK_BUDGET_S) return 0;
+    const char *advice =
+        !strcmp(b->work_pointer, "/imc/max_steps")
+            ? "ask for fewer imc.max_steps (the IMC stops at its threshold long before)"
+        : !strcmp(b->work_pointer, "/container")
+            ? "use a container of fewer edges, more particles or fewer imc.max_steps (each IMC "
+              "move clips its cells against the container's edges near them)"
+        : !strcmp(b->work_pointer, "/material/young")
+            ? "use a softer young (the paper's 1.5e7 Pa: the packing barely depends on it)"
+        : !strcmp(b->work_pointer, "/material/density")
+            ? "use a higher density (the packing barely depends on it)"
+        : !strcmp(b->work_pointer, "/box")
+            ? "use a smaller box or a coarser sieve (check sieve_units)"
+            : "ask for fewer grains, contour_points or outputs";
+    return too_large(p, b->work_pointer,
+                     "the job would take about %.2g s of one core (%s), over the budget of %.0f "
+                     "s; %s", b->work_s, what, GP_SPEC_WORK_BUDGET_S, advice);
+}
+
+int gp_spec_bounds(const json_t *effective_spec, gp_spec_bounds_t *out, gp_spec_problem *p)
+{
+    gp_spec_problem local;
+    if (!p) p = &local;
+    clear_problem(p);
+    memset(out, 0, sizeof *out);
+    const char *kind = json_string_value(json_object_get(effective_spec, "kind"));
+    switch (kind_index(kind)) {
+    case 0: {
+        gp_spec2d s;
+        size_t n = 0;
+        int rc = parse_2d_full(effective_spec, &s, p, 0, &n);
+        if (rc == 0) bounds_2d(&s, n, out);
+        gp_spec_2d_free(&s);
+        return rc;
+    }
+    case 1:
+        if (check_sieve_rows(json_object_get(effective_spec, "sieve"), "/sieve", p)) return -1;
+        return bounds_3d(effective_spec, out, p);
+    default:
+        set_problem(p, 400, "/kind", "unknown kind; expected one of \"%s\", \"%s\"", g_kinds[0],
+                    g_kinds[1]);
+        return -1;
+    }
+}
+
+int gp_spec_check_result(const json_t *effective_spec, double max_bytes, gp_spec_problem *p)
+{
+    gp_spec_problem local;
+    if (!p) p = &local;
+    gp_spec_bounds_t b;
+    if (gp_spec_bounds(effective_spec, &b, p)) return -1;
+    if (b.result_bytes <= max_bytes) return 0;
+    int d2 = !strcmp(b.result_pointer, "/particles") || !strcmp(b.result_pointer, "/size/sieve");
+    const char *fewer = !strcmp(b.result_pointer, "/particles")
+                            ? "particles, contour_points or outputs"
+                        : d2 ? "grains (a smaller container or coarser sieve), contour_points or "
+                               "outputs"
+                             : "spheres (a smaller tiling or box, a coarser sieve) or outputs "
+                               "(contacts are most of it)";
+    return too_large(p, b.result_pointer,
+                     "the result would be about %.0f MB (%.0f %s), over this server's limit of "
+                     "%.0f MB (--max-result-mb); ask for fewer %s", b.result_bytes / 1e6,
+                     b.items, d2 ? "grains" : "spheres", max_bytes / 1e6, fewer);
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -1378,7 +2013,23 @@ static int semantic_3d(const json_t *full, gp_spec_problem *p)
                     "%.6g m); check sieve_units", dmax * scale, bmin);
         return -1;
     }
-    return 0;
+    gp_spec_bounds_t b;
+    if (bounds_3d(full, &b, p)) return -1;
+    if (b.cells > DEM_MAX_SAMPLE)
+        return too_large(p, "/box",
+                         "about %.3g spheres fill %g %% of the box with this sieve curve, over "
+                         "the limit of %.0f spheres in the DEM sample; use a smaller box or a "
+                         "coarser sieve (check sieve_units)", b.cells,
+                         100 * (1 - num(full, "porosity")), DEM_MAX_SAMPLE);
+    if (b.items > DEM_MAX_TILED)
+        return too_large(p, "/tiling",
+                         "%.0f tiles of about %.0f spheres make about %.3g spheres, over the "
+                         "limit of %.0f; ask for fewer tiles or a smaller box", b.items / b.cells,
+                         b.cells, b.items, DEM_MAX_TILED);
+    char what[200];
+    snprintf(what, sizeof what, "about %.2g DEM steps of %.0f spheres at a time step of %.2g s",
+             b.steps, b.cells, b.dt);
+    return over_budget(&b, what, p);
 }
 
 /* ------------------------------------------------------------------------------------------ */

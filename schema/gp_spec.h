@@ -28,6 +28,11 @@
  *                                            the integer-count floor of the cell count, ...);
  *   http_status 422, code "too_large"     -- a 2D sieve law whose derived cell count exceeds
  *                                            the schema's particles maximum (/size/sieve);
+ *                                            a 3D sample of more spheres than the DEM takes
+ *                                            (/box) or a tiling beyond its sphere limit
+ *                                            (/tiling); a spec whose estimated work is over
+ *                                            GP_SPEC_WORK_BUDGET_S (see gp_spec_bounds), at
+ *                                            the field that drives it;
  *   http_status 500, code "internal"      -- out of memory, broken embedded schema.
  * pointer is an RFC 6901 JSON pointer into the spec ("" is the whole document, keys escaped
  * with ~0/~1). For a missing required field the pointer names the missing field itself
@@ -72,7 +77,8 @@ int gp_spec_validate(const json_t *spec, gp_spec_problem *p);
  * (the count is derived: gp_spec2d_cell_count) and no size.cov, and size.of is "grains";
  * without it there is no size.sieve_units; imc.threshold, when absent, is
  * gp_imc_default_threshold() of imc.error. The copy is itself a valid spec whose effective
- * spec is the same copy. */
+ * spec is the same copy. Its objects are new; its arrays (and scalars) are shared with spec,
+ * read-only: change neither in place while the other is in use. */
 json_t *gp_spec_with_defaults(const json_t *spec, gp_spec_problem *p);
 
 /* Validates and parses a spec of kind "fourier-voronoi-2d" into *out, defaults applied
@@ -89,5 +95,51 @@ void gp_spec_2d_free(gp_spec2d *s);
  * picks). *out owns its sieve array; release with gp_spec_3d_free(). */
 int gp_spec_parse_3d(const json_t *spec, gp_spec3d *out, gp_spec_problem *p);
 void gp_spec_3d_free(gp_spec3d *s);
+
+/* ---- work and result bounds (api.md "Limits and origin") ---- */
+
+/* What a job of a valid effective spec will cost, estimated from its numbers whatever their
+ * spelling (1e6 is the integer 1000000), in one place per kind:
+ *   fourier-voronoi-2d: cells = particles, or the count a sieve law derives; the IMC at its cap
+ *     (imc.max_steps moves, each costing a little more on more cells), the filling, ODEC and
+ *     descriptors per grain in proportion to contour_points; the result as server/http.c has
+ *     always estimated it (bytes per grain by outputs and contour_points);
+ *   spheres-3d: the sample's spheres (gp_sieve_expected_count, the count the DEM draws), its
+ *     time step (gp_dem3d.h: 0.3 sqrt(m / 2 E R) at the density-scaling radius of
+ *     gp_specimen3d.c) and the steps its protocol needs (durations are multiples of
+ *     sqrt(d50 / g)); the result by spheres and contacts of the tiled packing.
+ * The figures are estimates (within a factor of a few of what the benchmarks measure), meant
+ * for bounds, not for progress. */
+typedef struct gp_spec_bounds {
+    double cells;               /* 2D: Voronoi cells (= grains); 3D: spheres of the sample */
+    double items;               /* grains (2D) or spheres of the final, tiled packing (3D) */
+    double steps;               /* 2D: IMC moves at most; 3D: DEM steps the protocol needs */
+    double dt;                  /* 3D: the DEM time step, s (0 in 2D) */
+    double work_s;              /* estimated seconds of one core for the whole job */
+    double result_bytes;        /* estimated size of the result JSON */
+    const char *work_pointer;   /* the field that drives the work (static string) */
+    const char *result_pointer; /* the field that drives the result size (static string) */
+} gp_spec_bounds_t;
+
+/* The fixed work budget: a spec whose work_s is over it is refused at validation (422
+ * too_large at work_pointer), by gp_spec_validate, gp_spec_with_defaults and the parsers.
+ * Two days of one core. The paper's 3D example is estimated at ~30 s and a 10,000-grain 2D
+ * specimen with every output at ~2 min, three orders of magnitude below; the test suite's long
+ * job (40,000 cells, E3 at 1e-9, imc.max_steps 1e9: ~1.4 days at its cap) passes. Refused:
+ * every 2D maximum at once (a million grains of 4,096 points, 1e9 IMC moves: ~3 days), a DEM
+ * time step collapsed by a huge young on many spheres, a 1 MB container whose edges make each
+ * IMC move cost a second. The server's --job-timeout bounds what runs (1 h by default); this
+ * bounds what is accepted, whatever that setting. */
+#define GP_SPEC_WORK_BUDGET_S 172800.0
+
+/* Fills *out for a valid effective spec (from gp_spec_with_defaults; the container geometry
+ * is not checked again). Returns 0, or -1 with *p (e.g. a sieve count out of reach). */
+int gp_spec_bounds(const json_t *effective_spec, gp_spec_bounds_t *out, gp_spec_problem *p);
+
+/* The server's result bound: 0 when the estimated result of a valid effective spec is at most
+ * max_bytes, else -1 with *p = 422 too_large at result_pointer ("/particles", "/size/sieve",
+ * "/box" or "/tiling") and a message that gives both sizes in MB and names
+ * --max-result-mb; -1 with *p from gp_spec_bounds when it fails. */
+int gp_spec_check_result(const json_t *effective_spec, double max_bytes, gp_spec_problem *p);
 
 #endif /* GP_SPEC_H */

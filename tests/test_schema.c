@@ -190,9 +190,9 @@ static void test_examples(void)
     json_decref(j);
 
     /* defaults and metres */
-    j = load("{\"kind\": \"spheres-3d\", \"sieve\": [[0.001, 0], [0.002, 100]], \"sieve_units\": \"m\"}");
+    j = load("{\"kind\": \"spheres-3d\", \"sieve\": [[0.01, 0], [0.02, 100]], \"sieve_units\": \"m\"}");
     CHECK(gp_spec_parse_3d(j, &t, &p) == 0);
-    CHECK_NEAR(t.sieve[1].diameter, 0.002, 0);
+    CHECK_NEAR(t.sieve[1].diameter, 0.02, 0);
     CHECK(t.tiling[0] == 1 && t.tiling[1] == 1 && t.tiling[2] == 1);
     CHECK(t.outputs == GP_OUT3_SPHERES);
     CHECK_NEAR(t.box[1], 0.5, 0);
@@ -358,7 +358,7 @@ static void test_bad_2d(void)
     /* container */
     BAD2("/container/polygon", "[[0,0],[1,0]]", "/container/polygon", 400, "at least 3 items, got 2");
     BAD2("/container/polygon/1", "[1]", "/container/polygon/1", 400, "exactly 2 items");
-    BAD2("/container/polygon/1", "[1, \"a\"]", "/container/polygon/1/1", 400, "expected a number, got \"a\"");
+    BAD2("/container/polygon/1", "[1, \"a\"]", "/container/polygon/1/1", 400, "expected a number in [-1000000000, 1000000000], got \"a\"");
     BAD2("/container/polygon/1", "[1, 0, 0]", "/container/polygon/1", 400, NULL);
     BAD2("/container/polygon", "[[0,0],[1,1],[1,0],[0,1]]", "/container/polygon", 422, "not simple");
     BAD2("/container/polygon", "[[0,0],[1,1],[2,2]]", "/container/polygon", 422, "no area");
@@ -372,7 +372,7 @@ static void test_bad_2d(void)
     BAD2("/container/circle", "{\"center\": [0, 0], \"radius\": 1}", "/container", 400,
          "expected a polygon container");
     BAD2("/container", "{\"circle\": {\"center\": [0, 0], \"radius\": 0}}", "/container/circle/radius",
-         400, "expected a number > 0, got 0");
+         400, "expected a number in (0, 1000000000], got 0");
     BAD2("/container", "{\"circle\": {\"center\": [0, 0]}}", "/container/circle/radius", 400,
          "required field is missing");
     BAD2("/container", "{\"circle\": {\"center\": [0], \"radius\": 1}}", "/container/circle/center",
@@ -677,7 +677,7 @@ static void test_bad_3d(void)
     BAD3("/sieve_units", "\"m\"", "/sieve/4/0", 422, "does not fit");
     BAD3("/porosity", "1", "/porosity", 400, "(0, 1)");
     BAD3("/porosity", "0", "/porosity", 400, NULL);
-    BAD3("/material/density", "0", "/material/density", 400, "> 0");
+    BAD3("/material/density", "0", "/material/density", 400, "[100, 30000]");
     BAD3("/material/young", "-1", "/material/young", 400, NULL);
     BAD3("/material/poisson", "0.6", "/material/poisson", 400, "[0, 0.5]");
     BAD3("/material/friction_deg", "90", "/material/friction_deg", 400, NULL);
@@ -690,7 +690,11 @@ static void test_bad_3d(void)
     BAD3("/outputs", "[\"stress\", \"stress\"]", "/outputs/1", 400, "duplicate");
     BAD3("/holes", "[]", "/holes", 400, "unknown field");
     GOOD3("/sieve_units", "\"mm\"");
-    GOOD3("/sieve", "[[0.001, 0], [0.002, 100]]");
+    /* 1-2 um grains would fill the 0.5 m box with ~4e16 spheres: refused at submit (the DEM
+     * sample takes 400,000 at most), not failed on a worker */
+    expect_bad_code(EX3D, "/sieve", "[[0.001, 0], [0.002, 100]]", "/box", 422, "too_large",
+                    "over the limit of 400000 spheres", __LINE__);
+    GOOD3("/sieve", "[[10, 0], [20, 100]]"); /* ~40,000 spheres, 64 tiles */
     GOOD3("/tiling", NULL);
 
     /* a 3D spec is not a 2D spec */
@@ -737,6 +741,302 @@ static void test_documents(void)
     CHECK(gp_spec_validate(NULL, NULL) != 0);
 }
 
+/* ---- issue #14: polygons checked in near-linear time, exactly ---- */
+
+/* points (x, y) appended to a JSON array */
+static void add_pt(json_t *a, double x, double y)
+{
+    json_array_append_new(a, json_pack("[f, f]", x, y));
+}
+
+/* A container of stacked zigzag rings that share their x range (the layout that made the
+ * former pairwise check quadratic): the outer ring's left side a zigzag x = -10 + i % 2,
+ * y = 10 i, i < 9998, right side at x = 11; nholes holes x = i % 2, y = y0 + i, i < 9995,
+ * closed through (-5, y0 + 4997). cross: the last ring gets a spike through its own closing
+ * edge. About 10,000 edges a ring. */
+static json_t *stacked_spec(int nholes, int cross, size_t *edges)
+{
+    const int P = 10000;
+    json_t *outer = json_array(), *holes = json_array();
+    for (int i = 0; i <= P - 3; i++)
+        add_pt(outer, (cross && nholes == 0 && i == P / 2 + 1) ? 16 : -10 + i % 2, 10.0 * i);
+    add_pt(outer, 11, 10.0 * (P - 3));
+    add_pt(outer, 11, 0);
+    *edges = (size_t)P;
+    for (int k = 0; k < nholes; k++) {
+        json_t *h = json_array();
+        double y0 = 100 + k * (P + 100.0);
+        for (int i = 0; i <= P - 6; i++)
+            add_pt(h, (cross && k == nholes - 1 && i == 4999) ? -6 : i % 2, y0 + i);
+        add_pt(h, -5, y0 + 4997);
+        *edges += json_array_size(h);
+        json_array_append_new(holes, h);
+    }
+    return json_pack("{s:s, s:i, s:{s:o, s:o}}", "kind", "fourier-voronoi-2d", "particles", 100,
+                     "container", "polygon", outer, "holes", holes);
+}
+
+static void test_polygon_sweep(void)
+{
+    /* 100,000 edges (a 1 MB body): accepted; the same with one crossing: refused at that ring
+     * (bench/bench_validate times these) */
+    size_t ne;
+    json_t *j = stacked_spec(9, 0, &ne);
+    gp_spec_problem p;
+    CHECK(ne > 99900);
+    int rc = gp_spec_validate(j, &p);
+    if (rc) fprintf(stderr, "stacked zigzags refused: %s\n", p.message);
+    CHECK(rc == 0);
+    json_decref(j);
+    j = stacked_spec(9, 1, &ne);
+    CHECK(gp_spec_validate(j, &p) != 0 && p.http_status == 422 && !strcmp(p.code, "invalid_spec"));
+    CHECK(!strcmp(p.pointer, "/container/holes/8") && strstr(p.message, "not simple"));
+    json_decref(j);
+    j = stacked_spec(0, 1, &ne);
+    CHECK(gp_spec_validate(j, &p) != 0 && !strcmp(p.pointer, "/container/polygon"));
+    CHECK(strstr(p.message, "not simple: edge") != NULL);
+    json_decref(j);
+    /* the brief's zigzag: (i, i % 2), closed through a far point */
+    json_t *z = json_array();
+    for (int i = 0; i < 9999; i++) add_pt(z, i, i % 2);
+    add_pt(z, 5000, -1e6);
+    j = json_pack("{s:s, s:{s:o}}", "kind", "fourier-voronoi-2d", "container", "polygon", z);
+    CHECK(gp_spec_validate(j, &p) == 0);
+    /* a vertex pushed through the far point's edge */
+    json_array_set_new(z, 4001, json_pack("[f, f]", 4001.0, -2e6));
+    CHECK(gp_spec_validate(j, &p) != 0 && !strcmp(p.pointer, "/container/polygon"));
+    json_decref(j);
+
+    /* touching is crossing, decided exactly */
+    BAD2("/container/polygon", "[[0,0],[4,0],[4,4],[2,0],[0,4]]", "/container/polygon", 422,
+         "crosses or touches"); /* a vertex on an edge */
+    BAD2("/container/polygon", "[[0,0],[2,0],[1,1],[2,2],[0,2],[1,1]]", "/container/polygon", 422,
+         "crosses or touches"); /* a figure 8: one point twice */
+    BAD2("/container/polygon", "[[0,0],[2,0],[2,1],[3,1],[1,1],[0,1]]", "/container/polygon", 422,
+         "not simple"); /* edges 2 and 3 run back over each other */
+    BAD2("/container/polygon", "[[0,0],[2,0],[1,0],[1,1]]", "/container/polygon", 422,
+         "not simple"); /* edges 0 and 1 */
+    GOOD2("/container/polygon", "[[0,0],[1,0],[2,0],[2,1],[0,1]]"); /* collinear, same way */
+    GOOD2("/container/polygon", "[[0,0],[4,0],[4,4],[2,1e-300],[0,4]]"); /* just above */
+    GOOD2("/container/polygon", "[[0,0],[1e-9,0],[1e-9,1e-9],[0,1e-9]]");
+    /* holes: touching the outer ring, each other, nested, outside */
+    BAD2("/container/holes", "[[[0,0.5],[0.5,0.4],[0.5,0.6]]]", "/container/holes/0", 422,
+         "of /container/polygon"); /* a vertex on the outer ring */
+    BAD2("/container/holes", "[[[0.1,0.1],[0.4,0.1],[0.4,0.4]], [[0.4,0.4],[0.8,0.4],[0.8,0.8]]]",
+         "/container/holes/1", 422, "of /container/holes/0"); /* a shared vertex */
+    BAD2("/container/holes", "[[[0.2,0.2],[0.3,0.2],[0.3,0.3]], [[0.1,0.1],[0.9,0.1],[0.9,0.9],[0.1,0.9]]]",
+         "/container/holes/0", 422, "inside hole 1"); /* the first one inside the second */
+    BAD2("/container/holes",
+         "[[[0.1,0.1],[0.9,0.1],[0.9,0.9],[0.1,0.9]], [[0.2,0.2],[0.8,0.2],[0.8,0.8],[0.2,0.8]], [[0.4,0.4],[0.6,0.4],[0.5,0.6]]]",
+         "/container/holes/1", 422, "inside hole 0"); /* nested three deep */
+    BAD2("/container/holes", "[[[0.1,0.1],[0.2,0.1],[0.2,0.2]], [[-1,-1],[3,-1],[3,3],[-1,3]]]",
+         "/container/holes/0", 422, "inside hole 1"); /* a hole around the container */
+    BAD2("/container/holes", "[[[-1,-1],[3,-1],[3,3],[-1,3]]]", "/container/holes/0", 422,
+         "not inside");
+    GOOD2("/container/holes", "[[[0.1,0.1],[0.2,0.1],[0.2,0.2]], [[0.8,0.8],[0.9,0.8],[0.9,0.9],[0.8,0.9]], [[0.5,0.1],[0.6,0.1],[0.55,0.5]]]");
+    /* coordinates stay where the exact predicates are exact */
+    BAD2("/container/polygon", "[[0,0],[1e10,0],[0,1]]", "/container/polygon/1/0", 400,
+         "[-1000000000, 1000000000]");
+}
+
+/* ---- issue #14: work and result bounds, whatever the spelling of the numbers ---- */
+
+static void expect_too_large(const char *base, const char *ptr, const char *value,
+                             const char *want_ptr, const char *needle, int line)
+{
+    expect_bad_code(base, ptr, value, want_ptr, 422, "too_large", needle, line);
+}
+
+/* the bounds of a spec's effective spec */
+static int bounds_of(const char *text, gp_spec_bounds_t *b)
+{
+    json_t *j = load(text);
+    gp_spec_problem p;
+    json_t *eff = gp_spec_with_defaults(j, &p);
+    if (!eff) fprintf(stderr, "bounds_of: refused: %s\n", p.message);
+    int rc = eff ? gp_spec_bounds(eff, b, &p) : -1;
+    json_decref(eff);
+    json_decref(j);
+    return rc;
+}
+
+static void test_work_bounds_2d(void)
+{
+    gp_spec_bounds_t b;
+    /* the defaults, the paper's example and a 10,000-grain specimen with every output: far
+     * below the budget */
+    CHECK(bounds_of(MIN2D, &b) == 0);
+    CHECK(b.cells == 100 && b.items == 100 && b.steps == 1e6 && b.dt == 0);
+    CHECK_NEAR(b.result_bytes, 100 * (400 + 40 * 128), 0);
+    CHECK(!strcmp(b.result_pointer, "/particles"));
+    CHECK(b.work_s < GP_SPEC_WORK_BUDGET_S / 100);
+    CHECK(bounds_of(EX2D, &b) == 0 && b.cells == 500 && b.work_s < GP_SPEC_WORK_BUDGET_S / 100);
+    json_t *j = patched(EX2D, "/particles", "10000");
+    json_object_set_new(json_object_get(j, "imc"), "error", json_string("AD"));
+    json_object_del(json_object_get(j, "imc"), "threshold");
+    gp_spec_problem p;
+    json_t *eff = gp_spec_with_defaults(j, &p);
+    CHECK(eff != NULL);
+    CHECK(eff && gp_spec_bounds(eff, &b, &p) == 0 && b.cells == 10000);
+    CHECK(b.work_s < GP_SPEC_WORK_BUDGET_S / 100);
+    if (g_verbose) fprintf(stderr, "10,000 grains: %.0f s, %.0f MB\n", b.work_s, b.result_bytes / 1e6);
+    json_decref(eff);
+    json_decref(j);
+    expect_good(MIN2D, "/particles", "10000", __LINE__);
+    expect_good(MIN2D, "/particles", "1e6", __LINE__); /* the schema's most, at the defaults */
+    expect_good(MIN2D, "/imc/max_steps", "1e9", __LINE__); /* with 100 cells */
+
+    /* every 2D maximum at once (~3 days) is over the budget, spelled either way */
+    const char *most[] = {
+        "{\"kind\": \"fourier-voronoi-2d\", \"particles\": 1e6, \"imc\": {\"max_steps\": 1e9},"
+        " \"contour_points\": 4.096e3, \"outputs\": [\"grains\", \"odec\", \"descriptors\", \"cells\"]}",
+        "{\"kind\": \"fourier-voronoi-2d\", \"particles\": 1000000, \"imc\": {\"max_steps\": 1000000000},"
+        " \"contour_points\": 4096, \"outputs\": [\"grains\", \"odec\", \"descriptors\", \"cells\"]}"};
+    json_t *k;
+    for (int i = 0; i < 2; i++) {
+        k = load(most[i]);
+        CHECK(gp_spec_validate(k, &p) != 0 && p.http_status == 422 && !strcmp(p.code, "too_large"));
+        CHECK(!strcmp(p.pointer, "/imc/max_steps") && strstr(p.message, "over the budget of 172800 s"));
+        json_decref(k);
+    }
+    /* each of them alone passes; so does the test suite's long job */
+    expect_good(MIN2D, "/imc/max_steps", "1e9", __LINE__);
+    k = load("{\"kind\": \"fourier-voronoi-2d\", \"particles\": 1e6, \"contour_points\": 4.096e3,"
+             " \"outputs\": [\"grains\", \"odec\", \"descriptors\", \"cells\"]}");
+    CHECK(gp_spec_validate(k, &p) == 0); /* the server's result bound refuses it (below) */
+    json_decref(k);
+    k = load("{\"kind\": \"fourier-voronoi-2d\", \"seed\": 7, \"particles\": 40000,"
+             " \"imc\": {\"error\": \"E3\", \"threshold\": 1e-9, \"max_steps\": 1000000000},"
+             " \"contour_points\": 64, \"outputs\": [\"grains\", \"odec\", \"descriptors\"]}");
+    CHECK(gp_spec_validate(k, &p) == 0); /* tests/integration/gpd.py LONG_2D */
+    json_decref(k);
+    /* a 1 MB container makes each IMC move dear: its edges count, near each cell */
+    size_t ne;
+    k = stacked_spec(9, 0, &ne); /* 100 cells: accepted (above) */
+    json_object_set_new(k, "particles", json_real(1e1)); /* 10 cells, 10,000 edges each */
+    CHECK(gp_spec_validate(k, &p) != 0 && p.http_status == 422 && !strcmp(p.code, "too_large"));
+    CHECK(!strcmp(p.pointer, "/container") && strstr(p.message, "99964 edges") &&
+          strstr(p.message, "over the budget of 172800 s"));
+    json_object_set_new(k, "imc", json_pack("{s:i}", "max_steps", 1000));
+    CHECK(gp_spec_validate(k, &p) == 0); /* fewer moves: fine */
+    json_decref(k);
+    k = load("{\"kind\": \"fourier-voronoi-2d\", \"particles\": 100, \"imc\": {\"max_steps\": 1e9}}");
+    json_t *ring = json_array();
+    for (int i = 0; i < 9998; i++) add_pt(ring, i, i % 2);
+    add_pt(ring, 5000, -1e4);
+    json_object_set_new(k, "container", json_pack("{s:o}", "polygon", ring));
+    CHECK(gp_spec_validate(k, &p) != 0 && !strcmp(p.code, "too_large") && !strcmp(p.pointer, "/container"));
+    gp_spec2d s2;
+    gp_spec_problem q;
+    CHECK(gp_spec_parse_2d(k, &s2, &q) != 0 && !strcmp(q.pointer, "/container")); /* the worker too */
+    gp_spec_2d_free(&s2);
+    json_decref(k);
+
+    /* the server's result bound (gp_spec_check_result, --max-result-mb 1024): the same
+     * figure for 1e6 and 1000000 */
+    const char *big[] = {"{\"kind\": \"fourier-voronoi-2d\", \"particles\": 1e6, \"contour_points\": 512}",
+                         "{\"kind\": \"fourier-voronoi-2d\", \"particles\": 1000000, \"contour_points\": 512}"};
+    for (int i = 0; i < 2; i++) {
+        k = load(big[i]);
+        eff = gp_spec_with_defaults(k, &p);
+        CHECK(eff != NULL);
+        CHECK(eff && gp_spec_check_result(eff, 1024e6, &p) != 0 && p.http_status == 422);
+        CHECK(!strcmp(p.code, "too_large") && !strcmp(p.pointer, "/particles"));
+        CHECK(strstr(p.message, "/particles: the result would be about 20880 MB (1000000 grains)") != NULL);
+        CHECK(strstr(p.message, "--max-result-mb") != NULL);
+        json_decref(eff);
+        json_decref(k);
+    }
+    k = load(SV2D);
+    eff = gp_spec_with_defaults(k, &p);
+    CHECK(eff && gp_spec_check_result(eff, 1024e6, &p) == 0);
+    CHECK(eff && gp_spec_check_result(eff, 1e3, &p) != 0 && !strcmp(p.pointer, "/size/sieve"));
+    json_decref(eff);
+    json_decref(k);
+}
+
+static void test_work_bounds_3d(void)
+{
+    const char *MIN3D = "{\"kind\": \"spheres-3d\"}";
+    gp_spec_bounds_t b;
+    /* the paper's example: 2,430 spheres, dt 8.32e-5 s (bench_spheres3d), far below budget */
+    CHECK(bounds_of(MIN3D, &b) == 0);
+    CHECK_REL(b.cells, 2430, 0.02);
+    CHECK_REL(b.dt, 8.32e-5, 0.01);
+    CHECK(b.items == b.cells);
+    CHECK(b.work_s < GP_SPEC_WORK_BUDGET_S / 100);
+    CHECK(!strcmp(b.result_pointer, "/box"));
+    CHECK(bounds_of(EX3D, &b) == 0);
+    CHECK_REL(b.items, 64 * 2430, 0.02);
+    CHECK(!strcmp(b.result_pointer, "/tiling") && b.work_s < GP_SPEC_WORK_BUDGET_S / 100);
+    if (g_verbose) fprintf(stderr, "paper 3D: %.0f spheres, %.3g steps, %.0f s\n", b.cells, b.steps, b.work_s);
+    GOOD3("/material/young", "1e12"); /* diamond: ~1.6 M steps, still within the budget */
+    GOOD3("/material/density", "100");
+
+    /* young 1e25 made dt ~1e-14 s and the job ~50 days: out of the schema's range now, and
+     * far over the work budget even without it */
+    BAD3("/material/young", "1e25", "/material/young", 400, "[1000, 1000000000000]");
+    json_t *j = load(MIN3D);
+    gp_spec_problem p;
+    json_t *eff = gp_spec_with_defaults(j, &p);
+    CHECK(eff != NULL);
+    json_object_set_new(json_object_get(eff, "material"), "young", json_real(1e25));
+    CHECK(eff && gp_spec_bounds(eff, &b, &p) == 0);
+    CHECK(b.work_s > 1e4 * GP_SPEC_WORK_BUDGET_S && b.dt < 1e-12);
+    CHECK(!strcmp(b.work_pointer, "/material/young"));
+    json_decref(eff);
+    json_decref(j);
+    /* in range, but a stiff material on many spheres: refused at the field that drives it */
+    expect_good(MIN3D, "/material", "{\"young\": 1e11}", __LINE__); /* the paper's sieve: fine */
+    j = load("{\"kind\": \"spheres-3d\", \"sieve\": [[5, 0], [10, 100]], \"material\": {\"young\": 1e11}}");
+    CHECK(gp_spec_validate(j, &p) != 0 && p.http_status == 422 && !strcmp(p.code, "too_large"));
+    CHECK(!strcmp(p.pointer, "/material/young") && strstr(p.message, "over the budget of 172800 s"));
+    json_decref(j);
+    j = load("{\"kind\": \"spheres-3d\", \"sieve\": [[5, 0], [10, 100]], \"material\": {\"young\": 1e10}}");
+    CHECK(gp_spec_validate(j, &p) == 0); /* ~1.5 days */
+    json_decref(j);
+    j = load("{\"kind\": \"spheres-3d\", \"sieve\": [[5, 0], [10, 100]], \"material\": {\"young\": 1.5e7, \"density\": 1e2}}");
+    CHECK(gp_spec_validate(j, &p) == 0); /* the same sieve with a soft material */
+    json_decref(j);
+    j = load("{\"kind\": \"spheres-3d\", \"sieve\": [[5, 0], [10, 100]], \"material\": {\"young\": 1e12, \"density\": 100}}");
+    CHECK(gp_spec_validate(j, &p) != 0 && !strcmp(p.code, "too_large"));
+    CHECK(!strcmp(p.pointer, "/material/density") || !strcmp(p.pointer, "/material/young"));
+    json_decref(j);
+
+    /* counts: a 100 m box; a tiling past 20 million spheres */
+    expect_too_large(MIN3D, "/box", "[100, 100, 100]", "/box", "spheres in the DEM sample", __LINE__);
+    expect_too_large(MIN3D, "/box", "[1e2, 1e2, 1e2]", "/box", NULL, __LINE__);
+    expect_bad_code(MIN3D, "/sieve_units", "\"m\"", "/sieve/4/0", 422, "invalid_spec", "does not fit",
+                    __LINE__);
+    j = load("{\"kind\": \"spheres-3d\", \"sieve\": [[5, 0], [10, 100]], \"tiling\": [16, 16, 16]}");
+    CHECK(gp_spec_validate(j, &p) != 0 && !strcmp(p.code, "too_large") && !strcmp(p.pointer, "/tiling"));
+    json_decref(j);
+
+    /* physical ranges */
+    BAD3("/material/young", "500", "/material/young", 400, NULL);
+    BAD3("/material/young", "1e300", "/material/young", 400, NULL);
+    BAD3("/material/density", "50", "/material/density", 400, NULL);
+    BAD3("/material/density", "1e300", "/material/density", 400, NULL);
+    BAD3("/material/friction_deg", "89.5", "/material/friction_deg", 400, "[0, 89]");
+    BAD3("/material/damping", "1", "/material/damping", 400, "[0, 1)");
+    GOOD3("/material/friction_deg", "89");
+    GOOD3("/material/damping", "0.99");
+
+    /* the result bound: the 4 x 4 x 4 example fits 1024 MB; 16 x 16 x 16 tiles of it (10
+     * million spheres, within the tiling limit) with contacts do not */
+    j = load(EX3D);
+    eff = gp_spec_with_defaults(j, &p);
+    CHECK(eff && gp_spec_check_result(eff, 1024e6, &p) == 0);
+    json_decref(eff);
+    json_object_set_new(j, "tiling", json_pack("[i, i, i]", 16, 16, 16));
+    eff = gp_spec_with_defaults(j, &p);
+    CHECK(eff != NULL);
+    CHECK(eff && gp_spec_check_result(eff, 1024e6, &p) != 0 && !strcmp(p.code, "too_large"));
+    CHECK(!strcmp(p.pointer, "/tiling") && strstr(p.message, "spheres") != NULL);
+    json_decref(eff);
+    json_decref(j);
+}
+
 int main(int argc, char **argv)
 {
     g_verbose = argc > 1;
@@ -751,5 +1051,8 @@ int main(int argc, char **argv)
     test_bad_3d();
     test_pointer_escaping();
     test_documents();
+    test_polygon_sweep();
+    test_work_bounds_2d();
+    test_work_bounds_3d();
     return gp_test_summary();
 }
