@@ -76,8 +76,11 @@ void gp_dem3d_set_servo_limit(gp_dem3d *d, int w, double position);
 void gp_dem3d_zero_velocities(gp_dem3d *d);
 
 /* Advances nsteps. Fails (GP_ERR_DEGENERATE) if a sphere leaves the box or a value is not
- * finite. */
+ * finite, and with GP_ERR_CANCELLED before a step when the cancel flag is up. */
 gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err);
+/* A flag another thread may raise (with an atomic store) to stop gp_dem3d_run before its next
+ * step; NULL (the default) = none. Not owned; it must outlive the runs. */
+void gp_dem3d_set_cancel(gp_dem3d *d, const volatile int *cancel);
 
 typedef struct gp_dem3d_state {
     long steps;
@@ -127,6 +130,14 @@ void gp_dem3d_fabric(const gp_dem3d_contact *c, size_t nc, double F[3][3]);
  * (centre to contact point). xyzr: the spheres the contacts refer to. */
 void gp_dem3d_stress(const gp_dem3d_contact *c, size_t nc, const double *xyzr, double volume,
                      double S[3][3]);
+
+/* The same two, returning GP_ERR_CANCELLED (the matrix then half summed) as soon as *cancel
+ * (read atomically every 65536 contacts; may be NULL) is non-zero; GP_OK otherwise, with the
+ * same bits as above. */
+gp_status gp_dem3d_fabric_ex(const gp_dem3d_contact *c, size_t nc, double F[3][3],
+                             const volatile int *cancel);
+gp_status gp_dem3d_stress_ex(const gp_dem3d_contact *c, size_t nc, const double *xyzr,
+                             double volume, double S[3][3], const volatile int *cancel);
 
 /* Solid volume of the spheres inside the box [lo, hi] (each sphere clipped by the six planes;
  * caps of one sphere at two walls are assumed disjoint). */

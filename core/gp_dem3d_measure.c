@@ -119,11 +119,27 @@ gp_status gp_dem3d_find_pairs(const double *xyzr, size_t n, double gap, size_t *
     return GP_OK;
 }
 
+/* the caller's cancel flag (another thread raises it with an atomic store); looked at every
+ * 65536 contacts: a pass over the ~50 million contacts of a 20-million-sphere tiling takes a
+ * second, and the sums keep their order (bit-identical results) */
+static int cancel_due(size_t k, const volatile int *cancel)
+{
+    return (k & 0xFFFF) == 0 && cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED);
+}
+
 void gp_dem3d_fabric(const gp_dem3d_contact *c, size_t nc, double F[3][3])
+{
+    gp_dem3d_fabric_ex(c, nc, F, NULL);
+}
+
+gp_status gp_dem3d_fabric_ex(const gp_dem3d_contact *c, size_t nc, double F[3][3],
+                             const volatile int *cancel)
 {
     memset(F, 0, 9 * sizeof(double));
     double wsum = 0;
     for (size_t k = 0; k < nc; k++) {
+        if (cancel_due(k, cancel))
+            return GP_ERR_CANCELLED;
         double w = c[k].j >= 0 ? 2 : 1; /* seen by both spheres, or by one (a wall) */
         wsum += w;
         for (int a = 0; a < 3; a++)
@@ -134,13 +150,22 @@ void gp_dem3d_fabric(const gp_dem3d_contact *c, size_t nc, double F[3][3])
         for (int a = 0; a < 3; a++)
             for (int b = 0; b < 3; b++)
                 F[a][b] /= wsum;
+    return GP_OK;
 }
 
 void gp_dem3d_stress(const gp_dem3d_contact *c, size_t nc, const double *xyzr, double volume,
                      double S[3][3])
 {
+    gp_dem3d_stress_ex(c, nc, xyzr, volume, S, NULL);
+}
+
+gp_status gp_dem3d_stress_ex(const gp_dem3d_contact *c, size_t nc, const double *xyzr,
+                             double volume, double S[3][3], const volatile int *cancel)
+{
     memset(S, 0, 9 * sizeof(double));
     for (size_t k = 0; k < nc; k++) {
+        if (cancel_due(k, cancel))
+            return GP_ERR_CANCELLED;
         const double *pi = xyzr + 4 * c[k].i;
         double l[3];
         if (c[k].j >= 0) {
@@ -160,6 +185,7 @@ void gp_dem3d_stress(const gp_dem3d_contact *c, size_t nc, const double *xyzr, d
         for (int a = 0; a < 3; a++)
             for (int b = 0; b < 3; b++)
                 S[a][b] /= volume;
+    return GP_OK;
 }
 
 static double cap_volume(double r, double dist)

@@ -19,8 +19,20 @@ static gp_status check_tiles(const int tiles[3], size_t n, size_t *ntile, gp_err
     return GP_OK;
 }
 
+static int cancel_raised(const volatile int *cancel)
+{
+    return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
+}
+
 gp_status gp_flip_tile(const double *xyzr, size_t n, const double box[3], const int tiles[3],
                        size_t max_spheres, double **out, size_t *nout, gp_error *err)
+{
+    return gp_flip_tile_ex(xyzr, n, box, tiles, max_spheres, NULL, out, nout, err);
+}
+
+gp_status gp_flip_tile_ex(const double *xyzr, size_t n, const double box[3], const int tiles[3],
+                          size_t max_spheres, const volatile int *cancel, double **out,
+                          size_t *nout, gp_error *err)
 {
     *out = NULL;
     *nout = 0;
@@ -42,6 +54,10 @@ gp_status gp_flip_tile(const double *xyzr, size_t n, const double box[3], const 
     for (int kz = 0; kz < tiles[2]; kz++)
         for (int ky = 0; ky < tiles[1]; ky++)
             for (int kx = 0; kx < tiles[0]; kx++) {
+                if (cancel_raised(cancel)) { /* a tile: n spheres, at most 400,000 */
+                    free(o);
+                    return gp_error_set(err, GP_ERR_CANCELLED, "flip: cancelled");
+                }
                 int k[3] = {kx, ky, kz};
                 size_t t = ((size_t)kz * (size_t)tiles[1] + (size_t)ky) * (size_t)tiles[0] + (size_t)kx;
                 double *dst = o + 4 * t * n;
@@ -69,6 +85,13 @@ gp_status gp_flip_contacts(const gp_dem3d_contact *c, size_t nc, const double *x
                            const int tiles[3], gp_dem3d_contact **out, size_t *nout,
                            gp_error *err)
 {
+    return gp_flip_contacts_ex(c, nc, xyzr, n, tiles, NULL, out, nout, err);
+}
+
+gp_status gp_flip_contacts_ex(const gp_dem3d_contact *c, size_t nc, const double *xyzr, size_t n,
+                              const int tiles[3], const volatile int *cancel,
+                              gp_dem3d_contact **out, size_t *nout, gp_error *err)
+{
     *out = NULL;
     *nout = 0;
     size_t nt = 0;
@@ -87,8 +110,14 @@ gp_status gp_flip_contacts(const gp_dem3d_contact *c, size_t nc, const double *x
     for (int kz = 0; kz < tiles[2]; kz++)
         for (int ky = 0; ky < tiles[1]; ky++)
             for (int kx = 0; kx < tiles[0]; kx++) {
+                if (cancel_raised(cancel)) {
+                    free(o);
+                    free(w);
+                    return gp_error_set(err, GP_ERR_CANCELLED, "flip: cancelled");
+                }
                 int k[3] = {kx, ky, kz};
                 size_t t = ((size_t)kz * (size_t)tiles[1] + (size_t)ky) * (size_t)tiles[0] + (size_t)kx;
+                size_t m0 = m; /* this tile's sphere contacts start here */
                 size_t stride[3] = {1, (size_t)tiles[0], (size_t)tiles[0] * (size_t)tiles[1]};
                 for (size_t q = 0; q < nc; q++) {
                     gp_dem3d_contact e = c[q];
@@ -117,8 +146,12 @@ gp_status gp_flip_contacts(const gp_dem3d_contact *c, size_t nc, const double *x
                         o[m++] = e; /* normal +a (towards the image), force unchanged (-f e_a) */
                     }
                 }
+                /* Every contact made here has its i in this tile's range [t n, (t + 1) n), and
+                 * tiles come in increasing t: sorting each tile's run sorts them all, the same
+                 * order as one sort of the whole (a sort by (i, j), which no two contacts share),
+                 * in runs short enough to look at the cancel flag between them. */
+                qsort(o + m0, m - m0, sizeof *o, cmp_contact);
             }
-    qsort(o, m, sizeof *o, cmp_contact);
     for (size_t q = 0; q < mw; q++)
         o[m + q] = w[q];
     free(w);

@@ -148,8 +148,10 @@ typedef int (*gp_imc_progress_fn)(void *user, long steps, double error);
  * GP_ERR_INFEASIBLE when the threshold is below the floor (stop reason "floor", no step done);
  * GP_ERR_CANCELLED when *cancel became non-zero or progress returned non-zero. In these four
  * cases *out is the tessellation as it stands (free it with gp_voronoi_destroy) and *rep
- * (optional) is filled (free with gp_imc_report_free). Other errors (GP_ERR_INVALID, ...) leave
- * *out NULL. cancel and progress may be NULL. */
+ * (optional) is filled (free with gp_imc_report_free) -- except a cancel that came while the
+ * seeds were placed or the initial tessellation built (*cancel is looked at there too, every
+ * few thousand seeds or cells): then *out is NULL, as for other errors (GP_ERR_INVALID, ...).
+ * cancel and progress may be NULL. */
 gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *holes,
                      const size_t *nhole, size_t nholes, size_t n, const gp_imc_params *p,
                      gp_imc_progress_fn progress, void *user, const volatile int *cancel,

@@ -1016,6 +1016,13 @@ static gp_status build_grains(build_ctx *b, gp_error *err)
 
 #define FIT_CURVE_POINTS 64
 
+/* GP_ERR_CANCELLED once the caller's flag is up: between the steps that take up to a second at
+ * 10^6 cells and do not poll it themselves */
+static gp_status check_cancel(const build_ctx *b, gp_error *err)
+{
+    return cancelled(b->cancel) ? gp_error_set(err, GP_ERR_CANCELLED, "cancelled") : GP_OK;
+}
+
 static gp_status fit_report(build_ctx *b, gp_error *err)
 {
     gp_specimen2d *out = b->out;
@@ -1026,7 +1033,10 @@ static gp_status fit_report(build_ctx *b, gp_error *err)
     gp_fit2d *f = &out->fit;
     for (size_t i = 0; i < n; i++)
         v[i] = gp_voronoi_cell_area(b->vor, i);
+    /* each measure takes up to ~0.7 s at 10^6 cells: the cancel flag is looked at between them */
     gp_status st = gp_fit_area_measure(v, n, b->cell_law, FIT_CURVE_POINTS, &f->cell_area, err);
+    if (st == GP_OK)
+        st = check_cancel(b, err);
     for (size_t i = 0; i < n && st == GP_OK; i++)
         v[i] = gp_voronoi_cell_orientation(b->vor, i) * DEG;
     if (st == GP_OK)
@@ -1035,11 +1045,15 @@ static gp_status fit_report(build_ctx *b, gp_error *err)
     if (st == GP_OK && ng > 0) {
         for (size_t i = 0; i < ng; i++)
             v[i] = out->grains[i].area;
-        st = gp_fit_area_measure(v, ng, b->grain_law, FIT_CURVE_POINTS, &f->grain_area, err);
+        st = check_cancel(b, err);
+        if (st == GP_OK)
+            st = gp_fit_area_measure(v, ng, b->grain_law, FIT_CURVE_POINTS, &f->grain_area, err);
         if (st == GP_OK && b->spec->size_law == GP_LAW_SIEVE)
             st = gp_fit_passing_measure(v, ng, b->grain_law, &f->passing, err);
         for (size_t i = 0; i < ng && st == GP_OK; i++)
             v[i] = out->grains[i].orientation_deg;
+        if (st == GP_OK)
+            st = check_cancel(b, err);
         if (st == GP_OK)
             st = gp_fit_orient_measure(v, ng, b->spec->mean_deg, b->spec->anisotropy,
                                        &f->grain_orientation, err);
@@ -1122,10 +1136,16 @@ static gp_status build_steps(build_ctx *b, gp_error *err)
     }
     if (st == GP_OK)
         st = run_imc(b, err);
+    if (st == GP_OK)
+        st = check_cancel(b, err);
     if (st == GP_OK && (spec->outputs & GP_OUT_CELLS))
         st = output_cells(b, err);
+    if (st == GP_OK)
+        st = check_cancel(b, err);
     if (st == GP_OK && (spec->outputs & (GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS)))
         st = build_grains(b, err);
+    if (st == GP_OK)
+        st = check_cancel(b, err);
     if (st == GP_OK)
         st = fit_report(b, err);
     if (st == GP_OK)

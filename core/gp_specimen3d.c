@@ -108,10 +108,16 @@ typedef struct run_ctx {
     double last;
 } run_ctx;
 
+/* the caller's cancel flag, raised by another thread with an atomic store */
+static int cancel_raised(const volatile int *cancel)
+{
+    return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
+}
+
 static int report(run_ctx *c, const char *phase, double fraction, long steps, double porosity,
                   double sc, int force)
 {
-    if (c->cancel && __atomic_load_n((const int *)c->cancel, __ATOMIC_RELAXED))
+    if (cancel_raised(c->cancel))
         return 1;
     if (!c->fn)
         return 0;
@@ -146,9 +152,10 @@ static int cmp_desc(const void *a, const void *b)
 }
 
 /* Random sequential placement of spheres (radii lam * d / 2, largest first) without overlap in
- * [0, L]. Returns 0 on success. */
+ * [0, L]. Returns 0 on success, 1 when a sphere found no place, 2 when *cancel came up (looked
+ * at every 256 spheres: up to 4000 tries each), -1 out of memory. */
 static int place(const double *diam, size_t n, double lam, const double L[3], gp_rng *rng,
-                 double *xyzr)
+                 const volatile int *cancel, double *xyzr)
 {
     double rmax = 0.5 * lam * diam[0];
     double cs = 2 * rmax;
@@ -171,6 +178,10 @@ static int place(const double *diam, size_t n, double lam, const double L[3], gp
         head[c] = -1;
     int ok = 1;
     for (size_t i = 0; i < n && ok; i++) {
+        if (i % 256 == 0 && cancel_raised(cancel)) {
+            ok = -1;
+            break;
+        }
         double r = 0.5 * lam * diam[i];
         int placed = 0;
         for (int t = 0; t < 4000 && !placed; t++) {
@@ -213,7 +224,7 @@ static int place(const double *diam, size_t n, double lam, const double L[3], gp
     }
     free(head);
     free(next);
-    return ok ? 0 : 1;
+    return ok < 0 ? 2 : (ok ? 0 : 1);
 }
 
 /* statistics of a contact list over n spheres */
@@ -359,7 +370,16 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
     double L[3] = {B[0], B[1], H0};
     double lam = GROW_FROM;
     int tries = 0;
-    while (place(diam, n, lam, L, rng, xyzr) != 0) {
+    int pl;
+    while ((pl = place(diam, n, lam, L, rng, cancel, xyzr)) != 0) {
+        if (pl < 0) {
+            ret = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        if (pl == 2) {
+            ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+            goto fail;
+        }
         if (++tries > 12) {
             ret = gp_error_set(err, GP_ERR_INTERNAL, "deposition: cannot place the spheres");
             goto fail;
@@ -393,6 +413,7 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
         ret = st;
         goto fail;
     }
+    gp_dem3d_set_cancel(dem, cancel); /* a chunk of 100 steps of a large sample takes seconds */
     /* Every duration of the protocol is a multiple of the skeleton's time sqrt(d50 / g) (d50 the
      * median diameter by weight: the grains that carry the load), the time a grain takes to
      * fall its own size. In steps this unit is ~860 for the paper's sieve and ~2300 for a size
@@ -632,10 +653,17 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
     int tile = ntile > 1 && (ret == GP_OK || ret == GP_ERR_NOT_CONVERGED);
     if (tile) {
         report(&rc, "tiling", 0.9, S->steps, p, S->stability, 1);
-        st = gp_flip_tile(xyzr, n, res->sample_box, spec->tiling, MAX_TILED_SPHERES, &tiled,
-                          &ntiled, err);
+        st = gp_flip_tile_ex(xyzr, n, res->sample_box, spec->tiling, MAX_TILED_SPHERES, cancel,
+                             &tiled, &ntiled, err);
+        /* (the reports between the steps show the phase: a tiling of 10^7 spheres takes
+         * seconds, and the first report may have come too soon after the last to be shown) */
+        if (!st && report(&rc, "tiling", 0.93, S->steps, p, S->stability, 0))
+            st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
         if (!st)
-            st = gp_flip_contacts(con, ncon, xyzr, n, spec->tiling, &tcon, &ntcon, err);
+            st = gp_flip_contacts_ex(con, ncon, xyzr, n, spec->tiling, cancel, &tcon, &ntcon,
+                                     err);
+        if (!st && report(&rc, "tiling", 0.96, S->steps, p, S->stability, 0))
+            st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
         if (st) {
             ret = st;
             goto fail;
@@ -647,6 +675,8 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
             tp.scaled_radius = dp.scaled_radius;
             double thi[3] = {res->box[0], res->box[1], res->box[2]};
             st = gp_dem3d_create(&tp, tiled, ntiled, lo, thi, &dem, err);
+            if (!st)
+                gp_dem3d_set_cancel(dem, cancel);
             for (long s = 0; !st && s < spec->tile_relax_steps; s += CHUNK) {
                 st = gp_dem3d_run(dem, CHUNK, err);
                 gp_dem3d_get_state(dem, &ds);
@@ -676,6 +706,10 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
         /* true solid volume: each copy clipped to its own tile (inner faces are not walls) */
         double solid = 0;
         for (size_t t = 0; t < ntile; t++) {
+            if (cancel_raised(cancel)) {
+                ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+                goto fail;
+            }
             size_t kx = t % (size_t)spec->tiling[0], ky = (t / (size_t)spec->tiling[0]) % (size_t)spec->tiling[1],
                    kz = t / ((size_t)spec->tiling[0] * (size_t)spec->tiling[1]);
             double tlo[3] = {kx * res->sample_box[0], ky * res->sample_box[1], kz * res->sample_box[2]};
@@ -689,14 +723,31 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
     res->t_tiling = now() - t_phase;
 
     /* ---- measures on the final packing ---- */
+    /* Each measure is one pass over the contacts (up to ~50 million after a tiling of 20
+     * million spheres, a fraction of a second each): the flag is looked at between them. */
+#define CANCEL_POINT()                                                                    \
+    do {                                                                                  \
+        if (cancel_raised(cancel)) {                                                      \
+            ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");                       \
+            goto fail;                                                                    \
+        }                                                                                 \
+    } while (0)
+    if (report(&rc, "tiling", 0.98, S->steps, p, S->stability, 0)) {
+        ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+        goto fail;
+    }
     contact_stats(fc, nfc, nf, &S->coordination_number, &S->coordination_spheres, &S->contacts,
                   &S->wall_contacts);
     S->particles = nf;
     res->count = nf;
-    if (spec->outputs & GP_OUT3_FABRIC)
-        gp_dem3d_fabric(fc, nfc, S->fabric);
-    if (spec->outputs & GP_OUT3_STRESS)
-        gp_dem3d_stress(fc, nfc, fx, res->box[0] * res->box[1] * res->box[2], S->stress);
+    CANCEL_POINT();
+    if ((spec->outputs & GP_OUT3_FABRIC) && gp_dem3d_fabric_ex(fc, nfc, S->fabric, cancel))
+        CANCEL_POINT();
+    if ((spec->outputs & GP_OUT3_STRESS) &&
+        gp_dem3d_stress_ex(fc, nfc, fx, res->box[0] * res->box[1] * res->box[2], S->stress,
+                           cancel))
+        CANCEL_POINT();
+    CANCEL_POINT();
     if (spec->outputs & GP_OUT3_SPHERES) {
         if (tile) {
             res->spheres = tiled;
@@ -713,6 +764,8 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
             goto fail;
         }
         for (size_t k = 0; k < nfc; k++) {
+            if (k % 65536 == 0)
+                CANCEL_POINT();
             res->contacts[k].i = fc[k].i;
             res->contacts[k].j = fc[k].j;
             memcpy(res->contacts[k].normal, fc[k].normal, sizeof fc[k].normal);
@@ -721,6 +774,7 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
         }
         res->ncontacts = nfc;
     }
+#undef CANCEL_POINT
     report(&rc, "tiling", 1.0, S->steps, S->porosity, S->stability, 1);
     free(con); free(tcon); free(tiled); free(xyzr); free(diam); free(sd); free(sw);
     gp_rng_destroy(rng);

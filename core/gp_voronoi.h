@@ -57,6 +57,12 @@ typedef struct gp_voronoi gp_voronoi;
 gp_voronoi *gp_voronoi_create(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *holes,
                               const size_t *nhole, size_t nholes, const gp_vec2 *seeds, size_t n,
                               gp_error *err);
+/* The same, stopping early when *cancel (read atomically every few thousand cells; may be NULL)
+ * becomes non-zero: then NULL with GP_ERR_CANCELLED. A tessellation of 10^6 seeds takes
+ * seconds; the job service passes its cancel flag here. The result does not depend on cancel. */
+gp_voronoi *gp_voronoi_create_ex(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *holes,
+                                 const size_t *nhole, size_t nholes, const gp_vec2 *seeds,
+                                 size_t n, const volatile int *cancel, gp_error *err);
 void gp_voronoi_destroy(gp_voronoi *v);
 
 /* A regular polygon inscribed in the circle (centre c, radius r), counter-clockwise, whose largest

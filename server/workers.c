@@ -54,6 +54,20 @@ static pthread_mutex_t wd_mu = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t wd_cv;
 static unsigned long wd_gen = 0; /* guarded by wd_mu */
 
+/* The reaper: a thread that frees the JSON trees of finished results. The tree of a large
+ * result (a 233,000-sphere tiling with its contacts: ~10 million jansson values) takes about a
+ * second to free, which a worker would otherwise spend after a cancel or before storing. */
+typedef struct reap_item {
+    struct reap_item *next;
+    json_t *tree;
+} reap_item;
+static pthread_t reap_thread;
+static int reap_running = 0;
+static int reap_quit = 0; /* guarded by reap_mu */
+static reap_item *reap_head = NULL; /* guarded by reap_mu */
+static pthread_mutex_t reap_mu = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t reap_cv = PTHREAD_COND_INITIALIZER;
+
 int workers_total(void) { return nslots; }
 
 void workers_set_job_timeout(long seconds) { job_timeout_s = seconds > 0 ? seconds : 0; }
@@ -98,6 +112,48 @@ store_rc workers_cancel(const char *id, char status_out[16])
     if (rc == STORE_OK) gpd_log(GPD_LOG_INFO, "job %s cancelled (was %s)", id,
                                 was_running ? "running" : "queued");
     return rc;
+}
+
+/* Hands tree (taken; NULL is fine) to the reaper, or frees it here when there is none. */
+static void reap_later(json_t *tree)
+{
+    if (!tree) return;
+    reap_item *it = reap_running ? malloc(sizeof *it) : NULL;
+    if (!it) {
+        json_decref(tree);
+        return;
+    }
+    it->tree = tree;
+    pthread_mutex_lock(&reap_mu);
+    it->next = reap_head;
+    reap_head = it;
+    pthread_cond_signal(&reap_cv);
+    pthread_mutex_unlock(&reap_mu);
+}
+
+static void *reaper_main(void *arg)
+{
+    (void)arg;
+    pthread_mutex_lock(&reap_mu);
+    for (;;) {
+        while (!reap_head && !reap_quit) pthread_cond_wait(&reap_cv, &reap_mu);
+        reap_item *list = reap_head;
+        reap_head = NULL;
+        if (!list) break; /* quitting, nothing left */
+        pthread_mutex_unlock(&reap_mu);
+        while (list) {
+            reap_item *it = list;
+            list = it->next;
+            json_decref(it->tree);
+            free(it);
+        }
+#ifdef __GLIBC__
+        malloc_trim(0); /* as after a job (worker_main): an idle daemon is small again */
+#endif
+        pthread_mutex_lock(&reap_mu);
+    }
+    pthread_mutex_unlock(&reap_mu);
+    return NULL;
 }
 
 /* ------------------------------------------------------------------ progress */
@@ -162,6 +218,24 @@ static int on_progress3d(void *user, const gp_progress3d *p)
     return report(user, p->phase, p->fraction, p->steps, 0, 1, p->porosity, p->stability);
 }
 #endif
+
+/* Says "result" in the job's progress while a large result is built and written (seconds for
+ * 10^5 spheres or 10^4 grains), keeping the 4 Hz bound: waits out what is left of the interval
+ * since the last write (at most 0.25 s, next to seconds of work). */
+__attribute__((unused)) static void report_result_phase(run_ctx *c, double fraction)
+{
+    double wait = c->last_write + PROGRESS_MIN_INTERVAL_S - gpd_monotonic_s();
+    if (wait > 0) {
+        struct timespec ts = {0, (long)(wait * 1e9)};
+        nanosleep(&ts, NULL);
+    }
+    snprintf(c->phase, sizeof c->phase, "result");
+    c->last_write = gpd_monotonic_s();
+    char *t = progress_text("result", fraction, NAN, NULL);
+    if (t && store_progress(c->id, t) == STORE_CONFLICT)
+        __atomic_store_n(&c->s->cancel, 1, __ATOMIC_RELAXED);
+    free(t);
+}
 
 /* ------------------------------------------------------------------ one job */
 
@@ -266,18 +340,34 @@ static void finish_timeout(run_ctx *ctx, const char *phase)
     finish_failed(ctx->id, "timeout", msg);
 }
 
+static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err, const char *extra);
+
 /* Stores a result (takes r) and the export pack (takes pack, may be NULL) together with status
  * succeeded and the "done" progress (takes detail, NULL = {}). Reals get 17 significant digits:
- * the geometry reads back bit for bit, as in the exports. */
+ * the geometry reads back bit for bit, as in the exports. The writing stops at the cancel flag
+ * (a 133 MB result takes ~5 s to write); a result written in full is stored even when a
+ * shutdown came meanwhile (a second or so), not after a DELETE (the job is cancelled). */
 __attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r, json_t *detail,
                                                      void *pack, size_t pack_len)
 {
-    char *text = r ? json_dumps(r, JSON_COMPACT | JSON_REAL_PRECISION(17)) : NULL;
-    json_decref(r);
-    char *prog = progress_text("done", 1.0, 0.0, detail);
-    if (__atomic_load_n(&ctx->s->reason, __ATOMIC_RELAXED) == REASON_TIMEOUT) {
+    char *text = r ? gpd_dumps_c(r, JSON_COMPACT | JSON_REAL_PRECISION(17), &ctx->s->cancel)
+                   : NULL;
+    reap_later(r);
+    int reason = __atomic_load_n(&ctx->s->reason, __ATOMIC_RELAXED);
+    int stopped = __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED) &&
+                  (!text || reason == REASON_DELETE);
+    char *prog = NULL;
+    if (!stopped) {
+        prog = progress_text("done", 1.0, 0.0, detail); /* takes detail */
+        detail = NULL;
+    }
+    if (reason == REASON_TIMEOUT) {
         /* the limit passed while the result was being built */
         finish_timeout(ctx, "result");
+    } else if (stopped) {
+        /* cancelled (DELETE: already marked) or shutdown before the result was written:
+         * requeued */
+        finish_not_ok(ctx, GP_ERR_CANCELLED, NULL, NULL);
     } else if (!text || !prog) {
         finish_failed(ctx->id, "internal", "out of memory while serialising the result");
     } else {
@@ -302,12 +392,14 @@ __attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r, js
         }
         /* STORE_CONFLICT: cancelled by a DELETE meanwhile */
     }
+    json_decref(detail);
     free(text);
     free(prog);
     free(pack);
 }
 
-/* A build that did not succeed: cancelled (by DELETE or shutdown) or failed. */
+/* A build that did not succeed: cancelled (by DELETE or shutdown) or failed; err may be NULL
+ * only with GP_ERR_CANCELLED. */
 __attribute__((unused)) static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err,
                                                   const char *extra)
 {
@@ -324,9 +416,19 @@ __attribute__((unused)) static void finish_not_ok(run_ctx *ctx, gp_status st, co
         return;
     }
     char msg[GP_ERROR_MESSAGE_MAX + 128];
-    snprintf(msg, sizeof msg, "%s%s", err->message[0] ? err->message : gp_status_name(st),
+    snprintf(msg, sizeof msg, "%s%s",
+             err && err->message[0] ? err->message : gp_status_name(st),
              extra ? extra : "");
     finish_failed(ctx->id, gp_status_name(st), msg);
+}
+
+/* The result tree could not be built: cancelled meanwhile, or out of memory. */
+__attribute__((unused)) static void result_not_built(run_ctx *ctx)
+{
+    if (__atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED))
+        finish_not_ok(ctx, GP_ERR_CANCELLED, NULL, NULL);
+    else
+        finish_failed(ctx->id, "internal", "out of memory while building the result");
 }
 
 #ifdef GPD_HAVE_SPECIMEN2D
@@ -370,7 +472,18 @@ static void run_2d(slot *s, const char *id, json_t *spec_json)
     gp_error_clear(&err);
     gp_status st = gp_specimen2d_build(&spec, on_progress2d, &ctx, &s->cancel, &out, &err);
     if (st == GP_OK && out) {
-        json_t *r = gpd_result_2d(out, &spec, spec_json);
+        size_t np = out->ncells * 12; /* the result's size in points, roughly: ~0.5 s a million */
+        for (size_t i = 0; i < out->ngrains; i++)
+            np += out->grains[i].ncontour + out->grains[i].ndiscs;
+        if (np > 1000000) report_result_phase(&ctx, 1.0);
+        json_t *r = gpd_result_2d_c(out, &spec, spec_json, &s->cancel);
+        if (!r || __atomic_load_n(&s->cancel, __ATOMIC_RELAXED)) { /* (r: partial) */
+            reap_later(r);
+            gp_specimen2d_destroy(out);
+            gp_spec_2d_free(&spec);
+            result_not_built(&ctx);
+            return;
+        }
         /* exports need the ODEC discs; without them there is no pack and GET .../export
          * answers 409 naming the output to ask for */
         void *pack = NULL;
@@ -414,7 +527,16 @@ static void run_3d(slot *s, const char *id, json_t *spec_json)
     gp_error_clear(&err);
     gp_status st = gp_specimen3d_build(&spec, on_progress3d, &ctx, &s->cancel, &out, &err);
     if (st == GP_OK && out) {
-        json_t *r = gpd_result_3d(out, &spec, spec_json);
+        if ((out->spheres && out->count > 50000) || out->ncontacts > 100000)
+            report_result_phase(&ctx, 1.0); /* ~0.5 s and more */
+        json_t *r = gpd_result_3d_c(out, &spec, spec_json, &s->cancel);
+        if (!r || __atomic_load_n(&s->cancel, __ATOMIC_RELAXED)) { /* (r: partial) */
+            reap_later(r);
+            gp_specimen3d_destroy(out);
+            gp_spec_3d_free(&spec);
+            result_not_built(&ctx);
+            return;
+        }
         void *pack = NULL;
         size_t pack_len = 0;
         if (out->spheres) {
@@ -580,6 +702,11 @@ int workers_start(int n)
     slots = calloc((size_t)n, sizeof *slots);
     if (!slots) return -1;
     nslots = n;
+    reap_quit = 0;
+    if (pthread_create(&reap_thread, NULL, reaper_main, NULL) == 0)
+        reap_running = 1;
+    else /* not fatal: the workers then free their trees themselves */
+        gpd_log(GPD_LOG_WARN, "cannot start the reaper thread; results are freed by the workers");
     if (job_timeout_s > 0) {
         if (pthread_create(&wd_thread, NULL, watchdog_main, NULL) != 0) {
             gpd_log(GPD_LOG_ERROR, "cannot start the job-timeout watchdog");
@@ -615,6 +742,14 @@ void workers_stop(void)
         wd_running = 0;
     }
     for (int i = 0; i < nslots; i++) pthread_join(slots[i].thread, NULL);
+    if (reap_running) { /* frees what is left (a second at most per tree) */
+        pthread_mutex_lock(&reap_mu);
+        reap_quit = 1;
+        pthread_cond_signal(&reap_cv);
+        pthread_mutex_unlock(&reap_mu);
+        pthread_join(reap_thread, NULL);
+        reap_running = 0;
+    }
     pending_drain(1);
     free(slots);
     slots = NULL;

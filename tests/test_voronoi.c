@@ -570,6 +570,65 @@ static void property_moves(const char *name, const gp_vec2 *outer, size_t no, co
     free(s);
 }
 
+/* gp_voronoi_create_ex: a raised cancel flag stops a large tessellation (GP_ERR_CANCELLED, NULL),
+ * a lowered one changes nothing (the same cells, bit for bit, as gp_voronoi_create); a small
+ * one (under the polling interval) is never cut short. */
+static void test_cancel(void)
+{
+    gp_vec2 sq[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    size_t n = 20000;
+    gp_vec2 *s = malloc(n * sizeof *s);
+    for (size_t i = 0; i < n; i++) s[i] = (gp_vec2){urand(), urand()};
+    volatile int up = 1, down = 0;
+    gp_error e;
+    gp_error_clear(&e);
+    gp_voronoi *v = gp_voronoi_create_ex(sq, 4, NULL, NULL, 0, s, n, &up, &e);
+    CHECK(v == NULL && e.code == GP_ERR_CANCELLED);
+    gp_voronoi *a = gp_voronoi_create_ex(sq, 4, NULL, NULL, 0, s, n, &down, NULL);
+    gp_voronoi *b = gp_voronoi_create(sq, 4, NULL, NULL, 0, s, n, NULL);
+    CHECK(a && b);
+    int same = a && b;
+    for (size_t i = 0; same && i < n; i++) {
+        double x = gp_voronoi_cell_area(a, i), y = gp_voronoi_cell_area(b, i);
+        double p = gp_voronoi_cell_orientation(a, i), q = gp_voronoi_cell_orientation(b, i);
+        same = !memcmp(&x, &y, sizeof x) && !memcmp(&p, &q, sizeof p);
+    }
+    CHECK(same);
+    gp_voronoi_destroy(a);
+    gp_voronoi_destroy(b);
+    v = gp_voronoi_create_ex(sq, 4, NULL, NULL, 0, s, 100, &up, NULL);
+    CHECK(v != NULL);
+    gp_voronoi_destroy(v);
+    free(s);
+}
+
+/* A sliver (issue 14: [[0,0],[1,1],[1,1.00000002]], area 1e-8 of its bounding box): its width,
+ * ~1.4e-8, is far above the tolerance (1e-12 of the box), so it tessellates like any triangle;
+ * what made such a job slow was placing seeds by rejection in the bounding box (10^8 draws a
+ * seed, gp_imc.c), which looks at the cancel flag. */
+static void test_sliver(void)
+{
+    gp_vec2 t[3] = {{0, 0}, {1, 1}, {1, 1.00000002}};
+    gp_vec2 s[10];
+    for (int i = 0; i < 10; i++) { /* inside, along the sliver */
+        double u = 0.05 + 0.09 * i, w = 0.25 + 0.05 * i;
+        s[i] = (gp_vec2){u, u + w * 2e-8 * u};
+    }
+    gp_error e;
+    gp_error_clear(&e);
+    gp_voronoi *v = gp_voronoi_create(t, 3, NULL, NULL, 0, s, 10, &e);
+    CHECK(v != NULL);
+    if (!v) {
+        fprintf(stderr, "sliver: %s\n", e.message);
+        return;
+    }
+    double sum = 0.0;
+    for (size_t i = 0; i < 10; i++) sum += gp_voronoi_cell_area(v, i);
+    CHECK_REL(sum, 1e-8, 1e-6);
+    CHECK_REL(gp_voronoi_container_area(v), 1e-8, 1e-6);
+    gp_voronoi_destroy(v);
+}
+
 int main(void)
 {
     test_square_bruteforce();
@@ -590,5 +649,7 @@ int main(void)
     property_moves("annulus N=150", c, nc, holes, &nh, 1, 150, 4000, 8);
     free(c);
     free(h);
+    test_cancel(); /* last: it draws from urand() */
+    test_sliver();
     return gp_test_summary();
 }
