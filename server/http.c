@@ -27,6 +27,7 @@
 #endif
 #ifdef GPD_HAVE_SVG
 #include "svg.h"
+#include "svg_job.h"
 #endif
 #ifdef GPD_HAVE_DASHBOARD
 #include "dashboard.h"
@@ -552,6 +553,21 @@ static enum MHD_Result h_spec(struct MHD_Connection *c, req *r, const char *id)
                     NULL);
 }
 
+#ifdef GPD_HAVE_SVG
+static ssize_t read_svg(void *cls, uint64_t pos, char *buf, size_t max)
+{
+    (void)pos; /* read in order, once */
+    size_t n = 0;
+    if (svg_job_read(cls, buf, max, &n)) return MHD_CONTENT_READER_END_WITH_ERROR;
+    return n ? (ssize_t)n : MHD_CONTENT_READER_END_OF_STREAM;
+}
+
+static void free_svg(void *cls)
+{
+    svg_job_close(cls);
+}
+#endif
+
 static enum MHD_Result h_svg(struct MHD_Connection *c, req *r, const char *id)
 {
     char *kind = NULL;
@@ -598,31 +614,17 @@ static enum MHD_Result h_svg(struct MHD_Connection *c, req *r, const char *id)
         opt.has_z = 1;
         opt.z = v;
     }
-    char *text = NULL;
-    rc = store_get_text(id, "result", &text, st);
-    if (rc == STORE_NOT_FOUND) {
-        free(kind);
-        return not_found(c, r, id);
-    }
-    if (rc != STORE_OK || strcmp(st, "succeeded") || !text) {
-        free(text);
-        free(kind);
-        return rc != STORE_OK ? send_store_error(c, r) : not_ready(c, r, id, st);
-    }
-    json_error_t je;
-    json_t *res = json_loads(text, 0, &je);
-    free(text);
-    if (!res) {
-        free(kind);
-        return send_error(c, r, 500, "internal", NULL, "stored result is not valid JSON");
-    }
-    size_t len = 0;
+    /* drawn from the job's summary and its items read one at a time (the export pack or the
+     * stored result walked element by element), streamed: bounded memory (svg_job.h) */
+    svg_job *sj = NULL;
     int status = 500;
     char err[512] = "";
-    char *svg = gp_svg_render(res, kind, view, &opt, &len, &status, err, sizeof err);
-    json_decref(res);
+    svg_job_rc jr = svg_job_open(id, kind, view, &opt, &sj, st, &status, err, sizeof err);
     free(kind);
-    if (!svg) {
+    if (jr == SVG_JOB_NOT_FOUND) return not_found(c, r, id);
+    if (jr == SVG_JOB_NOT_READY) return not_ready(c, r, id, st);
+    if (jr == SVG_JOB_STORE_ERROR) return send_store_error(c, r);
+    if (jr != SVG_JOB_OK) {
         if (status < 400 || status > 599) status = 500;
         return send_error(c, r, (unsigned)status,
                           status == 400 ? "invalid_parameter"
@@ -630,8 +632,7 @@ static enum MHD_Result h_svg(struct MHD_Connection *c, req *r, const char *id)
                                           : "internal",
                           NULL, "%s", err[0] ? err : "cannot render this view");
     }
-    return send_buf(c, r, 200, "image/svg+xml", svg, len ? len : strlen(svg),
-                    MHD_RESPMEM_MUST_FREE, NULL);
+    return send_stream(c, r, "image/svg+xml", MHD_SIZE_UNKNOWN, read_svg, sj, free_svg, NULL);
 #else
     (void)in_list;
     free(kind);

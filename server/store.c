@@ -16,6 +16,8 @@
 
 #include <sqlite3.h>
 
+#include "json_scan.h"
+
 /* ------------------------------------------------------------------ logging */
 
 volatile int gpd_log_threshold = GPD_LOG_INFO;
@@ -155,7 +157,11 @@ static const char *SCHEMA_SQL =
     "CREATE INDEX IF NOT EXISTS jobs_status_seq ON jobs(status, seq);"
     /* the export pack of a succeeded job (core/gp_export.h), keyed by the job's seq so that
      * it can be read with incremental blob I/O */
-    "CREATE TABLE IF NOT EXISTS exports(seq INTEGER PRIMARY KEY, pack BLOB NOT NULL);";
+    "CREATE TABLE IF NOT EXISTS exports(seq INTEGER PRIMARY KEY, pack BLOB NOT NULL);"
+    /* the summary of a succeeded job's result (store_get_summary), committed with it; a
+     * table of its own so that databases written before it need no migration */
+    "CREATE TABLE IF NOT EXISTS summaries(seq INTEGER PRIMARY KEY, summary TEXT NOT NULL,"
+    " arrays TEXT);";
 
 static sqlite3 *conn_open(void)
 {
@@ -689,6 +695,43 @@ store_rc store_progress(const char *id, const char *progress_json)
                           progress_json, NULL, NULL);
 }
 
+/* the arrays' spans as stored: {"grains":[off,end],...} for the members present */
+static char *spans_text(uint64_t spans[STORE_SUMMARY_NSKIP][2])
+{
+    static const char *const skip[] = STORE_SUMMARY_SKIP;
+    char *t = malloc(64 + STORE_SUMMARY_NSKIP * 64);
+    if (!t) return NULL;
+    size_t n = 0;
+    t[n++] = '{';
+    for (int k = 0; k < STORE_SUMMARY_NSKIP; k++)
+        if (spans[k][1] > spans[k][0])
+            n += (size_t)sprintf(t + n, "%s\"%s\":[%llu,%llu]", n > 1 ? "," : "", skip[k],
+                                 (unsigned long long)spans[k][0], (unsigned long long)spans[k][1]);
+    t[n++] = '}';
+    t[n] = 0;
+    return t;
+}
+
+/* reads spans_text(); 0 on success */
+static int spans_parse(const char *text, uint64_t spans[STORE_SUMMARY_NSKIP][2])
+{
+    static const char *const skip[] = STORE_SUMMARY_SKIP;
+    json_t *j = text ? json_loads(text, 0, NULL) : NULL;
+    if (!json_is_object(j)) {
+        json_decref(j);
+        return -1;
+    }
+    for (int k = 0; k < STORE_SUMMARY_NSKIP; k++) {
+        const json_t *a = json_object_get(j, skip[k]);
+        json_int_t o = json_integer_value(json_array_get(a, 0)),
+                   e = json_integer_value(json_array_get(a, 1));
+        spans[k][0] = o >= 0 && e > o ? (uint64_t)o : 0;
+        spans[k][1] = o >= 0 && e > o ? (uint64_t)e : 0;
+    }
+    json_decref(j);
+    return 0;
+}
+
 store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
                        const void *pack, size_t pack_len, char *why, size_t why_len)
 {
@@ -718,6 +761,20 @@ store_rc store_succeed(const char *id, const char *result_json, const char *prog
                  "(%lld bytes)",
                  is_pack ? "export pack" : "result", is_pack ? pack_len : rlen, lim);
         return STORE_TOOBIG;
+    }
+    /* the summary (the result without its per-item arrays), made before the write lock is
+     * taken; a result it cannot be made of (not an object, out of memory) is stored without
+     * one, and its readers fall back to scanning the result */
+    static const char *const skip[] = STORE_SUMMARY_SKIP;
+    js_source rsrc = js_memory_source(result_json, rlen);
+    size_t slen = 0;
+    uint64_t spans[STORE_SUMMARY_NSKIP][2];
+    char *summary = js_object_without(&rsrc, skip, &slen, spans);
+    char *arrays = summary ? spans_text(spans) : NULL;
+    if (!summary || !arrays) {
+        gpd_log(GPD_LOG_WARN, "job %s: no result summary (the views will scan the result)", id);
+        free(summary);
+        summary = NULL;
     }
     char now[40];
     gpd_now_rfc3339(now, sizeof now);
@@ -769,6 +826,28 @@ store_rc store_succeed(const char *id, const char *result_json, const char *prog
             done(x);
         }
     }
+    if (rc == STORE_OK && summary) {
+        rc = STORE_ERROR;
+        sqlite3_stmt *x = prep(db, "INSERT OR REPLACE INTO summaries(seq, summary, arrays) "
+                                   "SELECT seq, ?2, ?3 FROM jobs WHERE id=?1");
+        if (!x) {
+            src = sqlite3_errcode(db);
+        } else {
+            src = bind_text(x, 1, id);
+            if (src == SQLITE_OK)
+                src = sqlite3_bind_text64(x, 2, summary, (sqlite3_uint64)slen, SQLITE_STATIC,
+                                          SQLITE_UTF8);
+            if (src == SQLITE_OK) src = bind_text(x, 3, arrays);
+            if (src == SQLITE_OK) {
+                src = sqlite3_step(x);
+                if (src == SQLITE_DONE) {
+                    src = SQLITE_OK;
+                    rc = sqlite3_changes(db) == 1 ? STORE_OK : STORE_ERROR;
+                }
+            }
+            done(x);
+        }
+    }
     if (rc == STORE_OK) {
         src = sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
         if (src != SQLITE_OK) rc = STORE_ERROR;
@@ -785,6 +864,8 @@ store_rc store_succeed(const char *id, const char *result_json, const char *prog
     }
     if (!sqlite3_get_autocommit(db) && sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK)
         gpd_log(GPD_LOG_ERROR, "sqlite rollback: %s", sqlite3_errmsg(db));
+    free(summary);
+    free(arrays);
     return rc;
 }
 
@@ -902,6 +983,75 @@ void store_stream_close(store_stream *s)
     sqlite3_blob_close(s->blob);
     sqlite3_close_v2(s->db);
     free(s);
+}
+
+/* ------------------------------------------------------------------ summaries */
+
+static int stream_js_read(void *user, uint64_t off, void *dst, size_t n)
+{
+    return store_stream_read(user, off, dst, n);
+}
+
+store_rc store_get_summary(const char *id, char **text, size_t *len,
+                           uint64_t spans[STORE_SUMMARY_NSKIP][2], char status[16])
+{
+    *text = NULL;
+    if (len) *len = 0;
+    status[0] = 0;
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
+    sqlite3_stmt *st = prep(db, "SELECT j.status, s.summary, s.arrays FROM jobs j "
+                                "LEFT JOIN summaries s ON s.seq = j.seq WHERE j.id=?1");
+    if (!st) return STORE_ERROR;
+    bind_text(st, 1, id);
+    store_rc rc = STORE_ERROR;
+    int s = sqlite3_step(st);
+    if (s == SQLITE_ROW) {
+        const unsigned char *stt = sqlite3_column_text(st, 0);
+        snprintf(status, 16, "%s", stt ? (const char *)stt : "");
+        const unsigned char *t = sqlite3_column_text(st, 1);
+        rc = STORE_OK;
+        uint64_t sp[STORE_SUMMARY_NSKIP][2];
+        if (t && spans_parse((const char *)sqlite3_column_text(st, 2), sp) == 0) {
+            size_t n = (size_t)sqlite3_column_bytes(st, 1);
+            *text = malloc(n + 1);
+            if (*text) {
+                memcpy(*text, t, n + 1);
+                if (len) *len = n;
+                if (spans) memcpy(spans, sp, sizeof sp);
+            } else {
+                rc = STORE_ERROR;
+            }
+        }
+    } else if (s == SQLITE_DONE) {
+        rc = STORE_NOT_FOUND;
+    } else {
+        gpd_log(GPD_LOG_ERROR, "sqlite get summary: %s", sqlite3_errmsg(db));
+    }
+    done(st);
+    if (rc != STORE_OK || *text || strcmp(status, "succeeded")) return rc;
+
+    /* a job stored before summaries: scan its result (streamed when large) */
+    store_stream *ss = NULL;
+    char *small = NULL;
+    size_t small_len = 0;
+    char st2[16];
+    rc = store_stream_open(id, "result", 256u * 1024u, &ss, &small, &small_len, st2);
+    if (rc != STORE_OK) return rc;
+    if (!ss && !small) return STORE_OK; /* no result */
+    js_source src = small ? js_memory_source(small, small_len)
+                          : (js_source){stream_js_read, ss, store_stream_size(ss)};
+    static const char *const skip[] = STORE_SUMMARY_SKIP;
+    uint64_t sp[STORE_SUMMARY_NSKIP][2];
+    *text = js_object_without(&src, skip, len, sp);
+    if (*text && spans) memcpy(spans, sp, sizeof sp);
+    free(small);
+    store_stream_close(ss);
+    if (!*text) {
+        gpd_log(GPD_LOG_ERROR, "job %s: cannot make the summary of its stored result", id);
+        return STORE_ERROR;
+    }
+    return STORE_OK;
 }
 
 store_rc store_fail(const char *id, const char *code, const char *message)

@@ -14,7 +14,10 @@
  *                                                  status='succeeded' (durable before it shows)
  *   attempts    INTEGER NOT NULL DEFAULT 0         times a worker claimed the job
  * and exports(seq INTEGER PRIMARY KEY = jobs.seq, pack BLOB NOT NULL): the export pack of a
- * succeeded job (core/gp_export.h), committed with the result.
+ * succeeded job (core/gp_export.h), committed with the result;
+ * and summaries(seq INTEGER PRIMARY KEY = jobs.seq, summary TEXT NOT NULL, arrays TEXT): the
+ * result's summary and where its arrays are in its text (store_get_summary), committed with
+ * the result.
  *
  * Connections: one per thread (opened lazily, closed when the thread exits or on
  * store_close()); every write is a single statement or an IMMEDIATE transaction, so claims and
@@ -107,8 +110,9 @@ store_rc store_progress(const char *id, const char *progress_json);
 
 /* Final transitions of a running job (no-ops returning STORE_CONFLICT when it is no longer
  * running, e.g. cancelled by DELETE).
- * store_succeed commits the result (non-NULL), the pack (may be NULL) and status 'succeeded'
- * in one transaction, or nothing: every SQLite code is checked and a failure rolls it all
+ * store_succeed commits the result (non-NULL), the pack (may be NULL), the result's summary
+ * (store_get_summary; made here from the result text, left out when it cannot be made) and
+ * status 'succeeded' in one transaction, or nothing: every SQLite code is checked and a failure rolls it all
  * back, leaving the job running. STORE_TOOBIG: the result or the pack is larger than the
  * database can store (SQLite's length limit, 1e9 bytes by default), so it never will be;
  * STORE_ERROR: anything else (disk full, I/O error, a failed commit...), which may pass on a
@@ -138,5 +142,24 @@ uint64_t store_stream_size(const store_stream *s);
 /* Reads n bytes at off; 0 on success. */
 int store_stream_read(store_stream *s, uint64_t off, void *dst, size_t n);
 void store_stream_close(store_stream *s);
+
+/* ---- the summary of a result: what pictures and a result panel read ---- */
+
+/* The members a summary leaves out: a result's per-item arrays, its bulk. */
+#define STORE_SUMMARY_SKIP {"grains", "cells", "spheres", "contacts", NULL}
+#define STORE_SUMMARY_NSKIP 4
+
+/* The summary of job id's result: the result object without STORE_SUMMARY_SKIP's members --
+ * kind, seed, outputs, container or box, stats, warnings, timings..., a few KB -- as JSON text
+ * (*text malloc'ed, *len bytes; len may be NULL), with the job's status; and, when spans is
+ * not NULL, where the left-out arrays are in the stored result text: spans[k] = [off, end) of
+ * the value of STORE_SUMMARY_SKIP[k] ({0, 0} when the result has none), for reading one of
+ * them element by element (store_stream_open(id, "result", ...)) without a scan.
+ * store_succeed stores both with the result (table summaries: summary, arrays); for a result
+ * stored before summaries existed they are made by scanning the stored result (streamed: time
+ * in the result's size, memory in the summary's). *text NULL when the job has no result (not
+ * succeeded). STORE_NOT_FOUND for an unknown id. */
+store_rc store_get_summary(const char *id, char **text, size_t *len,
+                           uint64_t spans[STORE_SUMMARY_NSKIP][2], char status[16]);
 
 #endif /* GPD_STORE_H */

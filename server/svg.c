@@ -13,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gp_export_internal.h" /* the pack's record readers (gp_xr_grain, gp_xr_point, ...) */
+
 #define KIND_2D "fourier-voronoi-2d"
 #define KIND_3D "spheres-3d"
 #define VIEWS_2D "packing, cells, size, orientation, descriptors"
@@ -74,6 +76,45 @@ static void sb_puts(sb *s, const char *str)
     if (s->oom) return;
     memcpy(s->buf + s->len, str, n + 1);
     s->len += n;
+}
+
+/* printf's "%.1f" of v, quickly (the points of a large picture are most of its time): the
+ * rounding is done on v * 10 unless that lies within 1e-6 of a half, where snprintf decides
+ * (its exact decimal rounding), so the text is always printf's. buf has F1_MAX bytes; returns
+ * the length. */
+#define F1_MAX 320 /* "%.1f" of -DBL_MAX is 312 bytes */
+static int fmt_f1(char *buf, double v)
+{
+    double t = v * 10.0;
+    if (!(fabs(t) < 1e15)) return snprintf(buf, F1_MAX, "%.1f", v);
+    double fl = floor(t), fr = t - fl;
+    if (fabs(fr - 0.5) < 1e-6) return snprintf(buf, F1_MAX, "%.1f", v);
+    long long q = (long long)fl + (fr > 0.5);
+    int neg = signbit(v) != 0;
+    unsigned long long a = (unsigned long long)(q < 0 ? -q : q);
+    char tmp[24];
+    int n = 0;
+    tmp[n++] = (char)('0' + a % 10);
+    tmp[n++] = '.';
+    a /= 10;
+    do {
+        tmp[n++] = (char)('0' + a % 10);
+        a /= 10;
+    } while (a);
+    int k = 0;
+    if (neg) buf[k++] = '-';
+    while (n) buf[k++] = tmp[--n];
+    buf[k] = 0;
+    return k;
+}
+
+static void sb_mem(sb *s, const char *p, size_t n)
+{
+    sb_grow(s, n);
+    if (s->oom) return;
+    memcpy(s->buf + s->len, p, n);
+    s->len += n;
+    s->buf[s->len] = 0;
 }
 
 /* text content with XML escaping */
@@ -352,6 +393,11 @@ static void bounds_ring(bounds *b, const json_t *ring)
     }
 }
 
+static void bounds_xy(bounds *b, const double *xy, size_t n)
+{
+    for (size_t i = 0; i < n; i++) bounds_add(b, xy[2 * i], xy[2 * i + 1]);
+}
+
 static int bounds_ok(const bounds *b) { return b->xmax >= b->xmin && b->ymax >= b->ymin; }
 
 /* a map frame with equal scales on both axes, fitting width px */
@@ -388,28 +434,51 @@ static frame map_frame(bounds b, int width, int *height)
     return f;
 }
 
-/* "x,y x,y ..." of a ring, decimated to min_px; returns points written */
-static size_t ring_points(sb *s, const frame *f, const json_t *ring, double min_px)
+/* "x,y x,y ..." of a ring of n points (xy: x0 y0 x1 y1 ...), decimated to min_px (a point
+ * within min_px of the last one written, in both directions, is dropped, but a ring keeps at
+ * least 3 points); returns points written */
+static size_t ring_points_xy(sb *s, const frame *f, const double *xy, size_t n, double min_px)
 {
-    size_t n = json_array_size(ring), written = 0;
+    size_t written = 0;
     double lx = NAN, ly = NAN;
-    double fx0 = NAN, fy0 = NAN;
     for (size_t i = 0; i < n; i++) {
-        const json_t *p = json_array_get(ring, i);
-        double x = fx(f, jnum(json_array_get(p, 0), NAN)), y = fy(f, jnum(json_array_get(p, 1), NAN));
+        double x = fx(f, xy[2 * i]), y = fy(f, xy[2 * i + 1]);
         if (!isfinite(x) || !isfinite(y)) continue;
         int last = i + 1 == n;
         if (written && !last && fabs(x - lx) < min_px && fabs(y - ly) < min_px) continue;
         if (written && last && fabs(x - lx) < min_px && fabs(y - ly) < min_px && written >= 3) continue;
-        sb_printf(s, "%s%.1f,%.1f", written ? " " : "", x, y);
-        if (!written) fx0 = x, fy0 = y;
+        char pt[2 * F1_MAX + 4];
+        int k = 0;
+        if (written) pt[k++] = ' ';
+        k += fmt_f1(pt + k, x);
+        pt[k++] = ',';
+        k += fmt_f1(pt + k, y);
+        sb_mem(s, pt, (size_t)k);
         lx = x;
         ly = y;
         written++;
     }
-    (void)fx0;
-    (void)fy0;
     return written;
+}
+
+/* the same for a JSON ring [[x,y],...] */
+static size_t ring_points(sb *s, const frame *f, const json_t *ring, double min_px)
+{
+    size_t n = json_array_size(ring);
+    if (!n) return 0;
+    double *xy = malloc(2 * n * sizeof *xy);
+    if (!xy) {
+        s->oom = 1;
+        return 0;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const json_t *p = json_array_get(ring, i);
+        xy[2 * i] = jnum(json_array_get(p, 0), NAN);
+        xy[2 * i + 1] = jnum(json_array_get(p, 1), NAN);
+    }
+    size_t w = ring_points_xy(s, f, xy, n, min_px);
+    free(xy);
+    return w;
 }
 
 /* the container outline (from result.container), as a path */
@@ -503,39 +572,606 @@ static char *finish(sb *s, size_t *len, int *status, char *errbuf, size_t errlen
 }
 
 /* ------------------------------------------------------------------------------------------ */
+/* item sources (svg.h): the geometry of a result, one item at a time */
+
+static const char *const PART_NAME[3] = {"grains", "cells", "spheres"};
+static const char *const DESC_NAME[4] = {"elongation", "roundness", "circularity", "regularity"};
+
+/* the current item; a number that is absent (or null, or not finite) is NaN */
+typedef struct item {
+    double *xy;               /* grains: the contour; cells: the polygons, one after the other */
+    size_t npts, cap;         /* points in xy, room in xy (points) */
+    size_t *rings;            /* cells: points of each polygon */
+    size_t nrings, rcap;
+    double area, orientation_deg, desc[4], seed[2];
+    double q[4];              /* spheres: x, y, z, r */
+} item;
+
+struct gp_svg_items {
+    gp_svg_part part;
+    int (*rewind)(gp_svg_items *it);
+    int (*next)(gp_svg_items *it); /* 1: an item in cur, 0: the end, -1: failed */
+    item cur;
+    const json_t *arr;  /* json */
+    size_t idx;
+    js_scan *js;        /* scan */
+    uint64_t off;
+    gp_export *e, *ep;  /* pack: its grain or sphere records, its contour points (a reader of
+                         * its own, so that both are read in order, each through its cache) */
+    uint64_t k;
+};
+
+static int pts_room(item *c, size_t n)
+{
+    if (n <= c->cap) return 0;
+    size_t cap = c->cap ? c->cap : 256;
+    while (cap < n) cap *= 2;
+    double *xy = realloc(c->xy, 2 * cap * sizeof *xy);
+    if (!xy) return -1;
+    c->xy = xy;
+    c->cap = cap;
+    return 0;
+}
+
+static void item_clear(item *c)
+{
+    c->npts = c->nrings = 0;
+    c->area = c->orientation_deg = NAN;
+    for (int k = 0; k < 4; k++) c->desc[k] = c->q[k] = NAN;
+    c->seed[0] = c->seed[1] = NAN;
+}
+
+/* appends the points of a JSON ring; -1 on out of memory */
+static int item_ring(item *c, const json_t *ring)
+{
+    size_t n = json_array_size(ring);
+    if (pts_room(c, c->npts + n)) return -1;
+    for (size_t i = 0; i < n; i++) {
+        const json_t *p = json_array_get(ring, i);
+        c->xy[2 * (c->npts + i)] = jnum(json_array_get(p, 0), NAN);
+        c->xy[2 * (c->npts + i) + 1] = jnum(json_array_get(p, 1), NAN);
+    }
+    c->npts += n;
+    return 0;
+}
+
+/* one element of a result array (as api.md writes it) into the item; -1 on out of memory */
+static int item_from_json(gp_svg_part part, item *c, const json_t *e)
+{
+    item_clear(c);
+    if (part == GP_SVG_SPHERES) {
+        for (int a = 0; a < 4; a++) c->q[a] = jnum(json_array_get(e, (size_t)a), NAN);
+        return 0;
+    }
+    c->area = jnum(json_object_get(e, "area"), NAN);
+    c->orientation_deg = jnum(json_object_get(e, "orientation_deg"), NAN);
+    if (part == GP_SVG_GRAINS) {
+        const json_t *d = json_object_get(e, "descriptors");
+        for (int k = 0; k < 4; k++) c->desc[k] = jnum(json_object_get(d, DESC_NAME[k]), NAN);
+        return item_ring(c, json_object_get(e, "contour"));
+    }
+    const json_t *sd = json_object_get(e, "seed");
+    c->seed[0] = jnum(json_array_get(sd, 0), NAN);
+    c->seed[1] = jnum(json_array_get(sd, 1), NAN);
+    const json_t *polys = json_object_get(e, "polygons");
+    size_t np = json_array_size(polys);
+    if (np > c->rcap) {
+        size_t *r = realloc(c->rings, np * sizeof *r);
+        if (!r) return -1;
+        c->rings = r;
+        c->rcap = np;
+    }
+    for (size_t j = 0; j < np; j++) {
+        size_t before = c->npts;
+        if (item_ring(c, json_array_get(polys, j))) return -1;
+        c->rings[c->nrings++] = c->npts - before;
+    }
+    return 0;
+}
+
+static gp_svg_items *items_new(gp_svg_part part)
+{
+    if ((unsigned)part > GP_SVG_SPHERES) return NULL;
+    gp_svg_items *it = calloc(1, sizeof *it);
+    if (it) it->part = part;
+    return it;
+}
+
+void gp_svg_items_close(gp_svg_items *it)
+{
+    if (!it) return;
+    js_close(it->js);
+    gp_export_destroy(it->e);
+    gp_export_destroy(it->ep);
+    free(it->cur.xy);
+    free(it->cur.rings);
+    free(it);
+}
+
+/* -- in memory */
+static int json_rewind(gp_svg_items *it)
+{
+    it->idx = 0;
+    return 0;
+}
+
+static int json_next(gp_svg_items *it)
+{
+    if (it->idx >= json_array_size(it->arr)) return 0;
+    return item_from_json(it->part, &it->cur, json_array_get(it->arr, it->idx++)) ? -1 : 1;
+}
+
+gp_svg_items *gp_svg_items_json(const json_t *array, gp_svg_part part)
+{
+    if (!json_is_array(array)) return NULL;
+    gp_svg_items *it = items_new(part);
+    if (!it) return NULL;
+    it->arr = array;
+    it->rewind = json_rewind;
+    it->next = json_next;
+    return it;
+}
+
+/* -- an element's text read straight into the item (the scan source): the same values as
+ * item_from_json() gives for the parsed element, without building a JSON tree (three times
+ * faster on cells, which are read in three passes). A number is read with strtod (the C
+ * locale: the daemon never sets another), null and any other value where a number belongs
+ * give NaN, unknown members are skipped. -1 on text that is not JSON. */
+typedef struct pp {
+    const char *p, *e;
+} pp;
+
+static void pp_ws(pp *q)
+{
+    while (q->p < q->e && (*q->p == ' ' || *q->p == '\n' || *q->p == '\r' || *q->p == '\t')) q->p++;
+}
+
+/* passes over one value of any type */
+static int pp_skip(pp *q)
+{
+    pp_ws(q);
+    if (q->p >= q->e) return -1;
+    char c = *q->p;
+    if (c == '"' || c == '[' || c == '{') {
+        int depth = 0, in_str = 0;
+        for (; q->p < q->e; q->p++) {
+            char ch = *q->p;
+            if (in_str) {
+                if (ch == '\\') q->p++;
+                else if (ch == '"') {
+                    in_str = 0;
+                    if (depth == 0) {
+                        q->p++;
+                        return 0;
+                    }
+                }
+            } else if (ch == '"') in_str = 1;
+            else if (ch == '[' || ch == '{') depth++;
+            else if ((ch == ']' || ch == '}') && --depth == 0) {
+                q->p++;
+                return 0;
+            }
+        }
+        return -1;
+    }
+    const char *s = q->p;
+    while (q->p < q->e && !strchr(" \n\r\t,]}:", *q->p)) q->p++;
+    return q->p > s ? 0 : -1;
+}
+
+/* a number (or NaN for null or any other value) */
+static int pp_num(pp *q, double *v)
+{
+    pp_ws(q);
+    *v = NAN;
+    if (q->p >= q->e) return -1;
+    char c = *q->p;
+    if (c == '-' || (c >= '0' && c <= '9')) {
+        char *end;
+        double x = strtod(q->p, &end);
+        if (end == q->p || end > q->e) return -1;
+        q->p = end;
+        *v = x;
+        return 0;
+    }
+    return pp_skip(q);
+}
+
+/* the next element of an array whose '[' was passed: 1 (q at the element), 0 after ']', -1 */
+static int pp_next(pp *q, int *first)
+{
+    pp_ws(q);
+    if (q->p >= q->e) return -1;
+    if (*q->p == ']') {
+        q->p++;
+        return 0;
+    }
+    if (!*first) {
+        if (*q->p != ',') return -1;
+        q->p++;
+        pp_ws(q);
+    }
+    *first = 0;
+    return 1;
+}
+
+/* 1 and past '[' when an array starts here */
+static int pp_open(pp *q, char bracket)
+{
+    pp_ws(q);
+    if (q->p < q->e && *q->p == bracket) {
+        q->p++;
+        return 1;
+    }
+    return 0;
+}
+
+/* up to n numbers of an array (NaN for the missing ones and for a value that is no array) */
+static int pp_nums(pp *q, double *v, int n)
+{
+    for (int i = 0; i < n; i++) v[i] = NAN;
+    if (!pp_open(q, '[')) return pp_skip(q);
+    int first = 1, r, i = 0;
+    while ((r = pp_next(q, &first)) > 0) {
+        double x;
+        if (pp_num(q, &x)) return -1;
+        if (i < n) v[i] = x;
+        i++;
+    }
+    return r;
+}
+
+/* a ring [[x,y],...] appended to the item's points (no points when it is no array) */
+static int pp_ring(pp *q, item *c)
+{
+    if (!pp_open(q, '[')) return pp_skip(q);
+    int first = 1, r;
+    while ((r = pp_next(q, &first)) > 0) {
+        if (pts_room(c, c->npts + 1)) return -1;
+        if (pp_nums(q, c->xy + 2 * c->npts, 2)) return -1;
+        c->npts++;
+    }
+    return r;
+}
+
+/* the next member of an object whose '{' was passed: 1 with its key (escapes kept) and q at
+ * its value, 0 after '}', -1 */
+static int pp_member(pp *q, int *first, const char **key, size_t *klen)
+{
+    pp_ws(q);
+    if (q->p >= q->e) return -1;
+    if (*q->p == '}') {
+        q->p++;
+        return 0;
+    }
+    if (!*first) {
+        if (*q->p != ',') return -1;
+        q->p++;
+        pp_ws(q);
+    }
+    *first = 0;
+    if (q->p >= q->e || *q->p != '"') return -1;
+    const char *k = ++q->p;
+    while (q->p < q->e && *q->p != '"') q->p += *q->p == '\\' ? 2 : 1;
+    if (q->p >= q->e) return -1;
+    *key = k;
+    *klen = (size_t)(q->p - k);
+    q->p++;
+    pp_ws(q);
+    if (q->p >= q->e || *q->p != ':') return -1;
+    q->p++;
+    return 1;
+}
+
+static int key_is(const char *k, size_t n, const char *name)
+{
+    return strlen(name) == n && !memcmp(k, name, n);
+}
+
+static int item_parse(gp_svg_part part, item *c, const char *text, size_t len)
+{
+    item_clear(c);
+    pp q = {text, text + len};
+    if (part == GP_SVG_SPHERES) return pp_nums(&q, c->q, 4);
+    if (!pp_open(&q, '{')) return pp_skip(&q);
+    int first = 1, r;
+    const char *k;
+    size_t kl;
+    while ((r = pp_member(&q, &first, &k, &kl)) > 0) {
+        int rc;
+        if (key_is(k, kl, "area")) rc = pp_num(&q, &c->area);
+        else if (key_is(k, kl, "orientation_deg")) rc = pp_num(&q, &c->orientation_deg);
+        else if (part == GP_SVG_GRAINS && key_is(k, kl, "contour")) {
+            c->npts = 0;
+            rc = pp_ring(&q, c);
+        } else if (part == GP_SVG_GRAINS && key_is(k, kl, "descriptors")) {
+            for (int j = 0; j < 4; j++) c->desc[j] = NAN;
+            if (!pp_open(&q, '{')) {
+                rc = pp_skip(&q);
+            } else {
+                int f2 = 1, r2;
+                const char *k2;
+                size_t kl2;
+                while ((r2 = pp_member(&q, &f2, &k2, &kl2)) > 0) {
+                    int j = 0;
+                    while (j < 4 && !key_is(k2, kl2, DESC_NAME[j])) j++;
+                    if (j < 4 ? pp_num(&q, &c->desc[j]) : pp_skip(&q)) return -1;
+                }
+                rc = r2;
+            }
+        } else if (part == GP_SVG_CELLS && key_is(k, kl, "seed")) {
+            rc = pp_nums(&q, c->seed, 2);
+        } else if (part == GP_SVG_CELLS && key_is(k, kl, "polygons")) {
+            c->npts = c->nrings = 0;
+            if (!pp_open(&q, '[')) {
+                rc = pp_skip(&q);
+            } else {
+                int f2 = 1, r2;
+                while ((r2 = pp_next(&q, &f2)) > 0) {
+                    if (c->nrings == c->rcap) {
+                        size_t nc = c->rcap ? 2 * c->rcap : 8;
+                        size_t *nr = realloc(c->rings, nc * sizeof *nr);
+                        if (!nr) return -1;
+                        c->rings = nr;
+                        c->rcap = nc;
+                    }
+                    size_t before = c->npts;
+                    if (pp_ring(&q, c)) return -1;
+                    c->rings[c->nrings++] = c->npts - before;
+                }
+                rc = r2;
+            }
+        } else {
+            rc = pp_skip(&q);
+        }
+        if (rc) return -1;
+    }
+    return r;
+}
+
+/* -- an array of a JSON text, element by element */
+static int scan_rewind(gp_svg_items *it)
+{
+    return js_array_begin(it->js, it->off);
+}
+
+static int scan_next(gp_svg_items *it)
+{
+    uint64_t a, b;
+    int r = js_array_next(it->js, &a, &b);
+    if (r <= 0) return r;
+    const char *t = js_span(it->js, a, b);
+    if (!t) return -1;
+    return item_parse(it->part, &it->cur, t, (size_t)(b - a)) ? -1 : 1;
+}
+
+gp_svg_items *gp_svg_items_scan(const js_source *text, uint64_t off, gp_svg_part part)
+{
+    gp_svg_items *it = items_new(part);
+    if (!it) return NULL;
+    it->js = js_open(text);
+    if (!it->js) {
+        gp_svg_items_close(it);
+        return NULL;
+    }
+    it->off = off;
+    it->rewind = scan_rewind;
+    it->next = scan_next;
+    return it;
+}
+
+/* -- an export pack */
+static int pack_rewind(gp_svg_items *it)
+{
+    it->k = 0;
+    return 0;
+}
+
+static int pack_next(gp_svg_items *it)
+{
+    gp_export *e = it->e;
+    item *c = &it->cur;
+    if (it->k >= e->nitems) return 0;
+    uint64_t k = it->k++;
+    item_clear(c);
+    if (it->part == GP_SVG_SPHERES) {
+        if (gp_xr_sphere(e, k, c->q)) return -1;
+        return 1;
+    }
+    gp_xgrain g;
+    if (gp_xr_grain(e, k, &g) || pts_room(c, (size_t)g.point_count)) return -1;
+    for (uint64_t i = 0; i < g.point_count; i++)
+        if (gp_xr_point(it->ep, g.point_first + i, c->xy + 2 * i)) return -1;
+    c->npts = (size_t)g.point_count;
+    c->area = g.area;
+    c->orientation_deg = g.orientation_deg;
+    c->desc[0] = g.elongation;
+    c->desc[1] = g.roundness;
+    c->desc[2] = g.circularity;
+    c->desc[3] = g.regularity;
+    /* the pack keeps raw doubles; the JSON result writes a non-finite one as null */
+    if (!isfinite(c->area)) c->area = NAN;
+    if (!isfinite(c->orientation_deg)) c->orientation_deg = NAN;
+    for (int j = 0; j < 4; j++)
+        if (!isfinite(c->desc[j])) c->desc[j] = NAN;
+    for (size_t i = 0; i < 2 * c->npts; i++)
+        if (!isfinite(c->xy[i])) c->xy[i] = NAN;
+    return 1;
+}
+
+gp_svg_items *gp_svg_items_pack(const gp_export_source *pack, gp_svg_part part)
+{
+    if (part == GP_SVG_CELLS) return NULL;
+    gp_svg_items *it = items_new(part);
+    if (!it) return NULL;
+    gp_error err;
+    /* any format opens the pack and checks its header; only the record readers are used */
+    if (gp_export_open(GP_EXPORT_CSV, pack, &it->e, &err) ||
+        it->e->dim != (part == GP_SVG_SPHERES ? 3 : 2) ||
+        (part == GP_SVG_GRAINS && gp_export_open(GP_EXPORT_CSV, pack, &it->ep, &err))) {
+        gp_svg_items_close(it);
+        return NULL;
+    }
+    it->rewind = pack_rewind;
+    it->next = pack_next;
+    return it;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* the rendering stream */
+
+#define STEP_BYTES (16u * 1024u) /* a step stages about this much of the document */
+
+struct gp_svg {
+    sb out;                    /* staged text; out.buf[pos..len) not handed out yet */
+    size_t pos;
+    int (*step)(gp_svg *g);    /* stages the next part: 0 more, 1 that was the last, -1 failed;
+                                * NULL once everything is staged */
+    char err[200];
+    /* the geometry views */
+    gp_svg_items *items;
+    int section;
+    frame f;
+    int by_orient, logscale;
+    double amin, amax, min_px, z, dmin, dmax, scale, seed_r;
+    sb mid, tail;              /* between the two loops (cells), after the last one */
+};
+
+static gp_svg_items *open_items(const gp_svg_input *in, gp_svg_part part, int *failed)
+{
+    *failed = 0;
+    if (in->open) return in->open(in->user, part, failed);
+    const json_t *a = json_object_get(in->summary, PART_NAME[part]);
+    gp_svg_items *it = gp_svg_items_json(a, part);
+    if (!it && json_is_array(a)) *failed = 1;
+    return it;
+}
+
+/* a pass over the items begins; -1 (with the message) when the source cannot go back */
+static int pass_begin(gp_svg *g)
+{
+    if (g->items->rewind(g->items) == 0) return 0;
+    snprintf(g->err, sizeof g->err, "reading the %s failed", PART_NAME[g->items->part]);
+    return -1;
+}
+
+static int pass_failed(gp_svg *g)
+{
+    snprintf(g->err, sizeof g->err, "reading the %s failed", PART_NAME[g->items->part]);
+    return -1;
+}
+
+/* values of one field of a part's items (NaN ones left out); NULL when none. field: 0 area,
+ * 1 orientation, 2..5 the descriptors. *failed when the items could not be read. */
+static double *collect_items(const gp_svg_input *in, gp_svg_part part, int field, size_t *n,
+                             int *failed)
+{
+    *n = 0;
+    gp_svg_items *it = open_items(in, part, failed);
+    if (!it) return NULL;
+    size_t cap = 0;
+    double *v = NULL;
+    int r;
+    if (it->rewind(it)) r = -1;
+    else
+        while ((r = it->next(it)) > 0) {
+            const item *c = &it->cur;
+            double x = field == 0 ? c->area : field == 1 ? c->orientation_deg : c->desc[field - 2];
+            if (isnan(x)) continue;
+            if (*n == cap) {
+                size_t nc = cap ? 2 * cap : 1024;
+                double *nv = realloc(v, nc * sizeof *nv);
+                if (!nv) {
+                    r = -1;
+                    break;
+                }
+                v = nv;
+                cap = nc;
+            }
+            v[(*n)++] = x;
+        }
+    gp_svg_items_close(it);
+    if (r < 0) *failed = 1;
+    if (r < 0 || !*n) {
+        free(v);
+        *n = 0;
+        return NULL;
+    }
+    return v;
+}
+
+/* ------------------------------------------------------------------------------------------ */
 /* 2D views */
 
-static char *view_packing(const json_t *res, const gp_svg_options *opt, int width, size_t *len,
-                          int *status, char *eb, size_t el)
+/* the packing: grains coloured by area or orientation. Pass 1: bounds, area range, count;
+ * then the head; step_packing draws the grains and stages the tail. */
+static int step_packing(gp_svg *g)
 {
-    const json_t *grains = json_object_get(res, "grains");
+    size_t start = g->out.len;
+    int r = 1;
+    while (g->out.len - start < STEP_BYTES && (r = g->items->next(g->items)) > 0) {
+        const item *c = &g->items->cur;
+        char col[16];
+        if (g->by_orient) {
+            cyclic(isnan(c->orientation_deg) ? 0 : c->orientation_deg, col, sizeof col);
+        } else {
+            double a = isnan(c->area) ? g->amin : c->area, t;
+            if (g->amax > g->amin)
+                t = g->logscale ? log(a / g->amin) / log(g->amax / g->amin)
+                                : (a - g->amin) / (g->amax - g->amin);
+            else t = 0.5;
+            ramp(t, col, sizeof col);
+        }
+        sb_printf(&g->out, "<polygon fill=\"%s\" points=\"", col);
+        ring_points_xy(&g->out, &g->f, c->xy, c->npts, g->min_px);
+        sb_puts(&g->out, "\"/>\n");
+    }
+    if (r < 0) return pass_failed(g);
+    if (r > 0) return 0;
+    sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
+    return 1;
+}
+
+static int view_packing(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+                        int *status, char *eb, size_t el)
+{
+    const json_t *res = in->summary;
     const char *color = opt && opt->color && *opt->color ? opt->color : "size";
     int by_orient = !strcmp(color, "orientation");
     if (!by_orient && strcmp(color, "size") != 0) {
         seterr(eb, el, status, 400, "unknown color \"%s\"; valid: size, orientation", color);
-        return NULL;
+        return -1;
     }
-    if (!json_is_array(grains)) {
-        seterr(eb, el, status, 409, "view \"packing\" needs the grains: the spec did not ask for output \"grains\"");
-        return NULL;
+    int failed;
+    g->items = open_items(in, GP_SVG_GRAINS, &failed);
+    if (!g->items) {
+        if (failed) seterr(eb, el, status, 500, "cannot read the grains of the result");
+        else seterr(eb, el, status, 409, "view \"packing\" needs the grains: the spec did not ask for output \"grains\"");
+        return -1;
     }
     bounds b;
     bounds_init(&b);
     container_bounds(&b, json_object_get(res, "container"));
-    size_t i, ng = json_array_size(grains);
-    const json_t *g;
+    size_t ng = 0;
     double amin = INFINITY, amax = -INFINITY;
-    json_array_foreach(grains, i, g) {
-        bounds_ring(&b, json_object_get(g, "contour"));
-        double a = jnum(json_object_get(g, "area"), NAN);
-        if (a > 0) amin = fmin(amin, a), amax = fmax(amax, a);
+    int r = pass_begin(g);
+    if (r == 0)
+        while ((r = g->items->next(g->items)) > 0) {
+            const item *c = &g->items->cur;
+            ng++;
+            bounds_xy(&b, c->xy, c->npts);
+            if (c->area > 0) amin = fmin(amin, c->area), amax = fmax(amax, c->area);
+        }
+    if (r < 0) {
+        seterr(eb, el, status, 500, "cannot read the grains of the result");
+        return -1;
     }
     if (!bounds_ok(&b)) b.xmin = b.ymin = 0, b.xmax = b.ymax = 1;
     if (!(amax >= amin)) amin = amax = 1;
     int logscale = amax > 10 * amin;
     int height;
     frame f = map_frame(b, width, &height);
-    sb s = {0};
+    sb *s = &g->out;
     char title[160];
     const json_t *stats = json_object_get(res, "stats");
     const json_t *sfj = json_object_get(stats, "solid_fraction");
@@ -545,86 +1181,120 @@ static char *view_packing(const json_t *res, const gp_svg_options *opt, int widt
         snprintf(title, sizeof title, "Packing: %zu grains, solid fraction %.3f", ng, sf);
     else
         snprintf(title, sizeof title, "Packing: %zu grains", ng);
-    doc_begin(&s, width, height, title);
-    axes(&s, &f, "x (m)", "y (m)", 0);
-    double min_px = ng > 2000 ? 0.6 : 0.3;
-    sb_puts(&s, "<g class=\"grains\" stroke=\"#222222\" stroke-width=\"0.4\">\n");
-    json_array_foreach(grains, i, g) {
-        char c[16];
-        if (by_orient) {
-            cyclic(jnum(json_object_get(g, "orientation_deg"), 0), c, sizeof c);
-        } else {
-            double a = jnum(json_object_get(g, "area"), amin), t;
-            if (amax > amin)
-                t = logscale ? log(a / amin) / log(amax / amin) : (a - amin) / (amax - amin);
-            else t = 0.5;
-            ramp(t, c, sizeof c);
-        }
-        sb_printf(&s, "<polygon fill=\"%s\" points=\"", c);
-        ring_points(&s, &f, json_object_get(g, "contour"), min_px);
-        sb_puts(&s, "\"/>\n");
-    }
-    sb_puts(&s, "</g>\n");
-    container_outline(&s, &f, json_object_get(res, "container"));
+    doc_begin(s, width, height, title);
+    axes(s, &f, "x (m)", "y (m)", 0);
+    sb_puts(s, "<g class=\"grains\" stroke=\"#222222\" stroke-width=\"0.4\">\n");
+    sb_puts(&g->tail, "</g>\n");
+    container_outline(&g->tail, &f, json_object_get(res, "container"));
     double cbx = f.x0 + f.w + 20, cbh = fmin(f.h - 30, 300);
-    if (by_orient) colorbar(&s, cbx, f.y0 + 24, cbh, -90, 90, 1, 0, "orientation (deg)");
-    else colorbar(&s, cbx, f.y0 + 24, cbh, amin, amax, 0, logscale, "area (m²)");
-    doc_end(&s);
-    return finish(&s, len, status, eb, el);
+    if (by_orient) colorbar(&g->tail, cbx, f.y0 + 24, cbh, -90, 90, 1, 0, "orientation (deg)");
+    else colorbar(&g->tail, cbx, f.y0 + 24, cbh, amin, amax, 0, logscale, "area (m²)");
+    doc_end(&g->tail);
+    g->f = f;
+    g->by_orient = by_orient;
+    g->logscale = logscale;
+    g->amin = amin;
+    g->amax = amax;
+    g->min_px = ng > 2000 ? 0.6 : 0.3;
+    if (pass_begin(g)) {
+        seterr(eb, el, status, 500, "cannot read the grains of the result");
+        return -1;
+    }
+    g->step = step_packing;
+    return 0;
 }
 
-static char *view_cells(const json_t *res, int width, size_t *len, int *status, char *eb, size_t el)
+/* the cells and their seeds: pass 1 bounds, area range and count; the head; step_cells draws
+ * the polygons (section 0), then the seeds (section 1, a second pass), then the tail */
+static int step_cells(gp_svg *g)
 {
-    const json_t *cells = json_object_get(res, "cells");
-    if (!json_is_array(cells)) {
-        seterr(eb, el, status, 409, "view \"cells\" needs the cells: the spec did not ask for output \"cells\"");
-        return NULL;
+    size_t start = g->out.len;
+    int r = 1;
+    while (g->out.len - start < STEP_BYTES && (r = g->items->next(g->items)) > 0) {
+        const item *c = &g->items->cur;
+        if (g->section == 0) {
+            double a = isnan(c->area) ? g->amin : c->area;
+            char col[16];
+            ramp(g->amax > g->amin ? (a - g->amin) / (g->amax - g->amin) : 0.5, col, sizeof col);
+            for (size_t j = 0, k = 0; j < c->nrings; k += c->rings[j], j++) {
+                sb_printf(&g->out, "<polygon fill=\"%s\" points=\"", col);
+                ring_points_xy(&g->out, &g->f, c->xy + 2 * k, c->rings[j], g->min_px);
+                sb_puts(&g->out, "\"/>\n");
+            }
+        } else {
+            double x = c->seed[0], y = c->seed[1];
+            if (!isfinite(x) || !isfinite(y)) continue;
+            sb_printf(&g->out, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"%.1f\"/>\n", fx(&g->f, x),
+                      fy(&g->f, y), g->seed_r);
+        }
+    }
+    if (r < 0) return pass_failed(g);
+    if (r > 0) return 0;
+    if (g->section == 0) {
+        sb_puts(&g->out, g->mid.buf ? g->mid.buf : "");
+        g->section = 1;
+        return pass_begin(g);
+    }
+    sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
+    return 1;
+}
+
+static int view_cells(gp_svg *g, const gp_svg_input *in, int width, int *status, char *eb,
+                      size_t el)
+{
+    const json_t *res = in->summary;
+    int failed;
+    g->items = open_items(in, GP_SVG_CELLS, &failed);
+    if (!g->items) {
+        if (failed) seterr(eb, el, status, 500, "cannot read the cells of the result");
+        else seterr(eb, el, status, 409, "view \"cells\" needs the cells: the spec did not ask for output \"cells\"");
+        return -1;
     }
     bounds b;
     bounds_init(&b);
     container_bounds(&b, json_object_get(res, "container"));
-    size_t i, j, nc = json_array_size(cells);
-    const json_t *c, *poly;
+    size_t nc = 0;
     double amin = INFINITY, amax = -INFINITY;
-    json_array_foreach(cells, i, c) {
-        json_array_foreach(json_object_get(c, "polygons"), j, poly) bounds_ring(&b, poly);
-        double a = jnum(json_object_get(c, "area"), NAN);
-        if (a > 0) amin = fmin(amin, a), amax = fmax(amax, a);
+    int r = pass_begin(g);
+    if (r == 0)
+        while ((r = g->items->next(g->items)) > 0) {
+            const item *c = &g->items->cur;
+            nc++;
+            bounds_xy(&b, c->xy, c->npts);
+            if (c->area > 0) amin = fmin(amin, c->area), amax = fmax(amax, c->area);
+        }
+    if (r < 0) {
+        seterr(eb, el, status, 500, "cannot read the cells of the result");
+        return -1;
     }
     if (!bounds_ok(&b)) b.xmin = b.ymin = 0, b.xmax = b.ymax = 1;
     if (!(amax >= amin)) amin = amax = 1;
     int height;
     frame f = map_frame(b, width, &height);
-    sb s = {0};
+    sb *s = &g->out;
     char title[160];
     snprintf(title, sizeof title, "Voronoi cells: %zu cells and their seeds", nc);
-    doc_begin(&s, width, height, title);
-    axes(&s, &f, "x (m)", "y (m)", 0);
-    double min_px = nc > 2000 ? 0.6 : 0.3;
-    sb_puts(&s, "<g class=\"cells\" stroke=\"#333333\" stroke-width=\"0.5\" fill-opacity=\"0.55\">\n");
-    json_array_foreach(cells, i, c) {
-        double a = jnum(json_object_get(c, "area"), amin);
-        char col[16];
-        ramp(amax > amin ? (a - amin) / (amax - amin) : 0.5, col, sizeof col);
-        json_array_foreach(json_object_get(c, "polygons"), j, poly) {
-            sb_printf(&s, "<polygon fill=\"%s\" points=\"", col);
-            ring_points(&s, &f, poly, min_px);
-            sb_puts(&s, "\"/>\n");
-        }
+    doc_begin(s, width, height, title);
+    axes(s, &f, "x (m)", "y (m)", 0);
+    sb_puts(s, "<g class=\"cells\" stroke=\"#333333\" stroke-width=\"0.5\" fill-opacity=\"0.55\">\n");
+    sb_puts(&g->mid, "</g>\n<g class=\"seeds\" fill=\"#d62728\">\n");
+    sb_puts(&g->tail, "</g>\n");
+    container_outline(&g->tail, &f, json_object_get(res, "container"));
+    colorbar(&g->tail, f.x0 + f.w + 20, f.y0 + 24, fmin(f.h - 30, 300), amin, amax, 0, 0,
+             "cell area (m²)");
+    doc_end(&g->tail);
+    g->f = f;
+    g->amin = amin;
+    g->amax = amax;
+    g->min_px = nc > 2000 ? 0.6 : 0.3;
+    g->seed_r = nc > 2000 ? 0.8 : nc > 200 ? 1.5 : 2.5;
+    g->section = 0;
+    if (pass_begin(g)) {
+        seterr(eb, el, status, 500, "cannot read the cells of the result");
+        return -1;
     }
-    sb_puts(&s, "</g>\n<g class=\"seeds\" fill=\"#d62728\">\n");
-    double r = nc > 2000 ? 0.8 : nc > 200 ? 1.5 : 2.5;
-    json_array_foreach(cells, i, c) {
-        const json_t *sd = json_object_get(c, "seed");
-        double x = jnum(json_array_get(sd, 0), NAN), y = jnum(json_array_get(sd, 1), NAN);
-        if (!isfinite(x) || !isfinite(y)) continue;
-        sb_printf(&s, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"%.1f\"/>\n", fx(&f, x), fy(&f, y), r);
-    }
-    sb_puts(&s, "</g>\n");
-    container_outline(&s, &f, json_object_get(res, "container"));
-    colorbar(&s, f.x0 + f.w + 20, f.y0 + 24, fmin(f.h - 30, 300), amin, amax, 0, 0, "cell area (m²)");
-    doc_end(&s);
-    return finish(&s, len, status, eb, el);
+    g->step = step_cells;
+    return 0;
 }
 
 /* a histogram read from JSON or computed from values */
@@ -704,28 +1374,6 @@ static int hist_from_values(const double *v, size_t n, size_t k, double lo, doub
     return 0;
 }
 
-/* values of a numeric member of each element of arr (key2 for a nested object); NULL if none */
-static double *collect(const json_t *arr, const char *key, const char *key2, size_t *n)
-{
-    *n = 0;
-    size_t m = json_array_size(arr);
-    if (!m) return NULL;
-    double *v = malloc(m * sizeof *v);
-    if (!v) return NULL;
-    size_t i;
-    const json_t *e;
-    json_array_foreach(arr, i, e) {
-        const json_t *x = json_object_get(e, key);
-        if (key2) x = json_object_get(x, key2);
-        if (json_is_number(x)) v[(*n)++] = json_number_value(x);
-    }
-    if (!*n) {
-        free(v);
-        return NULL;
-    }
-    return v;
-}
-
 static void minmax(const double *v, size_t n, double *lo, double *hi)
 {
     *lo = INFINITY;
@@ -787,9 +1435,10 @@ static frame hist_frame(double x0, double y0, double w, double h, const hist *hs
 }
 
 /* the size view as histograms (results without stats.fit) */
-static char *view_size_hist(const json_t *res, int width, size_t *len, int *status, char *eb,
-                            size_t el)
+static char *view_size_hist(const gp_svg_input *in, int width, size_t *len, int *status,
+                            char *eb, size_t el)
 {
+    const json_t *res = in->summary;
     const json_t *stats = json_object_get(res, "stats");
     hist h;
     const char *what = "cell area (m²)";
@@ -805,13 +1454,15 @@ static char *view_size_hist(const json_t *res, int width, size_t *len, int *stat
         }
     } else {
         size_t n;
-        double *v = collect(json_object_get(res, "cells"), "area", NULL, &n);
-        if (!v) {
-            v = collect(json_object_get(res, "grains"), "area", NULL, &n);
+        int failed;
+        double *v = collect_items(in, GP_SVG_CELLS, 0, &n, &failed);
+        if (!v && !failed) {
+            v = collect_items(in, GP_SVG_GRAINS, 0, &n, &failed);
             what = "grain area (m²)";
         }
         if (!v) {
-            seterr(eb, el, status, 409, "view \"size\" needs stats.size_histogram, cells or grains in the result");
+            if (failed) seterr(eb, el, status, 500, "cannot read the cells or grains of the result");
+            else seterr(eb, el, status, 409, "view \"size\" needs stats.size_histogram, cells or grains in the result");
             return NULL;
         }
         double lo, hi;
@@ -1007,29 +1658,37 @@ static char *view_size_fit(const json_t *res, cdf_series *c, int nc, int width, 
 
 /* the size view: CDFs from stats.fit when the result has them, else histograms (results stored
  * before stats.fit, or without it) */
-static char *view_size(const json_t *res, int width, size_t *len, int *status, char *eb, size_t el)
+static char *view_size(const gp_svg_input *in, int width, size_t *len, int *status, char *eb,
+                       size_t el)
 {
+    const json_t *res = in->summary;
     const json_t *fit = json_object_get(json_object_get(res, "stats"), "fit");
     cdf_series c[2];
     int nc = 0;
     if (cdf_read(fit, "cell_area", "cells", "#1f77b4", &c[nc]) == 0) nc++;
     if (cdf_read(fit, "grain_area", "grains", "#ff7f0e", &c[nc]) == 0) nc++;
-    if (!nc) return view_size_hist(res, width, len, status, eb, el);
+    if (!nc) return view_size_hist(in, width, len, status, eb, el);
     char *svg = view_size_fit(res, c, nc, width, len, status, eb, el);
     for (int k = 0; k < nc; k++) cdf_free(&c[k]);
     return svg;
 }
 
-static char *view_orientation(const json_t *res, int width, size_t *len, int *status, char *eb,
-                              size_t el)
+static char *view_orientation(const gp_svg_input *in, int width, size_t *len, int *status,
+                              char *eb, size_t el)
 {
+    const json_t *res = in->summary;
     hist h;
     int have = hist_read(json_object_get(json_object_get(res, "stats"), "orientation_histogram"), &h) == 0;
     if (!have) {
         size_t n;
-        double *v = collect(json_object_get(res, "grains"), "orientation_deg", NULL, &n);
-        if (!v) v = collect(json_object_get(res, "cells"), "orientation_deg", NULL, &n);
+        int failed;
+        double *v = collect_items(in, GP_SVG_GRAINS, 1, &n, &failed);
+        if (!v && !failed) v = collect_items(in, GP_SVG_CELLS, 1, &n, &failed);
         if (!v) {
+            if (failed) {
+                seterr(eb, el, status, 500, "cannot read the grains or cells of the result");
+                return NULL;
+            }
             seterr(eb, el, status, 409, "view \"orientation\" needs stats.orientation_histogram, grains or cells in the result");
             return NULL;
         }
@@ -1112,12 +1771,11 @@ static char *view_orientation(const json_t *res, int width, size_t *len, int *st
     return finish(&s, len, status, eb, el);
 }
 
-static char *view_descriptors(const json_t *res, int width, size_t *len, int *status, char *eb,
-                              size_t el)
+static char *view_descriptors(const gp_svg_input *in, int width, size_t *len, int *status,
+                              char *eb, size_t el)
 {
-    static const char *names[4] = {"elongation", "roundness", "circularity", "regularity"};
-    const json_t *d = json_object_get(json_object_get(res, "stats"), "descriptors");
-    const json_t *grains = json_object_get(res, "grains");
+    const char *const *names = DESC_NAME;
+    const json_t *d = json_object_get(json_object_get(in->summary, "stats"), "descriptors");
     hist h[4];
     int ok = 1, any = 0;
     for (int k = 0; k < 4; k++) {
@@ -1126,7 +1784,9 @@ static char *view_descriptors(const json_t *res, int width, size_t *len, int *st
             continue;
         }
         size_t n;
-        double *v = collect(grains, "descriptors", names[k], &n);
+        int failed;
+        double *v = collect_items(in, GP_SVG_GRAINS, 2 + k, &n, &failed);
+        if (failed) ok = 0;
         if (v) {
             double lo, hi;
             minmax(v, n, &lo, &hi);
@@ -1140,7 +1800,7 @@ static char *view_descriptors(const json_t *res, int width, size_t *len, int *st
     }
     if (!any || !ok) {
         for (int k = 0; k < 4; k++) hist_free(&h[k]);
-        if (!ok) seterr(eb, el, status, 500, "out of memory");
+        if (!ok) seterr(eb, el, status, 500, "out of memory or the grains cannot be read");
         else seterr(eb, el, status, 409, "view \"descriptors\" needs the descriptors: the spec did not ask for output \"descriptors\"");
         return NULL;
     }
@@ -1179,91 +1839,141 @@ static char *view_descriptors(const json_t *res, int width, size_t *len, int *st
 /* ------------------------------------------------------------------------------------------ */
 /* 3D views */
 
-static char *view_section(const json_t *res, const gp_svg_options *opt, int width, size_t *len,
-                          int *status, char *eb, size_t el)
+/* the section at z: pass 1 diameter range, bounds (when the result has no box), count and the
+ * spheres cut (once z is known); the head; step_section draws the cut spheres, then the tail */
+static int step_section(gp_svg *g)
 {
-    const json_t *spheres = json_object_get(res, "spheres");
-    if (!json_is_array(spheres)) {
-        seterr(eb, el, status, 409, "view \"section\" needs the spheres: the spec did not ask for output \"spheres\"");
-        return NULL;
+    size_t start = g->out.len;
+    int r = 1;
+    while (g->out.len - start < STEP_BYTES && (r = g->items->next(g->items)) > 0) {
+        const double *q = g->items->cur.q;
+        double r_ = q[3], dz = q[2] - g->z;
+        if (!(r_ > 0) || !(fabs(dz) < r_)) continue;
+        double rc = sqrt(r_ * r_ - dz * dz);
+        char c[16];
+        double t = g->dmax > g->dmin
+                       ? (g->logscale ? log(2 * r_ / g->dmin) / log(g->dmax / g->dmin)
+                                      : (2 * r_ - g->dmin) / (g->dmax - g->dmin))
+                       : 0.5;
+        ramp(t, c, sizeof c);
+        sb_printf(&g->out, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"%s\"/>\n",
+                  fx(&g->f, isnan(q[0]) ? 0 : q[0]), fy(&g->f, isnan(q[1]) ? 0 : q[1]),
+                  rc * g->scale, c);
+    }
+    if (r < 0) return pass_failed(g);
+    if (r > 0) return 0;
+    sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
+    return 1;
+}
+
+static int view_section(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+                        int *status, char *eb, size_t el)
+{
+    const json_t *res = in->summary;
+    int failed;
+    g->items = open_items(in, GP_SVG_SPHERES, &failed);
+    if (!g->items) {
+        if (failed) seterr(eb, el, status, 500, "cannot read the spheres of the result");
+        else seterr(eb, el, status, 409, "view \"section\" needs the spheres: the spec did not ask for output \"spheres\"");
+        return -1;
     }
     double box[3] = {NAN, NAN, NAN}, lo[3] = {0, 0, 0};
     const json_t *jb = json_object_get(res, "box");
     int have_box = json_is_array(jb) && json_array_size(jb) == 3;
-    double dmin = INFINITY, dmax = -INFINITY;
-    double bl[3] = {INFINITY, INFINITY, INFINITY}, bh[3] = {-INFINITY, -INFINITY, -INFINITY};
-    size_t i;
-    const json_t *sp;
-    json_array_foreach(spheres, i, sp) {
-        double r = jnum(json_array_get(sp, 3), NAN);
-        if (!(r > 0)) continue;
-        dmin = fmin(dmin, 2 * r);
-        dmax = fmax(dmax, 2 * r);
-        for (int a = 0; a < 3; a++) {
-            double c = jnum(json_array_get(sp, a), NAN);
-            bl[a] = fmin(bl[a], c - r);
-            bh[a] = fmax(bh[a], c + r);
+    for (int a = 0; a < 3; a++) {
+        if (have_box) box[a] = jnum(json_array_get(jb, (size_t)a), NAN);
+        if (!(box[a] > 0)) have_box = 0;
+    }
+    /* z is known before the pass when the result has its box: check it, count the cut spheres
+     * in the same pass */
+    double z = have_box ? box[2] / 2 : NAN;
+    if (have_box && opt && opt->has_z) {
+        z = opt->z;
+        if (!isfinite(z) || z < 0 || z > box[2]) {
+            seterr(eb, el, status, 400, "z = %g is outside the box (z from %g to %g m)", z, 0.0,
+                   box[2]);
+            return -1;
         }
     }
-    for (int a = 0; a < 3; a++) {
-        if (have_box) box[a] = jnum(json_array_get(jb, a), NAN);
-        if (!(box[a] > 0)) {
-            have_box = 0;
+    double dmin = INFINITY, dmax = -INFINITY;
+    double bl[3] = {INFINITY, INFINITY, INFINITY}, bh[3] = {-INFINITY, -INFINITY, -INFINITY};
+    size_t n = 0, ncut = 0;
+    int r = pass_begin(g);
+    if (r == 0)
+        while ((r = g->items->next(g->items)) > 0) {
+            const double *q = g->items->cur.q;
+            n++;
+            double rr = q[3];
+            if (!(rr > 0)) continue;
+            if (fabs(q[2] - z) < rr) ncut++;
+            dmin = fmin(dmin, 2 * rr);
+            dmax = fmax(dmax, 2 * rr);
+            for (int a = 0; a < 3; a++) {
+                bl[a] = fmin(bl[a], q[a] - rr);
+                bh[a] = fmax(bh[a], q[a] + rr);
+            }
         }
+    if (r < 0) {
+        seterr(eb, el, status, 500, "cannot read the spheres of the result");
+        return -1;
     }
     if (!have_box) {
         for (int a = 0; a < 3; a++) {
             lo[a] = bh[a] >= bl[a] ? bl[a] : 0;
             box[a] = bh[a] >= bl[a] ? bh[a] - bl[a] : 1;
         }
-    }
-    double z = lo[2] + box[2] / 2;
-    if (opt && opt->has_z) {
-        z = opt->z;
-        if (!isfinite(z) || z < lo[2] || z > lo[2] + box[2]) {
-            seterr(eb, el, status, 400, "z = %g is outside the box (z from %g to %g m)", z, lo[2],
-                   lo[2] + box[2]);
-            return NULL;
+        z = lo[2] + box[2] / 2;
+        if (opt && opt->has_z) {
+            z = opt->z;
+            if (!isfinite(z) || z < lo[2] || z > lo[2] + box[2]) {
+                seterr(eb, el, status, 400, "z = %g is outside the box (z from %g to %g m)", z,
+                       lo[2], lo[2] + box[2]);
+                return -1;
+            }
+        }
+        /* a second pass counts the spheres cut */
+        r = pass_begin(g);
+        if (r == 0)
+            while ((r = g->items->next(g->items)) > 0) {
+                const double *q = g->items->cur.q;
+                if (q[3] > 0 && fabs(q[2] - z) < q[3]) ncut++;
+            }
+        if (r < 0) {
+            seterr(eb, el, status, 500, "cannot read the spheres of the result");
+            return -1;
         }
     }
     if (!(dmax >= dmin)) dmin = dmax = 1;
     bounds b = {lo[0], lo[0] + box[0], lo[1], lo[1] + box[1]};
     int height;
     frame f = map_frame(b, width, &height);
-    sb s = {0};
-    size_t ncut = 0;
-    json_array_foreach(spheres, i, sp) {
-        double r = jnum(json_array_get(sp, 3), NAN), dz = jnum(json_array_get(sp, 2), NAN) - z;
-        if (r > 0 && fabs(dz) < r) ncut++;
-    }
+    sb *s = &g->out;
     char title[200];
-    snprintf(title, sizeof title, "Section at z = %.4g m: %zu of %zu spheres cut", z, ncut,
-             json_array_size(spheres));
-    doc_begin(&s, width, height, title);
-    axes(&s, &f, "x (m)", "y (m)", 0);
-    sb_printf(&s, "<rect class=\"box\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#f4f4f4\" "
-                  "stroke=\"#000000\" stroke-width=\"1.5\"/>\n",
+    snprintf(title, sizeof title, "Section at z = %.4g m: %zu of %zu spheres cut", z, ncut, n);
+    doc_begin(s, width, height, title);
+    axes(s, &f, "x (m)", "y (m)", 0);
+    sb_printf(s, "<rect class=\"box\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#f4f4f4\" "
+                 "stroke=\"#000000\" stroke-width=\"1.5\"/>\n",
               fx(&f, b.xmin), fy(&f, b.ymax), fx(&f, b.xmax) - fx(&f, b.xmin), fy(&f, b.ymin) - fy(&f, b.ymax));
-    int logscale = dmax > 4 * dmin;
-    sb_puts(&s, "<g class=\"spheres\" stroke=\"#222222\" stroke-width=\"0.4\">\n");
-    double scale = f.w / (f.xmax - f.xmin);
-    json_array_foreach(spheres, i, sp) {
-        double r = jnum(json_array_get(sp, 3), NAN), dz = jnum(json_array_get(sp, 2), NAN) - z;
-        if (!(r > 0) || !(fabs(dz) < r)) continue;
-        double rc = sqrt(r * r - dz * dz);
-        char c[16];
-        double t = dmax > dmin ? (logscale ? log(2 * r / dmin) / log(dmax / dmin) : (2 * r - dmin) / (dmax - dmin)) : 0.5;
-        ramp(t, c, sizeof c);
-        sb_printf(&s, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"%s\"/>\n",
-                  fx(&f, jnum(json_array_get(sp, 0), 0)), fy(&f, jnum(json_array_get(sp, 1), 0)),
-                  rc * scale, c);
-    }
-    sb_puts(&s, "</g>\n");
+    sb_puts(s, "<g class=\"spheres\" stroke=\"#222222\" stroke-width=\"0.4\">\n");
+    sb_puts(&g->tail, "</g>\n");
     double k = dmax < 1 ? 1000 : 1;
-    colorbar(&s, f.x0 + f.w + 20, f.y0 + 24, fmin(f.h - 30, 300), dmin * k, dmax * k, 0, logscale,
-             k > 1 ? "diameter (mm)" : "diameter (m)");
-    doc_end(&s);
-    return finish(&s, len, status, eb, el);
+    int logscale = dmax > 4 * dmin;
+    colorbar(&g->tail, f.x0 + f.w + 20, f.y0 + 24, fmin(f.h - 30, 300), dmin * k, dmax * k, 0,
+             logscale, k > 1 ? "diameter (mm)" : "diameter (m)");
+    doc_end(&g->tail);
+    g->f = f;
+    g->z = z;
+    g->dmin = dmin;
+    g->dmax = dmax;
+    g->logscale = logscale;
+    g->scale = f.w / (f.xmax - f.xmin);
+    if (pass_begin(g)) {
+        seterr(eb, el, status, 500, "cannot read the spheres of the result");
+        return -1;
+    }
+    g->step = step_section;
+    return 0;
 }
 
 static char *view_psd(const json_t *res, int width, size_t *len, int *status, char *eb, size_t el)
@@ -1342,16 +2052,35 @@ const char *gp_svg_views(const char *kind)
     return NULL;
 }
 
-char *gp_svg_render(const json_t *result, const char *kind, const char *view,
-                    const gp_svg_options *opt, size_t *len, int *status, char *errbuf,
-                    size_t errlen)
+void gp_svg_close(gp_svg *g)
 {
-    if (len) *len = 0;
+    if (!g) return;
+    gp_svg_items_close(g->items);
+    free(g->out.buf);
+    free(g->mid.buf);
+    free(g->tail.buf);
+    free(g);
+}
+
+/* a view drawn whole (the statistics views): the document becomes the stream's staged text */
+static int whole(gp_svg *g, char *svg, size_t len)
+{
+    if (!svg) return -1;
+    g->out.buf = svg;
+    g->out.len = g->out.cap = len;
+    return 0;
+}
+
+gp_svg *gp_svg_open(const gp_svg_input *in, const char *view, const gp_svg_options *opt,
+                    int *status, char *errbuf, size_t errlen)
+{
     if (errbuf && errlen) errbuf[0] = 0;
+    const json_t *result = in ? in->summary : NULL;
     if (!json_is_object(result)) {
         seterr(errbuf, errlen, status, 500, "the result is not a JSON object");
         return NULL;
     }
+    const char *kind = in->kind;
     if (!kind || !*kind) {
         const char *k = json_string_value(json_object_get(result, "kind"));
         if (k) kind = k;
@@ -1372,18 +2101,113 @@ char *gp_svg_render(const json_t *result, const char *kind, const char *view,
         seterr(errbuf, errlen, status, 400, "missing view; valid views for %s: %s", kind, views);
         return NULL;
     }
-    if (!strcmp(kind, KIND_2D)) {
-        if (!strcmp(view, "packing")) return view_packing(result, opt, width, len, status, errbuf, errlen);
-        if (!strcmp(view, "cells")) return view_cells(result, width, len, status, errbuf, errlen);
-        if (!strcmp(view, "size")) return view_size(result, width, len, status, errbuf, errlen);
-        if (!strcmp(view, "orientation")) return view_orientation(result, width, len, status, errbuf, errlen);
-        if (!strcmp(view, "descriptors")) return view_descriptors(result, width, len, status, errbuf, errlen);
-    } else {
-        if (!strcmp(view, "section")) return view_section(result, opt, width, len, status, errbuf, errlen);
-        if (!strcmp(view, "psd")) return view_psd(result, width, len, status, errbuf, errlen);
+    gp_svg *g = calloc(1, sizeof *g);
+    if (!g) {
+        seterr(errbuf, errlen, status, 500, "out of memory");
+        return NULL;
     }
-    char v[64];
-    snprintf(v, sizeof v, "%s", view);
-    seterr(errbuf, errlen, status, 400, "unknown view \"%s\"; valid views for %s: %s", v, kind, views);
-    return NULL;
+    int rc = 1; /* 1: unknown view */
+    size_t len = 0;
+    char *doc = NULL; /* a view drawn whole */
+    if (!strcmp(kind, KIND_2D)) {
+        if (!strcmp(view, "packing")) rc = view_packing(g, in, opt, width, status, errbuf, errlen);
+        else if (!strcmp(view, "cells")) rc = view_cells(g, in, width, status, errbuf, errlen);
+        else if (!strcmp(view, "size")) rc = -1, doc = view_size(in, width, &len, status, errbuf, errlen);
+        else if (!strcmp(view, "orientation"))
+            rc = -1, doc = view_orientation(in, width, &len, status, errbuf, errlen);
+        else if (!strcmp(view, "descriptors"))
+            rc = -1, doc = view_descriptors(in, width, &len, status, errbuf, errlen);
+    } else {
+        if (!strcmp(view, "section")) rc = view_section(g, in, opt, width, status, errbuf, errlen);
+        else if (!strcmp(view, "psd")) rc = -1, doc = view_psd(result, width, &len, status, errbuf, errlen);
+    }
+    if (doc) rc = whole(g, doc, len);
+    if (rc == 0 && (g->out.oom || g->mid.oom || g->tail.oom)) {
+        seterr(errbuf, errlen, status, 500, "out of memory while drawing");
+        rc = -1;
+    }
+    if (rc) {
+        if (rc > 0) {
+            char v[64];
+            snprintf(v, sizeof v, "%s", view);
+            seterr(errbuf, errlen, status, 400, "unknown view \"%s\"; valid views for %s: %s", v,
+                   kind, views);
+        }
+        gp_svg_close(g);
+        return NULL;
+    }
+    if (status) *status = 200;
+    return g;
+}
+
+/* runs one step; 0 more, 1 done, -1 failed */
+static int run_step(gp_svg *g)
+{
+    int r = g->step(g);
+    if (r >= 0 && g->out.oom) {
+        snprintf(g->err, sizeof g->err, "out of memory while drawing");
+        r = -1;
+    }
+    if (r < 0) {
+        if (!g->err[0]) snprintf(g->err, sizeof g->err, "drawing failed");
+        g->step = NULL;
+        return -1;
+    }
+    if (r > 0) g->step = NULL;
+    return r;
+}
+
+int gp_svg_read(gp_svg *g, char *buf, size_t cap, size_t *n)
+{
+    *n = 0;
+    if (g->err[0]) return -1;
+    size_t got = 0;
+    while (got < cap) {
+        if (g->pos < g->out.len) {
+            size_t k = g->out.len - g->pos;
+            if (k > cap - got) k = cap - got;
+            memcpy(buf + got, g->out.buf + g->pos, k);
+            g->pos += k;
+            got += k;
+            continue;
+        }
+        if (!g->step) break;
+        g->out.len = g->pos = 0;
+        if (run_step(g) < 0) return -1;
+    }
+    *n = got;
+    return 0;
+}
+
+const char *gp_svg_error(const gp_svg *g)
+{
+    return g->err[0] ? g->err : "no error";
+}
+
+char *gp_svg_render(const json_t *result, const char *kind, const char *view,
+                    const gp_svg_options *opt, size_t *len, int *status, char *errbuf,
+                    size_t errlen)
+{
+    if (len) *len = 0;
+    gp_svg_input in = {kind, result, NULL, NULL};
+    gp_svg *g = gp_svg_open(&in, view, opt, status, errbuf, errlen);
+    if (!g) return NULL;
+    /* the whole document in memory: every step appends to the staged text */
+    while (g->step)
+        if (run_step(g) < 0) {
+            seterr(errbuf, errlen, status, 500, "%s", g->err);
+            gp_svg_close(g);
+            return NULL;
+        }
+    char *svg = g->out.buf;
+    if (!svg) { /* cannot happen: every view stages its head */
+        gp_svg_close(g);
+        seterr(errbuf, errlen, status, 500, "nothing drawn");
+        return NULL;
+    }
+    if (len) *len = g->out.len;
+    g->out.buf = NULL;
+    gp_svg_close(g);
+    if (status) *status = 200;
+    return svg;
 }

@@ -44,14 +44,30 @@
  *             "target_number": [n], "achieved_number": [n]}  (percent passing, 0..100)}
  *
  * Output: a standalone SVG 1.1 document with width, height and viewBox; coordinates printed
- * with at most 6 significant digits. Rendering is O(size of the result).
+ * with at most 6 significant digits.
+ *
+ * Compact reading (what grainpackd does): a view reads the result's small members -- the
+ * "summary": stats, warnings, container, box, kind (the result without grains, cells, spheres
+ * and contacts, see store_get_summary) -- and its geometry one item at a time from an item
+ * source: the export pack (gp_svg_items_pack: 2D grains, 3D spheres), or an array of the
+ * result text walked element by element (gp_svg_items_scan, server/json_scan.h), or an array in
+ * memory (gp_svg_items_json). The statistics views (size, orientation, descriptors, psd) need
+ * only the summary (they fall back to the grains or cells when a histogram is missing); the
+ * geometry views (packing, cells, section) read their items in two or three passes (bounds and
+ * colour range, then drawing). The SVG is handed out as a pull stream (gp_svg_open /
+ * gp_svg_read), one item at a time, so memory is O(1) in the number of items: the summary, one
+ * item, the sources' caches and a staging buffer of about 16 KiB.
  */
 #ifndef GP_SVG_H
 #define GP_SVG_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include <jansson.h>
+
+#include "gp_export.h"
+#include "json_scan.h"
 
 typedef struct gp_svg_options {
     const char *color;  /* packing: "size" (default) or "orientation"; NULL = default */
@@ -68,7 +84,8 @@ typedef struct gp_svg_options {
  *   409 -- the view needs a part of the result that was not asked for (e.g. "cells" without
  *          output "cells", "packing" without "grains");
  *   500 -- out of memory or a result that is not an object.
- * The caller free()s the returned string. Thread-safe (no global state). */
+ * The caller free()s the returned string. Thread-safe (no global state).
+ * (gp_svg_open over the result in memory, read to the end.) */
 char *gp_svg_render(const json_t *result, const char *kind, const char *view,
                     const gp_svg_options *opt, size_t *len, int *status, char *errbuf,
                     size_t errlen);
@@ -76,5 +93,58 @@ char *gp_svg_render(const json_t *result, const char *kind, const char *view,
 /* The views of a kind as a comma-separated list ("packing, cells, size, orientation,
  * descriptors"), or NULL for an unknown kind. */
 const char *gp_svg_views(const char *kind);
+
+/* ---- item sources: a result's geometry, one item at a time ---- */
+
+/* "grains", "cells" or "spheres" */
+typedef enum gp_svg_part { GP_SVG_GRAINS = 0, GP_SVG_CELLS, GP_SVG_SPHERES } gp_svg_part;
+
+typedef struct gp_svg_items gp_svg_items;
+
+/* The elements of array (a result's "grains", "cells" or "spheres"), which must outlive the
+ * source; NULL when array is not an array. */
+gp_svg_items *gp_svg_items_json(const json_t *array, gp_svg_part part);
+
+/* The elements of the JSON array whose text starts at offset off of text (e.g. the stored
+ * result, read as an SQLite blob), each parsed on its own when it is read; text's reader must
+ * stay valid until the source is closed. NULL on out of memory. */
+gp_svg_items *gp_svg_items_scan(const js_source *text, uint64_t off, gp_svg_part part);
+
+/* The grains (2D) or spheres (3D) of an export pack (core/gp_export.h), which must stay
+ * readable until the source is closed. NULL when pack is not a pack, or not of that part
+ * (cells are not in packs). */
+gp_svg_items *gp_svg_items_pack(const gp_export_source *pack, gp_svg_part part);
+
+void gp_svg_items_close(gp_svg_items *it);
+
+/* ---- rendering as a pull stream ---- */
+
+/* What a view reads. summary: the result's small members (or the whole result: its arrays
+ * are then the items when open is NULL); it must outlive the rendering.
+ * open(user, part, &failed): the items of a part when a view needs them (the rendering closes
+ * them); NULL when the result has no such part, with failed = 1 when they could not be read
+ * (a 500). NULL open: the arrays of summary. */
+typedef struct gp_svg_input {
+    const char *kind;
+    const json_t *summary;
+    gp_svg_items *(*open)(void *user, gp_svg_part part, int *failed);
+    void *user;
+} gp_svg_input;
+
+typedef struct gp_svg gp_svg;
+
+/* Prepares view (reading what it needs: its statistics, its items' bounds and ranges) and
+ * returns a stream of the SVG document; NULL with the status and message of gp_svg_render. */
+gp_svg *gp_svg_open(const gp_svg_input *in, const char *view, const gp_svg_options *opt,
+                    int *status, char *errbuf, size_t errlen);
+
+/* Copies up to cap (> 0) bytes of the document into buf; *n = 0 at the end. -1 when an item
+ * source failed mid-way or memory ran out (the document is then incomplete: drop it; the
+ * reason is gp_svg_error()). */
+int gp_svg_read(gp_svg *g, char *buf, size_t cap, size_t *n);
+const char *gp_svg_error(const gp_svg *g);
+
+/* Closes the stream and the item sources it opened. */
+void gp_svg_close(gp_svg *g);
 
 #endif /* GP_SVG_H */

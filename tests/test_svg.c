@@ -2,7 +2,12 @@
  * <polygon>/<circle> per grain, cell part, seed or cut sphere, axes and labels, errors for
  * unknown views and missing parts, and a 10,000-grain packing drawn quickly and compactly.
  * The size view from stats.fit (CDF curves, KS lines, warnings), and stats.fit / warnings as
- * server/result_json.c writes them from a specimen, drawn by the size view. */
+ * server/result_json.c writes them from a specimen, drawn by the size view.
+ * Compact reading (what GET /svg does): server/json_scan.c (member spans, array walks, the
+ * summary of a result, cut texts refused), the element parser against jansson, the fast
+ * "%.1f", and every view drawn as a pull stream from a summary plus an export pack or the
+ * scanned result text, in pieces of 7 bytes to 1 MiB, byte for byte as gp_svg_render draws
+ * the whole result; a source failing anywhere fails the picture (500 or a read error). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,6 +15,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "../server/json_scan.c"
 #include "../server/result_json.c"
 #include "../server/svg.c"
 #include "gp_test.h"
@@ -542,6 +548,440 @@ static void test_large(void)
     json_decref(r);
 }
 
+/* ---- compact reading: json_scan, the item sources, the pull stream ---- */
+
+static void test_json_scan(void)
+{
+    const char *t = "{\"a\":\"x]\\\"}\" , \"grains\":[{\"k\":\"]\"},[1,2],3],\"b\":[1,2,{\"c\":null}],"
+                    "\"n\":-1.5e3,\"cells\":[],\"z\":true}";
+    js_source src = js_memory_source(t, strlen(t));
+    static const char *const skip[] = {"grains", "cells", "spheres", NULL};
+    uint64_t sp[3][2];
+    size_t len;
+    char *w = js_object_without(&src, skip, &len, sp);
+    CHECK(w && !strcmp(w, "{\"a\":\"x]\\\"}\",\"b\":[1,2,{\"c\":null}],\"n\":-1.5e3,\"z\":true}"));
+    CHECK(w && len == strlen(w));
+    CHECK(sp[0][0] > 0 && !strncmp(t + sp[0][0], "[{\"k\"", 5) && t[sp[0][1] - 1] == ']');
+    CHECK(sp[1][1] == sp[1][0] + 2 && sp[2][0] == 0 && sp[2][1] == 0);
+    /* the elements of the grains array, one at a time */
+    js_scan *s = js_open(&src);
+    CHECK(s && js_array_begin(s, sp[0][0]) == 0);
+    uint64_t a, b;
+    int n = 0;
+    while (js_array_next(s, &a, &b) > 0) {
+        json_t *e = js_load(s, a, b);
+        CHECK(e != NULL);
+        if (n == 0) CHECK(!strcmp(json_string_value(json_object_get(e, "k")), "]"));
+        if (n == 2) CHECK(json_integer_value(e) == 3);
+        json_decref(e);
+        n++;
+    }
+    CHECK(n == 3);
+    CHECK(js_array_begin(s, sp[1][0]) == 0 && js_array_next(s, &a, &b) == 0); /* [] */
+    CHECK(js_array_begin(s, 0) == -1);                                        /* not an array */
+    js_close(s);
+    free(w);
+    /* every cut of the text is refused, never read past */
+    for (size_t k = 0; k < strlen(t); k++) {
+        char *cut = strndup(t, k);
+        js_source cs = js_memory_source(cut, k);
+        char *x = js_object_without(&cs, skip, NULL, NULL);
+        CHECK(x == NULL);
+        free(x);
+        free(cut);
+    }
+    js_source bad = js_memory_source("[1,2]", 5);
+    CHECK(js_object_without(&bad, skip, NULL, NULL) == NULL);
+    /* across cache windows: a string of 200,000 bytes with escapes, then an array */
+    size_t big = 200000;
+    char *bt = malloc(big + big / 1000 + 64);
+    size_t k = (size_t)sprintf(bt, "{\"s\":\"");
+    for (size_t i = 0; i < big; i++) {
+        if (i % 1000 == 999) bt[k++] = '\\', bt[k++] = '"';
+        else bt[k++] = (char)('a' + i % 26);
+    }
+    k += (size_t)sprintf(bt + k, "\",\"grains\":[[1],[2]]}");
+    js_source bs = js_memory_source(bt, k);
+    w = js_object_without(&bs, skip, &len, sp);
+    CHECK(w && len == k - strlen(",\"grains\":[[1],[2]]") && sp[0][1] == k - 1);
+    free(w);
+    free(bt);
+}
+
+/* reads a stream in pieces of cap bytes */
+static char *read_all(gp_svg *g, size_t cap, size_t *len)
+{
+    size_t n = 0, room = 1 << 16;
+    char *out = malloc(room), *buf = malloc(cap);
+    for (;;) {
+        size_t got;
+        if (gp_svg_read(g, buf, cap, &got)) {
+            free(out);
+            free(buf);
+            return NULL;
+        }
+        if (!got) break;
+        if (n + got + 1 > room) out = realloc(out, room = 2 * (n + got + 1));
+        memcpy(out + n, buf, got);
+        n += got;
+    }
+    out[n] = 0;
+    free(buf);
+    *len = n;
+    return out;
+}
+
+/* what grainpackd's svg_job does: a summary, grains/spheres from a pack, the rest scanned */
+typedef struct src_ctx {
+    const void *pack;
+    size_t pack_len;
+    const char *text;
+    uint64_t spans[3][2];
+    int fail_after; /* reads the scan source allows (0 = any) */
+    int reads;
+} src_ctx;
+
+static int counting_read(void *user, uint64_t off, void *dst, size_t n)
+{
+    src_ctx *c = user;
+    if (c->fail_after && ++c->reads > c->fail_after) return -1;
+    memcpy(dst, c->text + off, n);
+    return 0;
+}
+
+static gp_svg_items *test_open(void *user, gp_svg_part part, int *failed)
+{
+    src_ctx *c = user;
+    *failed = 0;
+    if (c->pack && part != GP_SVG_CELLS) {
+        gp_export_source ps = gp_export_memory_source(c->pack, c->pack_len);
+        gp_svg_items *it = gp_svg_items_pack(&ps, part);
+        if (it) return it;
+    }
+    if (c->spans[part][1] <= c->spans[part][0]) return NULL;
+    js_source ts = {counting_read, c, strlen(c->text)};
+    return gp_svg_items_scan(&ts, c->spans[part][0], part);
+}
+
+static void check_stream_equal(json_t *result, const char *kind, const char *view,
+                               const gp_svg_options *o, src_ctx *ctx, const json_t *summary)
+{
+    size_t rlen;
+    int st;
+    char err[256];
+    char *ref = gp_svg_render(result, kind, view, o, &rlen, &st, err, sizeof err);
+    CHECK(ref != NULL);
+    if (!ref) {
+        fprintf(stderr, "%s: %s\n", view, err);
+        return;
+    }
+    gp_svg_input in = {kind, summary, test_open, ctx};
+    size_t caps[3] = {7, 4096, 1 << 20};
+    for (int k = 0; k < 3; k++) {
+        gp_svg *g = gp_svg_open(&in, view, o, &st, err, sizeof err);
+        CHECK(g != NULL && st == 200);
+        if (!g) continue;
+        size_t len;
+        char *s = read_all(g, caps[k], &len);
+        CHECK(s && len == rlen && !memcmp(s, ref, rlen));
+        if (s && (len != rlen || memcmp(s, ref, rlen)))
+            fprintf(stderr, "%s (pieces of %zu): the stream differs from gp_svg_render\n", view, caps[k]);
+        free(s);
+        gp_svg_close(g);
+    }
+    free(ref);
+}
+
+static void set_spans(src_ctx *c)
+{
+    static const char *const skip[] = {"grains", "cells", "spheres", NULL};
+    js_source s = js_memory_source(c->text, strlen(c->text));
+    free(js_object_without(&s, skip, NULL, c->spans));
+}
+
+static void test_compact_2d(void)
+{
+    enum { NG = 12, NP = 24 };
+    gp_specimen2d s;
+    memset(&s, 0, sizeof s);
+    gp_grain2d grains[NG];
+    gp_vec2 contours[NG][NP];
+    double discs[NG][6];
+    gp_cell2d cells[NG];
+    gp_ring rings[NG][2];
+    gp_vec2 cpts[NG][2][4];
+    memset(grains, 0, sizeof grains);
+    memset(cells, 0, sizeof cells);
+    for (int g = 0; g < NG; g++) {
+        double cx = 0.125 + 0.25 * (g % 4), cy = 0.12 + 0.23 * (g / 4), r = 0.05 + 0.004 * g;
+        for (int k = 0; k < NP; k++) {
+            double t = 2 * M_PI * k / NP;
+            contours[g][k] = (gp_vec2){cx + r * cos(t) * (1 + 0.2 * sin(3 * t)), cy + 0.7 * r * sin(t)};
+        }
+        if (g == 5) contours[g][3].x = NAN; /* a point the JSON writes as null */
+        grains[g].cell = (size_t)g;
+        grains[g].contour = contours[g];
+        grains[g].ncontour = NP;
+        grains[g].area = g == 7 ? NAN : M_PI * r * r * 0.7;
+        grains[g].orientation_deg = g == 8 ? NAN : -80 + 15.3 * g;
+        grains[g].descriptors = (gp_descriptors){0.5 + 0.03 * g, 0.4 + 0.02 * g, 0.7 + 0.01 * g, 2 + 0.1 * g};
+        discs[g][0] = cx, discs[g][1] = cy, discs[g][2] = r * 0.5;
+        discs[g][3] = cx + r * 0.3, discs[g][4] = cy, discs[g][5] = r * 0.3;
+        grains[g].discs = discs[g];
+        grains[g].ndiscs = 2;
+        double x0 = 0.25 * (g % 4), y0 = 0.23 * (g / 4);
+        int parts = g == 3 ? 2 : 1;
+        for (int p = 0; p < parts; p++) {
+            double h = 0.23 / parts;
+            cpts[g][p][0] = (gp_vec2){x0, y0 + p * h};
+            cpts[g][p][1] = (gp_vec2){x0 + 0.25, y0 + p * h};
+            cpts[g][p][2] = (gp_vec2){x0 + 0.25, y0 + (p + 1) * h};
+            cpts[g][p][3] = (gp_vec2){x0, y0 + (p + 1) * h};
+            rings[g][p] = (gp_ring){cpts[g][p], 4};
+        }
+        cells[g].seed = (gp_vec2){x0 + 0.12, y0 + 0.11};
+        cells[g].polygons = rings[g];
+        cells[g].npolygons = (size_t)parts;
+        cells[g].area = 0.25 * 0.23 * (1 + 0.01 * g);
+        cells[g].orientation_deg = 10.0 * g - 60;
+    }
+    s.grains = grains;
+    s.ngrains = NG;
+    s.cells = cells;
+    s.ncells = NG;
+    gp_spec2d spec;
+    memset(&spec, 0, sizeof spec);
+    gp_vec2 outer[4] = {{0, 0}, {1, 0}, {1, 0.69}, {0, 0.69}};
+    spec.container = GP_CONTAINER_POLYGON;
+    spec.outer = (gp_ring){outer, 4};
+    spec.particles = NG;
+    spec.outputs = GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS | GP_OUT_CELLS;
+    json_error_t e;
+    json_t *sj = json_loads("{\"container\": {\"polygon\": [[0,0],[1,0],[1,0.69],[0,0.69]]}}", 0, &e);
+    json_t *r = gpd_result_2d(&s, &spec, sj);
+    CHECK(r != NULL);
+    char *text = json_dumps(r, JSON_COMPACT | JSON_REAL_PRECISION(17));
+    void *pack = NULL;
+    size_t pack_len = 0;
+    gp_error perr;
+    CHECK(gp_export_pack_2d(&s, &spec, 2650, &pack, &pack_len, &perr) == GP_OK);
+    /* the summary: the result without its arrays */
+    static const char *const skip[] = {"grains", "cells", "spheres", "contacts", NULL};
+    js_source ts = js_memory_source(text, strlen(text));
+    char *sum_text = js_object_without(&ts, skip, NULL, NULL);
+    json_t *summary = sum_text ? json_loads(sum_text, 0, &e) : NULL;
+    CHECK(summary && !json_object_get(summary, "grains") && !json_object_get(summary, "cells"));
+    json_t *copy = json_deep_copy(r);
+    json_object_del(copy, "grains");
+    json_object_del(copy, "cells");
+    CHECK(json_equal(copy, summary));
+    json_decref(copy);
+    /* every view, from the pack and the scanned text, from the scanned text only, as the
+     * result in memory draws it (the statistics here have no histograms: the size, orientation
+     * and descriptors views fall back to the items) */
+    const char *views[5] = {"packing", "cells", "size", "orientation", "descriptors"};
+    gp_svg_options og = {.color = "orientation"}, ow = {.width = 1500};
+    for (int with_pack = 0; with_pack < 2; with_pack++) {
+        src_ctx ctx = {with_pack ? pack : NULL, pack_len, text, {{0}}, 0, 0};
+        set_spans(&ctx);
+        for (int v = 0; v < 5; v++) check_stream_equal(r, KIND_2D, views[v], NULL, &ctx, summary);
+        check_stream_equal(r, KIND_2D, "packing", &og, &ctx, summary);
+        check_stream_equal(r, KIND_2D, "packing", &ow, &ctx, summary);
+    }
+    /* without the part: 409, as from the result */
+    {
+        src_ctx ctx = {NULL, 0, text, {{0}}, 0, 0};
+        gp_svg_input in = {KIND_2D, summary, test_open, &ctx};
+        int st = 0;
+        char err[256];
+        CHECK(gp_svg_open(&in, "cells", NULL, &st, err, sizeof err) == NULL && st == 409);
+    }
+    json_decref(summary);
+    free(sum_text);
+    free(pack);
+    free(text);
+    json_decref(r);
+    json_decref(sj);
+}
+
+static void test_compact_3d(void)
+{
+    json_error_t e;
+    json_t *r = json_loads(RESULT_3D, 0, &e);
+    const json_t *sp = json_object_get(r, "spheres");
+    size_t n = json_array_size(sp);
+    double *q = malloc(4 * n * sizeof *q);
+    for (size_t i = 0; i < n; i++)
+        for (int a = 0; a < 4; a++) q[4 * i + a] = json_number_value(json_array_get(json_array_get(sp, i), (size_t)a));
+    gp_specimen3d s;
+    memset(&s, 0, sizeof s);
+    s.spheres = q;
+    s.count = n;
+    s.box[0] = s.box[1] = s.box[2] = 0.5;
+    void *pack = NULL;
+    size_t pack_len = 0;
+    gp_error perr;
+    CHECK(gp_export_pack_3d(&s, 2650, &pack, &pack_len, &perr) == GP_OK);
+    char *text = json_dumps(r, JSON_COMPACT | JSON_REAL_PRECISION(17));
+    json_t *summary = json_deep_copy(r);
+    json_object_del(summary, "spheres");
+    gp_svg_options oz = {.has_z = 1, .z = 0.05}, obad = {.has_z = 1, .z = 0.7};
+    for (int with_pack = 0; with_pack < 2; with_pack++) {
+        src_ctx ctx = {with_pack ? pack : NULL, pack_len, text, {{0}}, 0, 0};
+        set_spans(&ctx);
+        check_stream_equal(r, KIND_3D, "section", NULL, &ctx, summary);
+        check_stream_equal(r, KIND_3D, "section", &oz, &ctx, summary);
+        check_stream_equal(r, KIND_3D, "psd", NULL, &ctx, summary);
+        gp_svg_input in = {KIND_3D, summary, test_open, &ctx};
+        int st = 0;
+        char err[256];
+        CHECK(gp_svg_open(&in, "section", &obad, &st, err, sizeof err) == NULL && st == 400 &&
+              strstr(err, "outside"));
+    }
+    /* a 2D pack is no source of spheres, a 3D one none of grains or cells */
+    gp_export_source ps = gp_export_memory_source(pack, pack_len);
+    CHECK(gp_svg_items_pack(&ps, GP_SVG_GRAINS) == NULL && gp_svg_items_pack(&ps, GP_SVG_CELLS) == NULL);
+    gp_svg_items *it = gp_svg_items_pack(&ps, GP_SVG_SPHERES);
+    CHECK(it != NULL);
+    gp_svg_items_close(it);
+    json_decref(summary);
+    free(text);
+    free(pack);
+    free(q);
+    json_decref(r);
+}
+
+/* a source failing anywhere: a 500 from gp_svg_open or -1 from gp_svg_read, never a short
+ * picture (3,000 cells: a text of several cache windows, read in three passes) */
+static void test_failing_source(void)
+{
+    json_t *r = json_object(), *cells = json_array();
+    for (int i = 0; i < 3000; i++) {
+        double x = (i % 60) / 60.0, y = (i / 60) / 50.0;
+        json_array_append_new(cells, json_pack("{s:i, s:[f,f], s:[[[f,f],[f,f],[f,f]]], s:f, s:f}",
+                                               "id", i, "seed", x + 0.005, y + 0.005, "polygons",
+                                               x, y, x + 1 / 60.0, y, x, y + 0.02, "area",
+                                               1e-4 * (1 + i % 5), "orientation_deg", 0.0));
+    }
+    json_object_set_new(r, "kind", json_string(KIND_2D));
+    json_object_set_new(r, "cells", cells);
+    char *text = json_dumps(r, JSON_COMPACT | JSON_REAL_PRECISION(17));
+    CHECK(strlen(text) > 4 * 65536);
+    json_t *summary = json_pack("{s:s}", "kind", KIND_2D);
+    src_ctx ctx = {NULL, 0, text, {{0}}, 0, 0};
+    set_spans(&ctx);
+    check_stream_equal(r, KIND_2D, "cells", NULL, &ctx, summary);
+    /* the reads a whole picture takes */
+    ctx.reads = 0;
+    ctx.fail_after = 1000000;
+    gp_svg_input in = {KIND_2D, summary, test_open, &ctx};
+    int st = 0;
+    char err[256];
+    size_t len;
+    gp_svg *g = gp_svg_open(&in, "cells", NULL, &st, err, sizeof err);
+    char *x = g ? read_all(g, 4096, &len) : NULL;
+    CHECK(x != NULL);
+    free(x);
+    gp_svg_close(g);
+    int total = ctx.reads, at_open = 0, mid = 0;
+    CHECK(total > 6);
+    for (int fail = 1; fail < total; fail++) { /* reads after the first `fail` fail */
+        ctx.reads = 0;
+        ctx.fail_after = fail;
+        g = gp_svg_open(&in, "cells", NULL, &st, err, sizeof err);
+        if (!g) {
+            CHECK(st == 500);
+            at_open++;
+            continue;
+        }
+        x = read_all(g, 4096, &len);
+        CHECK(x == NULL && strstr(gp_svg_error(g), "cells"));
+        mid += x == NULL;
+        free(x);
+        gp_svg_close(g);
+    }
+    CHECK(at_open > 0 && mid > 0);
+    json_decref(summary);
+    free(text);
+    json_decref(r);
+}
+
+/* the element parser of the scan source reads what the JSON tree gives, odd elements too */
+static void test_item_parse(void)
+{
+    const char *grains[] = {
+        "{\"id\":1,\"contour\":[[1,2],[3.5,-4e-3],null,[5],\"x\",[6,7,8]],\"area\":null,"
+        "\"orientation_deg\":\"no\",\"descriptors\":{\"roundness\":0.25,\"x\":{\"y\":\"]}\"},"
+        "\"regularity\":3},\"discs\":[[1,2,3]]}",
+        "{\"contour\":5,\"area\":1e-3,\"k\\\"ey\":[\"]\"],\"descriptors\":[1,2]}",
+        "[1,2]",
+        "{ \"contour\" : [ [ 0 , 1 ] ] , \"area\" : 2 }",
+    };
+    const char *cells[] = {
+        "{\"seed\":[0.5,null],\"polygons\":[[[0,0],[1,0],[1,1]],7,[]],\"area\":0.5,\"orientation_deg\":-3}",
+        "{\"seed\":3,\"polygons\":{}}",
+    };
+    const char *spheres[] = {"[1,2,3,4]", "[1,null,3]", "{\"x\":1}", "[1,2,3,4,5,[6]]"};
+    struct { gp_svg_part part; const char *const *t; int n; } sets[3] = {
+        {GP_SVG_GRAINS, grains, 4}, {GP_SVG_CELLS, cells, 2}, {GP_SVG_SPHERES, spheres, 4}};
+    item a = {0}, b = {0};
+    for (int s = 0; s < 3; s++)
+        for (int i = 0; i < sets[s].n; i++) {
+            const char *t = sets[s].t[i];
+            json_error_t e;
+            json_t *j = json_loads(t, JSON_DECODE_ANY, &e);
+            CHECK(j != NULL);
+            CHECK(item_from_json(sets[s].part, &a, j) == 0);
+            CHECK(item_parse(sets[s].part, &b, t, strlen(t)) == 0);
+            int same = a.npts == b.npts && a.nrings == b.nrings;
+            for (size_t k = 0; same && k < 2 * a.npts; k++)
+                same = (isnan(a.xy[k]) && isnan(b.xy[k])) || a.xy[k] == b.xy[k];
+            for (size_t k = 0; same && k < a.nrings; k++) same = a.rings[k] == b.rings[k];
+            double va[13] = {a.area, a.orientation_deg, a.desc[0], a.desc[1], a.desc[2], a.desc[3],
+                             a.seed[0], a.seed[1], a.q[0], a.q[1], a.q[2], a.q[3], 0};
+            double vb[13] = {b.area, b.orientation_deg, b.desc[0], b.desc[1], b.desc[2], b.desc[3],
+                             b.seed[0], b.seed[1], b.q[0], b.q[1], b.q[2], b.q[3], 0};
+            for (int k = 0; same && k < 13; k++) same = (isnan(va[k]) && isnan(vb[k])) || va[k] == vb[k];
+            CHECK(same);
+            if (!same) fprintf(stderr, "item_parse differs on %s\n", t);
+            json_decref(j);
+        }
+    /* malformed text is refused */
+    /* (values that are skipped are only matched bracket to bracket, not checked) */
+    const char *bad[] = {"{\"contour\":[[1,2]", "{\"area\":}", "{\"area\" 1}",
+                         "{\"contour\":[[1,,2]]}", "{\"contour\":[[1,2],]}"};
+    for (int i = 0; i < 5; i++) CHECK(item_parse(GP_SVG_GRAINS, &b, bad[i], strlen(bad[i])) == -1);
+    CHECK(item_parse(GP_SVG_SPHERES, &b, "[1,2", 4) == -1);
+    free(a.xy);
+    free(a.rings);
+    free(b.xy);
+    free(b.rings);
+}
+
+/* printf's "%.1f" exactly, halves included */
+static void test_fmt_f1(void)
+{
+    double v[] = {0, -0.0, 0.05, 0.25, -0.25, 0.15, 1.05, 2.5, -0.04, 99.95, 12345.65, 0.35,
+                  1e14, -3e15, 1e300, 799.95, 123.449999999};
+    int bad = 0;
+    for (size_t i = 0; i < sizeof v / sizeof *v; i++) {
+        char a[400], b[400];
+        snprintf(a, sizeof a, "%.1f", v[i]);
+        fmt_f1(b, v[i]);
+        bad += strcmp(a, b) != 0;
+    }
+    unsigned x = 12345;
+    for (int i = 0; i < 2000000; i++) {
+        x = x * 1103515245u + 12345u;
+        double d = (i % 2) ? (x % 400000) / 20.0 - 1000 : (double)x / 7919.0 - 3000;
+        char a[64], b[64];
+        snprintf(a, sizeof a, "%.1f", d);
+        fmt_f1(b, d);
+        bad += strcmp(a, b) != 0;
+    }
+    CHECK(bad == 0);
+}
+
 int main(void)
 {
     test_2d();
@@ -549,5 +989,11 @@ int main(void)
     test_result_fit();
     test_3d();
     test_large();
+    test_json_scan();
+    test_item_parse();
+    test_fmt_f1();
+    test_compact_2d();
+    test_compact_3d();
+    test_failing_source();
     return gp_test_summary();
 }

@@ -1,0 +1,241 @@
+#!/usr/bin/env python3
+"""bench_svg.py -- the daemon's memory and speed while it serves the SVG views of large jobs.
+
+    python3 bench/bench_svg.py build/server/grainpackd [--tiling 4,4,6] [--grains 10000]
+    python3 bench/bench_svg.py build/server/grainpackd --db DB --job3 ID --job2 ID  (reuse)
+
+Starts grainpackd on a free port with a temporary database and runs the 3D paper example (the
+spec of bench_export.py: 0.5 m cube, the default Table-2 sieve, porosity 0.38, output spheres,
+tiled 4x4x6: 233,280 spheres) and a 2D Fourier-Voronoi job of 10,000 grains with outputs
+grains, odec, descriptors and cells (descriptors so that the "descriptors" view has data).
+Then it restarts the daemon on the same database with one worker (the heap the jobs freed,
+still resident in the process that ran them, would otherwise absorb the SVG requests unseen),
+waits for it to settle and reads its idle VmRSS. For every view of both jobs it then sends
+four identical requests at once and reads the daemon's peak RSS during them (VmHWM, reset
+with `echo 5 > /proc/PID/clear_refs` first) and its RSS once they are answered; a last row
+sends all the views of both jobs, four at a time. It prints one table:
+
+    view, bytes of one answer, ms (the slowest of the four), peak RSS over idle (MB), RSS
+    after the round over idle (MB).
+
+MB = 2^20 bytes here (as /proc counts kB). With --db/--job3/--job2 it reuses jobs already in
+a database (e.g. one kept with --keep, or built by an older daemon: rows stored before the
+result summary existed take the fallback path). Linux only (/proc); Python standard library
+only; not part of `cmake --build build --target bench` (no C to build).
+"""
+import argparse
+import json
+import os
+import re
+import select
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import urllib.error
+import urllib.request
+from concurrent.futures import ThreadPoolExecutor
+
+SPEC_3D = {"kind": "spheres-3d", "box": [0.5, 0.5, 0.5], "porosity": 0.38,
+           "outputs": ["spheres"]}
+SPEC_2D = {"kind": "fourier-voronoi-2d", "size": {"cov": 0.5},
+           "outputs": ["grains", "odec", "descriptors", "cells"]}
+VIEWS = {3: ["section", "psd"], 2: ["packing", "cells", "size", "orientation", "descriptors"]}
+CONCURRENCY = 4
+
+
+def start(binary, db, workers):
+    log = open(db + ".log", "ab")
+    p = subprocess.Popen([binary, "--listen", "127.0.0.1:0", "--db", db, "--workers",
+                          str(workers), "--log-level", "warn"],
+                         stdout=subprocess.PIPE, stderr=log)
+    line = b""
+    deadline = time.time() + 30
+    while not line.endswith(b"\n"):
+        if time.time() > deadline or p.poll() is not None:
+            p.kill()
+            sys.exit("grainpackd did not start; see " + db + ".log")
+        r, _, _ = select.select([p.stdout], [], [], 1)
+        if r:
+            line += os.read(p.stdout.fileno(), 1)
+    m = re.match(r"listening on (http://\S+)", line.decode())
+    assert m, line
+    return p, m.group(1)
+
+
+def stop(proc):
+    if proc.poll() is not None:
+        return
+    proc.send_signal(signal.SIGTERM)
+    try:
+        proc.wait(30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
+
+def call(url, method="GET", body=None):
+    data = json.dumps(body).encode() if body is not None else None
+    req = urllib.request.Request(url, data=data, method=method,
+                                 headers={"Content-Type": "application/json"} if data else {})
+    try:
+        with urllib.request.urlopen(req, timeout=60) as r:
+            return r.status, json.loads(r.read())
+    except urllib.error.HTTPError as e:
+        return e.code, json.loads(e.read() or b"null")
+
+
+def submit(base, spec):
+    st, j = call(base + "/v1/jobs", "POST", spec)
+    if st != 201:
+        sys.exit("submit failed: %s %s" % (st, j))
+    return j["id"]
+
+
+def wait(base, jid, what):
+    t0 = time.time()
+    while True:
+        st, j = call(base + "/v1/jobs/" + jid)
+        if j["status"] in ("succeeded", "failed", "cancelled"):
+            print("  %s: %s in %.1f s" % (what, j["status"], time.time() - t0), flush=True)
+            if j["status"] != "succeeded":
+                sys.exit("the job did not succeed: %s" % j["error"])
+            return j
+        time.sleep(0.5)
+
+
+def proc_status(pid):
+    out = {}
+    with open("/proc/%d/status" % pid) as f:
+        for line in f:
+            k, _, v = line.partition(":")
+            if k in ("VmRSS", "VmHWM", "RssAnon", "RssFile"):
+                out[k] = int(v.split()[0])  # kB
+    return out
+
+
+def fetch(url):
+    t0 = time.perf_counter()
+    n = 0
+    with urllib.request.urlopen(url, timeout=600) as r:
+        status = r.status
+        while True:
+            b = r.read(1 << 20)
+            if not b:
+                break
+            n += len(b)
+    assert status == 200, (url, status)
+    return n, time.perf_counter() - t0
+
+
+def settle(pid, seconds=1.0):
+    time.sleep(seconds)
+    return proc_status(pid)["VmRSS"]
+
+
+def round_(pid, urls):
+    """Fetches urls, CONCURRENCY at a time; returns bytes of each, the slowest seconds and the
+    daemon's peak RSS (kB) during the round."""
+    with open("/proc/%d/clear_refs" % pid, "w") as f:
+        f.write("5")  # VmHWM := VmRSS
+    with ThreadPoolExecutor(CONCURRENCY) as ex:
+        res = list(ex.map(fetch, urls))
+    peak = proc_status(pid)["VmHWM"]
+    return [n for n, _ in res], max(dt for _, dt in res), peak
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("binary")
+    ap.add_argument("--tiling", default="4,4,6", help="3D tiling (default 4,4,6: 233,280 spheres)")
+    ap.add_argument("--seed", type=int, default=7)
+    ap.add_argument("--grains", type=int, default=10000, help="2D grains (0: no 2D job)")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--db", help="reuse this database (with --job3 and/or --job2)")
+    ap.add_argument("--job3", help="id of a succeeded spheres-3d job in --db")
+    ap.add_argument("--job2", help="id of a succeeded fourier-voronoi-2d job in --db")
+    ap.add_argument("--keep", action="store_true", help="keep the temporary database")
+    a = ap.parse_args()
+    binary = os.path.abspath(a.binary)
+
+    tmp = None
+    if a.db:
+        db = os.path.abspath(a.db)
+        j3, j2 = a.job3, a.job2
+    else:
+        tmp = tempfile.mkdtemp(prefix="bench-svg-")
+        db = os.path.join(tmp, "bench.db")
+        proc, base = start(binary, db, a.workers)
+        try:
+            print("jobs (daemon pid %d, %d workers):" % (proc.pid, a.workers), flush=True)
+            tiling = [int(v) for v in a.tiling.split(",")]
+            j3 = submit(base, dict(SPEC_3D, seed=a.seed, tiling=tiling))
+            j2 = submit(base, dict(SPEC_2D, seed=a.seed, particles=a.grains)) if a.grains else None
+            wait(base, j3, "3D paper example, tiling %s" % a.tiling)
+            if j2:
+                wait(base, j2, "2D %d grains" % a.grains)
+        finally:
+            stop(proc)
+        print("  jobs: --db %s --job3 %s --job2 %s" % (db, j3, j2), flush=True)
+
+    proc, base = start(binary, db, 1)
+    pid = proc.pid
+    try:
+        labels = {}
+        for dim, jid in ((3, j3), (2, j2)):
+            if not jid:
+                continue
+            st, j = call(base + "/v1/jobs/" + jid)
+            assert st == 200 and j["status"] == "succeeded", (jid, st, j.get("status"))
+            st, res = call(base + "/v1/jobs/%s/spec" % jid)
+            if dim == 3:
+                t = res.get("tiling", [1, 1, 1])
+                labels[jid] = "3D x%d" % (t[0] * t[1] * t[2])
+            else:
+                labels[jid] = "2D %d" % res.get("particles", 0)
+        idle = settle(pid, 2.0)
+        print("  daemon pid %d on the jobs' database: idle VmRSS %.1f MB" % (pid, idle / 1024),
+              flush=True)
+
+        rows = []
+        every = []
+        for dim, jid in ((3, j3), (2, j2)):
+            if not jid:
+                continue
+            for v in VIEWS[dim]:
+                url = base + "/v1/jobs/%s/svg?view=%s" % (jid, v)
+                every.append(url)
+                sizes, dt, peak = round_(pid, [url] * CONCURRENCY)
+                after = settle(pid, 0.5)
+                rows.append(("%s %s" % (labels[jid], v), sizes[0], dt, peak, after))
+                print("  %-22s %10d bytes %8.1f ms  peak %+7.1f MB  after %+6.1f MB" % (
+                    rows[-1][0], sizes[0], dt * 1e3, (peak - idle) / 1024, (after - idle) / 1024),
+                    flush=True)
+        sizes, dt, peak = round_(pid, every)
+        after = settle(pid, 0.5)
+        rows.append(("all %d views, %d at a time" % (len(every), CONCURRENCY), sum(sizes), dt,
+                     peak, after))
+
+        print("\nSVG views (grainpackd %s; %d identical requests at once per row; idle VmRSS "
+              "%.1f MB; MB = 2^20 bytes)\n" % (os.path.basename(binary), CONCURRENCY,
+                                              idle / 1024))
+        print("| view | bytes | ms (slowest) | peak RSS over idle (MB) | RSS after (MB over idle) |")
+        print("|---|---:|---:|---:|---:|")
+        for label, n, dt, peak, after in rows:
+            print("| %s | %d | %.0f | %+.1f | %+.1f |" % (label, n, dt * 1e3, (peak - idle) / 1024,
+                                                       (after - idle) / 1024))
+        worst = max(r[3] for r in rows)
+        print("\nworst peak: %+.1f MB over idle (the bound: 20 MB)" % ((worst - idle) / 1024))
+    finally:
+        stop(proc)
+        if tmp and not a.keep:
+            shutil.rmtree(tmp, ignore_errors=True)
+        elif tmp:
+            print("database kept in", tmp)
+
+
+if __name__ == "__main__":
+    main()
