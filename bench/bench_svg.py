@@ -24,20 +24,17 @@ result summary existed take the fallback path). Linux only (/proc); Python stand
 only; not part of `cmake --build build --target bench` (no C to build).
 """
 import argparse
-import json
 import os
-import re
-import select
 import shutil
-import signal
-import subprocess
 import sys
 import tempfile
-import threading
 import time
-import urllib.error
 import urllib.request
 from concurrent.futures import ThreadPoolExecutor
+
+# the daemon harness is bench_export.py's
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_export import call, proc_status, start, stop, submit  # noqa: E402
 
 SPEC_3D = {"kind": "spheres-3d", "box": [0.5, 0.5, 0.5], "porosity": 0.38,
            "outputs": ["spheres"]}
@@ -45,54 +42,6 @@ SPEC_2D = {"kind": "fourier-voronoi-2d", "size": {"cov": 0.5},
            "outputs": ["grains", "odec", "descriptors", "cells"]}
 VIEWS = {3: ["section", "psd"], 2: ["packing", "cells", "size", "orientation", "descriptors"]}
 CONCURRENCY = 4
-
-
-def start(binary, db, workers):
-    log = open(db + ".log", "ab")
-    p = subprocess.Popen([binary, "--listen", "127.0.0.1:0", "--db", db, "--workers",
-                          str(workers), "--log-level", "warn"],
-                         stdout=subprocess.PIPE, stderr=log)
-    line = b""
-    deadline = time.time() + 30
-    while not line.endswith(b"\n"):
-        if time.time() > deadline or p.poll() is not None:
-            p.kill()
-            sys.exit("grainpackd did not start; see " + db + ".log")
-        r, _, _ = select.select([p.stdout], [], [], 1)
-        if r:
-            line += os.read(p.stdout.fileno(), 1)
-    m = re.match(r"listening on (http://\S+)", line.decode())
-    assert m, line
-    return p, m.group(1)
-
-
-def stop(proc):
-    if proc.poll() is not None:
-        return
-    proc.send_signal(signal.SIGTERM)
-    try:
-        proc.wait(30)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait()
-
-
-def call(url, method="GET", body=None):
-    data = json.dumps(body).encode() if body is not None else None
-    req = urllib.request.Request(url, data=data, method=method,
-                                 headers={"Content-Type": "application/json"} if data else {})
-    try:
-        with urllib.request.urlopen(req, timeout=60) as r:
-            return r.status, json.loads(r.read())
-    except urllib.error.HTTPError as e:
-        return e.code, json.loads(e.read() or b"null")
-
-
-def submit(base, spec):
-    st, j = call(base + "/v1/jobs", "POST", spec)
-    if st != 201:
-        sys.exit("submit failed: %s %s" % (st, j))
-    return j["id"]
 
 
 def wait(base, jid, what):
@@ -105,16 +54,6 @@ def wait(base, jid, what):
                 sys.exit("the job did not succeed: %s" % j["error"])
             return j
         time.sleep(0.5)
-
-
-def proc_status(pid):
-    out = {}
-    with open("/proc/%d/status" % pid) as f:
-        for line in f:
-            k, _, v = line.partition(":")
-            if k in ("VmRSS", "VmHWM", "RssAnon", "RssFile"):
-                out[k] = int(v.split()[0])  # kB
-    return out
 
 
 def fetch(url):
