@@ -267,79 +267,6 @@ static enum MHD_Result h_dashboard(struct MHD_Connection *c, req *r)
 #endif
 }
 
-/* ------------------------------------------------------------------ result-size bound */
-
-/* bytes of one grain in a 2D result with np contour points and these outputs */
-static double bytes_per_grain(const json_t *outputs, double np)
-{
-    double per = 400; /* stats, ids, areas, descriptors */
-    size_t k;
-    json_t *o;
-    json_array_foreach(outputs, k, o)
-    {
-        const char *w = json_string_value(o);
-        if (!w) continue;
-        if (!strcmp(w, "grains")) per += 40 * np;
-        else if (!strcmp(w, "odec")) per += 40 * np + 60 * 16;
-        else if (!strcmp(w, "descriptors")) per += 40 * np + 120;
-        else if (!strcmp(w, "cells")) per += 40 * 12 + 100;
-    }
-    return per;
-}
-
-/* the grains and contour points of a valid effective 2D spec, whatever the spelling of its
- * numbers (1e6 is 1000000); *pointer: the field that sets the count. 0, or -1 with msg */
-static int grains_2d(const json_t *eff, double *n, double *np, const char **pointer, char *msg,
-                     size_t msglen)
-{
-#ifdef GPD_HAVE_SCHEMA
-    gp_spec2d s;
-    gp_spec_problem prob;
-    if (gp_spec_parse_2d(eff, &s, &prob) != 0) {
-        snprintf(msg, msglen, "the effective spec does not parse: %.400s", prob.message);
-        return -1;
-    }
-    size_t cells = s.particles;
-    double area = 0;
-    gp_error err;
-    memset(&err, 0, sizeof err);
-    int rc = 0;
-    if (s.size_law == GP_LAW_SIEVE) {
-        *pointer = "/size/sieve";
-        if (gp_spec2d_cell_count(&s, &area, &cells, &err) != GP_OK) {
-            snprintf(msg, msglen, "the cell count of a valid spec failed: %s", err.message);
-            rc = -1;
-        }
-    }
-    *n = (double)cells;
-    *np = (double)s.contour_points;
-    gp_spec_2d_free(&s);
-    return rc;
-#else
-    *n = json_number_value(json_object_get(eff, "particles"));
-    *np = json_number_value(json_object_get(eff, "contour_points"));
-    if (*np <= 0) *np = 128;
-    return 0;
-#endif
-}
-
-/* bounds the memory of one job by an estimate of its result's size: 0 within the limit, 1 over
- * it (msg and *pointer say why), -1 internal error (msg) */
-static int result_too_large_2d(const json_t *eff, char *msg, size_t msglen, const char **pointer)
-{
-    double n = 0, np = 0;
-    if (grains_2d(eff, &n, &np, pointer, msg, msglen)) return -1;
-    double mb = n * bytes_per_grain(json_object_get(eff, "outputs"), np) / 1e6;
-    if (mb <= max_result_mb) return 0;
-    snprintf(msg, msglen,
-             "%s: the result would be about %.0f MB (%.0f grains), over this server's limit of "
-             "%.0f MB (--max-result-mb); ask for fewer %s, contour_points or outputs",
-             *pointer, mb, n, max_result_mb,
-             strcmp(*pointer, "/particles") ? "grains (a smaller container or coarser sieve)"
-                                            : "particles");
-    return 1;
-}
-
 static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
 {
     if (r->len == 0)
@@ -387,16 +314,16 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
                           "/kind: \"spheres-3d\" is not available in this build yet");
     }
 #endif
-    if (!strcmp(kind, "fourier-voronoi-2d")) {
-        char msg[512];
-        const char *pointer = "/particles";
-        int big = result_too_large_2d(eff, msg, sizeof msg, &pointer);
-        if (big) {
-            json_decref(eff);
-            if (big < 0) return send_error(c, r, 500, "internal", NULL, "%s", msg);
-            return send_error(c, r, 422, "too_large", pointer, "%s", msg);
-        }
+#ifdef GPD_HAVE_SCHEMA
+    /* the result bound of both kinds, from the spec's numbers whatever their spelling */
+    if (gp_spec_check_result(eff, max_result_mb * 1e6, &prob)) {
+        json_decref(eff);
+        if (prob.http_status >= 500)
+            return send_error(c, r, 500, "internal", NULL, "%s", prob.message);
+        return send_error(c, r, 422, prob.code[0] ? prob.code : "too_large", prob.pointer, "%s",
+                          prob.message);
     }
+#endif
     char *text = json_dumps(eff, JSON_COMPACT);
     char id[33];
     store_rc rc = text ? store_insert(kind, text, id) : STORE_ERROR;

@@ -59,6 +59,12 @@ def test_spec_errors(env):
         # ~700,000 grains of 1-1.2 mm: within particles' bound, but the result is too large
         ("sieve result", dict(sieve_2d, contour_points=512, size=dict(
             sieve_2d["size"], sieve=[[1, 0], [1.2, 100]])), 422, "too_large", "/size/sieve"),
+        # 3D results are bounded too: ~3.5M tiled spheres with their contacts (~2.2 GB)
+        ("3D result", dict(gpd.SMALL_3D, box=[0.015] * 3, tiling=[16, 16, 16]), 422,
+         "too_large", "/tiling"),
+        # ... and the same bound read from a real spelling of the tiling
+        ("3D result, 16.0", json.dumps(dict(gpd.SMALL_3D, box=[0.015] * 3, tiling="T")).replace(
+            '"T"', "[16.0, 1.6e1, 16]").encode(), 422, "too_large", "/tiling"),
         # E3's floor at 20 cells is above 0.002: refused at submit, not failed in the queue
         ("E3 floor", dict(base, particles=20, imc={"error": "E3", "threshold": 0.002}), 422,
          "invalid_spec", "/imc/threshold"),
