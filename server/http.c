@@ -20,6 +20,7 @@
 #include <microhttpd.h>
 
 #include "gp_export.h"
+#include "offload.h"
 #include "store.h"
 #include "workers.h"
 #ifdef GPD_HAVE_SCHEMA
@@ -58,6 +59,12 @@ typedef struct req {
     char url[128];
     char acao[256];  /* an accepted Origin, echoed in Access-Control-Allow-Origin */
     double t0;
+    /* offloaded requests (offload.h): the connection is suspended while a pool thread runs
+     * the handler; its response is kept here until the connection is resumed */
+    int offloaded;
+    struct MHD_Connection *conn;
+    enum MHD_Result (*handler)(struct MHD_Connection *, struct req *);
+    struct MHD_Response *resp;
 } req;
 
 /* *con_cls before the access handler has run: the length of the request target (on_uri) */
@@ -88,6 +95,21 @@ static void std_headers(struct MHD_Response *resp, const req *r, const char *cty
 
 /* ------------------------------------------------------------------ responses */
 
+/* Queues resp on c, or keeps it in r while r runs on a pool thread (libmicrohttpd takes a
+ * response only from within its access handler: on_request queues it once resumed) */
+static enum MHD_Result queue_response(struct MHD_Connection *c, req *r, unsigned status,
+                                      struct MHD_Response *resp)
+{
+    if (r) r->status = (int)status;
+    if (r && r->offloaded) {
+        r->resp = resp;
+        return MHD_YES;
+    }
+    enum MHD_Result ret = MHD_queue_response(c, status, resp);
+    MHD_destroy_response(resp);
+    return ret;
+}
+
 static enum MHD_Result send_buf(struct MHD_Connection *c, req *r, unsigned status,
                                 const char *ctype, char *buf, size_t len,
                                 enum MHD_ResponseMemoryMode mode, const char *allow)
@@ -99,10 +121,7 @@ static enum MHD_Result send_buf(struct MHD_Connection *c, req *r, unsigned statu
     }
     std_headers(resp, r, ctype);
     if (allow) MHD_add_response_header(resp, MHD_HTTP_HEADER_ALLOW, allow);
-    if (r) r->status = (int)status;
-    enum MHD_Result ret = MHD_queue_response(c, status, resp);
-    MHD_destroy_response(resp);
-    return ret;
+    return queue_response(c, r, status, resp);
 }
 
 static enum MHD_Result send_json_hdr(struct MHD_Connection *c, req *r, unsigned status,
@@ -132,10 +151,7 @@ static enum MHD_Result send_json_hdr(struct MHD_Connection *c, req *r, unsigned 
     }
     std_headers(resp, r, "application/json");
     if (hname) MHD_add_response_header(resp, hname, hval);
-    if (r) r->status = (int)status;
-    enum MHD_Result ret = MHD_queue_response(c, status, resp);
-    MHD_destroy_response(resp);
-    return ret;
+    return queue_response(c, r, status, resp);
 }
 
 static enum MHD_Result send_json(struct MHD_Connection *c, req *r, unsigned status, json_t *j)
@@ -1066,6 +1082,30 @@ static enum MHD_Result method_not_allowed(struct MHD_Connection *c, req *r, cons
                             "%s is not allowed on %s; allowed: %s", method, url, allow);
 }
 
+/* runs r's handler on a pool thread, then wakes its connection */
+static void run_offloaded(void *arg)
+{
+    req *r = arg;
+    if (r->handler(r->conn, r) != MHD_YES && !r->resp) r->status = -1; /* close it */
+    MHD_resume_connection(r->conn);
+}
+
+/* Answers r by h off the HTTP threads (offload.h): the connection is suspended until the
+ * response is ready, and on_request queues it. Where the pool does not take it (shutting
+ * down), h runs here. */
+static enum MHD_Result offload(struct MHD_Connection *c, req *r,
+                               enum MHD_Result (*h)(struct MHD_Connection *, req *))
+{
+    r->conn = c;
+    r->handler = h;
+    r->offloaded = 1;
+    MHD_suspend_connection(c);
+    if (gpd_offload_submit(run_offloaded, r) == 0) return MHD_YES;
+    MHD_resume_connection(c);
+    r->offloaded = 0;
+    return h(c, r);
+}
+
 static enum MHD_Result route(struct MHD_Connection *c, req *r, const char *url,
                              const char *method)
 {
@@ -1090,7 +1130,8 @@ static enum MHD_Result route(struct MHD_Connection *c, req *r, const char *url,
         return h_schema(c, r);
     }
     if (!strcmp(path, "/v1/jobs")) {
-        if (!strcmp(method, "POST")) return h_submit(c, r);
+        /* parsing and validating a body costs CPU in proportion to it: off the HTTP threads */
+        if (!strcmp(method, "POST")) return offload(c, r, h_submit);
         if (is_get(method)) return h_list(c, r);
         return method_not_allowed(c, r, method, path, "GET, HEAD, POST");
     }
@@ -1190,6 +1231,16 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         r->len += n;
         return MHD_YES;
     }
+    if (r->offloaded) {
+        /* resumed: the pool thread's response, or none (out of memory): close */
+        struct MHD_Response *resp = r->resp;
+        r->resp = NULL;
+        r->offloaded = 0;
+        if (!resp) return MHD_NO;
+        enum MHD_Result ret = MHD_queue_response(c, (unsigned)r->status, resp);
+        MHD_destroy_response(resp);
+        return ret;
+    }
     if (r->refused) return MHD_YES; /* answered at the first call */
     if (r->too_big)
         return send_error(c, r, 413, "payload_too_large", NULL,
@@ -1224,6 +1275,7 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
                 1e3 * (gpd_monotonic_s() - r->t0),
                 toe == MHD_REQUEST_TERMINATED_COMPLETED_OK ? "" : " (aborted)");
     }
+    if (r->resp) MHD_destroy_response(r->resp);
     free(r->body);
     free(r);
     *con_cls = NULL;
@@ -1326,7 +1378,12 @@ int gpd_http_start(const gpd_http_config *cfg)
     started_at = gpd_monotonic_s();
     setup_names(cfg);
     build_dashboard_csp();
-    unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_ERROR_LOG | MHD_USE_AUTO | MHD_USE_ITC;
+    if (gpd_offload_start(cfg->threads) != 0) {
+        gpd_log(GPD_LOG_ERROR, "cannot start the request pool");
+        return -1;
+    }
+    unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_ERROR_LOG | MHD_USE_AUTO |
+                     MHD_USE_ITC | MHD_ALLOW_SUSPEND_RESUME;
     daemon_ = MHD_start_daemon(
         flags, 0, NULL, NULL, &on_request, NULL, MHD_OPTION_EXTERNAL_LOGGER, &mhd_log, NULL,
         MHD_OPTION_LISTEN_SOCKET, cfg->listen_fd,
@@ -1340,6 +1397,7 @@ int gpd_http_start(const gpd_http_config *cfg)
         &on_completed, NULL, MHD_OPTION_END);
     if (!daemon_) {
         gpd_log(GPD_LOG_ERROR, "cannot start the HTTP server");
+        gpd_offload_stop();
         return -1;
     }
     return 0;
@@ -1348,8 +1406,12 @@ int gpd_http_start(const gpd_http_config *cfg)
 void gpd_http_stop(void)
 {
     if (!daemon_) return;
-    MHD_socket fd = MHD_quiesce_daemon(daemon_);
+    /* every suspended connection is resumed (its task run) before the daemon stops; not
+     * MHD_quiesce_daemon: in libmicrohttpd 0.9.75 it races with a pool thread that removes
+     * the listening socket from its epoll set on its own, and aborts the process ("Failed to
+     * remove listen FD from epoll set", seen in it_test_bad_inputs under ASan).
+     * MHD_stop_daemon closes the listening socket. */
+    gpd_offload_stop();
     MHD_stop_daemon(daemon_);
     daemon_ = NULL;
-    if (fd != MHD_INVALID_SOCKET) close(fd);
 }
