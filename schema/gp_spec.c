@@ -1653,6 +1653,35 @@ static int cell_count_2d(const gp_spec2d *s, size_t *n, gp_spec_problem *p)
     return s->size_law == GP_LAW_SIEVE ? check_sieve_count(s, area, *n, p) : 0;
 }
 
+/* Seeds are placed uniformly in the container by rejection in its bounding box (gp_imc): n /
+ * fill draws on average, fill = the container's area over its box's. A sliver such as
+ * [[0,0],[1,1],[1,1.00000002]] fills 1e-8 of its box, and 10 seeds would take 1e9 draws
+ * (a minute); refused at submit rather than failed or timed out in the queue. */
+#define MAX_SEED_DRAWS 1e8
+
+static int check_seed_draws_2d(const gp_spec2d *s, size_t n, gp_spec_problem *p)
+{
+    if (s->container != GP_CONTAINER_POLYGON) return 0;
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    for (size_t k = 0; k < s->outer.n; k++) {
+        x0 = fmin(x0, s->outer.pts[k].x);
+        x1 = fmax(x1, s->outer.pts[k].x);
+        y0 = fmin(y0, s->outer.pts[k].y);
+        y1 = fmax(y1, s->outer.pts[k].y);
+    }
+    double area = fabs(ring_area(s->outer.pts, s->outer.n));
+    for (size_t h = 0; h < s->nholes; h++) area -= fabs(ring_area(s->holes[h].pts, s->holes[h].n));
+    double fill = area / ((x1 - x0) * (y1 - y0));
+    double draws = (double)n / fill;
+    if (draws <= MAX_SEED_DRAWS) return 0;
+    set_problem(p, 422, "/container/polygon",
+                "the container fills %.3g of its bounding box: placing %zu seeds uniformly in it "
+                "(by rejection in that box) would take about %.3g draws, over the limit of %.0e; "
+                "a sliver this thin cannot hold a specimen (fill at least %.3g for %zu cells)",
+                fill, n, draws, MAX_SEED_DRAWS, (double)n / MAX_SEED_DRAWS, n);
+    return -1;
+}
+
 /* v rounded up, as short text that reads back >= v (v > 0) */
 static void fmt_up(char *buf, size_t n, double v)
 {
@@ -1732,7 +1761,7 @@ static int parse_2d_full(const json_t *full, gp_spec2d *out, gp_spec_problem *p,
     if (cell_count_2d(out, &n, p)) return -1;
     if (ncells) *ncells = n;
     if (!checks) return 0;
-    if (check_threshold_2d(out, n, p)) return -1;
+    if (check_seed_draws_2d(out, n, p) || check_threshold_2d(out, n, p)) return -1;
     gp_spec_bounds_t b;
     bounds_2d(out, n, &b);
     char what[200];

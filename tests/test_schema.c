@@ -1037,6 +1037,30 @@ static void test_work_bounds_3d(void)
     json_decref(j);
 }
 
+/* seeds are placed by rejection in the container's bounding box: n / fill draws. The issue's
+ * sliver fills 1e-8 of its box (area 1e-8 over a unit box): 10 seeds, 1e9 draws, refused; a
+ * sliver of fill 1e-6 holds 10 seeds (1e7 draws) but not 200 (2e8) */
+static void test_seed_draws(void)
+{
+    const char *B = "{\"kind\": \"fourier-voronoi-2d\", \"particles\": 10}";
+    expect_bad_code(B, "/container", "{\"polygon\": [[0,0],[1,1],[1,1.00000002]]}",
+                    "/container/polygon", 422, "invalid_spec", "fills 1e-08 of its bounding box",
+                    __LINE__);
+    json_t *doc = patched(B, "/container", "{\"polygon\": [[0,0],[1,1],[1,1.000002]]}");
+    gp_spec_problem p;
+    CHECK(gp_spec_validate(doc, &p) == 0);
+    json_decref(doc);
+    const char *B200 = "{\"kind\": \"fourier-voronoi-2d\", \"particles\": 200}";
+    expect_bad_code(B200, "/container", "{\"polygon\": [[0,0],[1,1],[1,1.000002]]}",
+                    "/container/polygon", 422, "invalid_spec", "about 2e+08 draws", __LINE__);
+    /* a hole that leaves a thin frame: the fill counts the holes out */
+    expect_bad_code(B, "/container",
+                    "{\"polygon\": [[0,0],[1,0],[1,1],[0,1]], \"holes\": "
+                    "[[[1e-9,1e-9],[1e-9,0.999999999],[0.999999999,0.999999999],"
+                    "[0.999999999,1e-9]]]}",
+                    "/container/polygon", 422, "invalid_spec", "bounding box", __LINE__);
+}
+
 int main(int argc, char **argv)
 {
     g_verbose = argc > 1;
@@ -1054,5 +1078,6 @@ int main(int argc, char **argv)
     test_polygon_sweep();
     test_work_bounds_2d();
     test_work_bounds_3d();
+    test_seed_draws();
     return gp_test_summary();
 }

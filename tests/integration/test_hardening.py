@@ -6,7 +6,8 @@ Where each case of the list is tested:
   1 a count spelled as a real (1e6)       here (test_submit_refusals) and test_bad_inputs
   2 a 3D job that would run for weeks     here: young 1e25 and 1e300, density 1e300, 100 m box
   3 a 1 MB zigzag body                    here (test_health_under_zigzag_posts), bench_validate
-  4 phases that cannot be cancelled       test_cancel_phases (every phase, the sliver, SIGTERM)
+  4 phases that cannot be cancelled       test_cancel_phases (every phase, SIGTERM; the sliver:
+                                          refused at submit, a thinner one cancelled in seeding)
   5 origin and Host                       test_origin
   6 memory past the bound                 here (3D result bound), bench/bench_svg.py
   7 store errors                          test_limits (too big, disk full)
