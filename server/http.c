@@ -39,6 +39,7 @@
 #endif
 
 #define LIST_DEFAULT_LIMIT 50
+#define HEALTH_WRITE_WINDOW_S 300.0
 #define LIST_MAX_LIMIT 500
 
 static struct MHD_Daemon *daemon_ = NULL;
@@ -251,7 +252,18 @@ static enum MHD_Result h_health(struct MHD_Connection *c, req *r)
                         json_pack("{s:I, s:I, s:I, s:I, s:I}", "queued", (json_int_t)q,
                                   "running", (json_int_t)run, "succeeded", (json_int_t)su,
                                   "failed", (json_int_t)f, "cancelled", (json_int_t)ca));
-    json_object_set_new(j, "database", json_string(rc == STORE_OK ? "ok" : "error"));
+    /* reads pass while writes may fail (a full disk): a failed write in the last 5 minutes
+     * makes the daemon "degraded" (still 200: it serves what it has; 503 when reads fail) */
+    char wmsg[256], wat[40];
+    long wcount = 0;
+    int werr = store_last_write_error(HEALTH_WRITE_WINDOW_S, wmsg, sizeof wmsg, wat, &wcount);
+    const char *db = rc != STORE_OK ? "error" : werr ? "write_failed" : "ok";
+    json_object_set_new(j, "database", json_string(db));
+    if (werr)
+        json_object_set_new(j, "database_error",
+                            json_pack("{s:s, s:s, s:I}", "message", wmsg, "at", wat, "count",
+                                      (json_int_t)wcount));
+    if (rc == STORE_OK && werr) json_object_set_new(j, "status", json_string("degraded"));
     return send_json(c, r, rc == STORE_OK ? 200 : 503, j);
 }
 

@@ -372,6 +372,39 @@ static void done(sqlite3_stmt *st)
     sqlite3_finalize(st);
 }
 
+/* ---- the last failed write, for /v1/health ---- */
+static pthread_mutex_t werr_mu = PTHREAD_MUTEX_INITIALIZER;
+static struct {
+    long count;
+    double when; /* gpd_monotonic_s */
+    char at[40];
+    char msg[256];
+} werr;
+
+static void note_write_error(const char *what, const char *msg)
+{
+    pthread_mutex_lock(&werr_mu);
+    werr.count++;
+    werr.when = gpd_monotonic_s();
+    gpd_now_rfc3339(werr.at, sizeof werr.at);
+    snprintf(werr.msg, sizeof werr.msg, "%s: %s", what, msg);
+    pthread_mutex_unlock(&werr_mu);
+}
+
+int store_last_write_error(double window_s, char *msg, size_t msg_len, char at[40],
+                           long *count)
+{
+    pthread_mutex_lock(&werr_mu);
+    int recent = werr.count > 0 && gpd_monotonic_s() - werr.when <= window_s;
+    if (recent) {
+        snprintf(msg, msg_len, "%s", werr.msg);
+        snprintf(at, 40, "%s", werr.at);
+        *count = werr.count;
+    }
+    pthread_mutex_unlock(&werr_mu);
+    return recent;
+}
+
 /* Returns SQLite's code: SQLITE_OK, or e.g. SQLITE_TOOBIG (the parameter is then NULL, so a
  * write must not go on). */
 static int bind_text(sqlite3_stmt *st, int i, const char *s)
@@ -385,6 +418,7 @@ static int step_done(sqlite3 *db, sqlite3_stmt *st)
     int rc = sqlite3_step(st);
     if (rc != SQLITE_DONE && rc != SQLITE_ROW) {
         gpd_log(GPD_LOG_ERROR, "sqlite step: %s", sqlite3_errmsg(db));
+        if (!sqlite3_stmt_readonly(st)) note_write_error("a job update", sqlite3_errmsg(db));
         return -1;
     }
     return 0;
@@ -662,7 +696,10 @@ store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts)
     } else if (s == SQLITE_DONE) {
         rc = STORE_NOT_FOUND;
     }
-    if (rc == STORE_ERROR) gpd_log(GPD_LOG_ERROR, "sqlite claim: %s", sqlite3_errmsg(db));
+    if (rc == STORE_ERROR) {
+        gpd_log(GPD_LOG_ERROR, "sqlite claim: %s", sqlite3_errmsg(db));
+        note_write_error("claiming a job", sqlite3_errmsg(db));
+    }
     done(st);
     return rc;
 }
@@ -861,6 +898,7 @@ store_rc store_succeed(const char *id, const char *result_json, const char *prog
                  em && strcmp(em, sqlite3_errstr(src)) ? ": " : "",
                  em && strcmp(em, sqlite3_errstr(src)) ? em : "");
         gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result: %s", id, why);
+        if (rc != STORE_TOOBIG) note_write_error("storing a result", why);
     }
     if (!sqlite3_get_autocommit(db) && sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK)
         gpd_log(GPD_LOG_ERROR, "sqlite rollback: %s", sqlite3_errmsg(db));

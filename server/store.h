@@ -100,6 +100,13 @@ json_t *store_list(const char *status, int limit, const char *after, store_rc *r
 store_rc store_counts(long *queued, long *running, long *succeeded, long *failed,
                       long *cancelled);
 
+/* The last failed write (any SQLite error on a statement that writes, a failed commit of a
+ * result): 1 and its message, time (RFC 3339) and how many writes have failed since the start,
+ * or 0 when none has failed within the last window_s seconds. A write that succeeds does not
+ * clear it: on a nearly full disk small updates pass while results fail. */
+int store_last_write_error(double window_s, char *msg, size_t msg_len, char at[40],
+                           long *count);
+
 /* Atomically claims the oldest queued job: status running, started_at now, attempts+1.
  * Returns STORE_OK and malloc'ed id/kind/spec, STORE_NOT_FOUND when the queue is empty. */
 store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts);

@@ -4,6 +4,7 @@ second daemon on the same database refuses to start, the first keeps working), a
 the database cannot store (too big, or the disk full) fails its job with a reason instead of
 committing "succeeded" without a result or staying "running"."""
 import datetime
+import json
 import os
 import subprocess
 import sys
@@ -168,6 +169,8 @@ def test_result_too_big_fails(env):
     assert st == 409, (st, b)
     _, h = health_latency(d)
     assert h["running"] == 0 and h["workers_busy"] == 0, h
+    # a result over SQLite's value limit is the job's problem, not the database's
+    assert h["status"] == "ok" and h["database"] == "ok", h
     assert d.stop() == 0, d.read_log()
 
 
@@ -188,6 +191,11 @@ def test_disk_full_fails_visibly(env):
     assert d.json("GET", "/v1/jobs/%s/result" % jid)[0] == 409
     _, h = health_latency(d)
     assert h["running"] == 0 and h["workers_busy"] == 0, h
+    # health says that writes fail, though reads (and the small status update) pass
+    assert h["status"] == "degraded" and h["database"] == "write_failed", h
+    we = h["database_error"]
+    assert "full" in we["message"] and we["count"] >= 2, we
+    print("  health: %s" % json.dumps(we))
     assert d.stop() == 0, d.read_log()
 
 
