@@ -7,7 +7,7 @@
  * refused, at most GP_FUZZ_SPEC_MAX_INPUT bytes):
  *   - gp_spec_validate and gp_spec_with_defaults agree (same verdict, same problem), and a
  *     problem is well formed (status 400/422/500, a known code, an RFC 6901 pointer, a message);
- *   - gp_spec_parse_2d / gp_spec_parse_3d of the spec's kind succeed exactly when it is valid;
+ *   - gp_spec2d_read / gp_spec3d_read of the spec's kind succeed exactly when it is valid;
  *     the other kind's parser refuses it with 400 at /kind;
  *   - for a valid spec: the parsed struct holds what the core relies on (a polygon of >= 3
  *     points or a circle of positive radius, a cell count or a sieve of >= 2 rows, a spectrum
@@ -142,14 +142,14 @@ static int gp_fuzz_parse(const json_t *spec, int k, gp_spec_problem *p, const ch
     int rc;
     if (k == 0) {
         gp_spec2d s;
-        rc = gp_spec_parse_2d(spec, &s, p);
+        rc = gp_spec2d_read(spec, &s, p);
         if (rc == 0 && !*broken) *broken = gp_fuzz_check_2d(&s);
-        gp_spec_2d_free(&s);
+        gp_spec2d_free(&s);
     } else {
         gp_spec3d s;
-        rc = gp_spec_parse_3d(spec, &s, p);
+        rc = gp_spec3d_read(spec, &s, p);
         if (rc == 0 && !*broken) *broken = gp_fuzz_check_3d(&s);
-        gp_spec_3d_free(&s);
+        gp_spec3d_free(&s);
     }
     return rc;
 }

@@ -1390,7 +1390,7 @@ static int read_ring(const json_t *arr, gp_ring *r)
     return 0;
 }
 
-void gp_spec_2d_free(gp_spec2d *s)
+void gp_spec2d_free(gp_spec2d *s)
 {
     if (!s) return;
     free(s->outer.pts);
@@ -1778,11 +1778,11 @@ static int semantic_2d(const json_t *full, gp_spec_problem *p)
 {
     gp_spec2d tmp;
     int rc = parse_2d_full(full, &tmp, p, 1, NULL);
-    gp_spec_2d_free(&tmp);
+    gp_spec2d_free(&tmp);
     return rc;
 }
 
-int gp_spec_parse_2d(const json_t *spec, gp_spec2d *out, gp_spec_problem *p)
+int gp_spec2d_read(const json_t *spec, gp_spec2d *out, gp_spec_problem *p)
 {
     gp_spec_problem local;
     if (!p) p = &local;
@@ -1797,7 +1797,7 @@ int gp_spec_parse_2d(const json_t *spec, gp_spec2d *out, gp_spec_problem *p)
     else
         rc = parse_2d_full(full, out, p, 1, NULL);
     json_decref(full);
-    if (rc) gp_spec_2d_free(out);
+    if (rc) gp_spec2d_free(out);
     return rc;
 }
 
@@ -1988,7 +1988,7 @@ int gp_spec_bounds(const json_t *effective_spec, gp_spec_bounds_t *out, gp_spec_
         size_t n = 0;
         int rc = parse_2d_full(effective_spec, &s, p, 0, &n);
         if (rc == 0) bounds_2d(&s, n, out);
-        gp_spec_2d_free(&s);
+        gp_spec2d_free(&s);
         return rc;
     }
     case 1:
@@ -2064,14 +2064,14 @@ static int semantic_3d(const json_t *full, gp_spec_problem *p)
 /* ------------------------------------------------------------------------------------------ */
 /* 3D parser */
 
-void gp_spec_3d_free(gp_spec3d *s)
+void gp_spec3d_free(gp_spec3d *s)
 {
     if (!s) return;
     free((gp_sieve_row *)s->sieve);
     memset(s, 0, sizeof *s);
 }
 
-int gp_spec_parse_3d(const json_t *spec, gp_spec3d *out, gp_spec_problem *p)
+int gp_spec3d_read(const json_t *spec, gp_spec3d *out, gp_spec_problem *p)
 {
     gp_spec_problem local;
     if (!p) p = &local;

@@ -85,16 +85,16 @@ json_t *gp_spec_with_defaults(const json_t *spec, gp_spec_problem *p);
  * (out->threads is set to 0: the caller picks; out->particles is 0 with a sieve law, whose
  * sieve_d are in metres, converted from size.sieve_units). Returns 0 on success; *out then
  * owns its arrays (outer.pts, holes[*].pts, holes, spectrum, sieve_d, sieve_pass) and must be
- * released with gp_spec_2d_free(). On failure returns -1, fills *p, and *out owns nothing
+ * released with gp_spec2d_free(). On failure returns -1, fills *p, and *out owns nothing
  * (freeing it is still allowed). */
-int gp_spec_parse_2d(const json_t *spec, gp_spec2d *out, gp_spec_problem *p);
-void gp_spec_2d_free(gp_spec2d *s);
+int gp_spec2d_read(const json_t *spec, gp_spec2d *out, gp_spec_problem *p);
+void gp_spec2d_free(gp_spec2d *s);
 
 /* The same for kind "spheres-3d": sieve diameters converted to metres (sieve_units), tiling
  * {1, 1, 1} when absent; threads, max_steps and tile_relax_steps are set to 0 (the caller
- * picks). *out owns its sieve array; release with gp_spec_3d_free(). */
-int gp_spec_parse_3d(const json_t *spec, gp_spec3d *out, gp_spec_problem *p);
-void gp_spec_3d_free(gp_spec3d *s);
+ * picks). *out owns its sieve array; release with gp_spec3d_free(). */
+int gp_spec3d_read(const json_t *spec, gp_spec3d *out, gp_spec_problem *p);
+void gp_spec3d_free(gp_spec3d *s);
 
 /* ---- work and result bounds (api.md "Limits and origin") ---- */
 

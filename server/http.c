@@ -318,7 +318,7 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
     eff = gp_spec_with_defaults(spec, &prob);
     json_decref(spec);
     if (!eff) {
-        if (prob.http_status >= 500)
+        if (!strcmp(prob.code, "internal"))
             return send_error(c, r, 500, prob.code[0] ? prob.code : "internal", NULL, "%s",
                               prob.message);
         /* every spec problem is a 422, invalid_spec (or too_large: a sieve law that derives
@@ -346,7 +346,7 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
     /* the result bound of both kinds, from the spec's numbers whatever their spelling */
     if (gp_spec_check_result(eff, max_result_mb * 1e6, &prob)) {
         json_decref(eff);
-        if (prob.http_status >= 500)
+        if (!strcmp(prob.code, "internal"))
             return send_error(c, r, 500, "internal", NULL, "%s", prob.message);
         return send_error(c, r, 422, prob.code[0] ? prob.code : "too_large", prob.pointer, "%s",
                           prob.message);

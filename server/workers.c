@@ -459,8 +459,8 @@ static void run_2d(slot *s, const char *id, json_t *spec_json)
     gp_spec2d spec;
     gp_spec_problem prob;
     memset(&prob, 0, sizeof prob);
-    if (gp_spec_parse_2d(spec_json, &spec, &prob) != 0) {
-        gp_spec_2d_free(&spec);
+    if (gp_spec2d_read(spec_json, &spec, &prob) != 0) {
+        gp_spec2d_free(&spec);
         finish_failed(id, "invalid_spec", prob.message);
         return;
     }
@@ -480,7 +480,7 @@ static void run_2d(slot *s, const char *id, json_t *spec_json)
         if (!r || __atomic_load_n(&s->cancel, __ATOMIC_RELAXED)) { /* (r: partial) */
             reap_later(r);
             gp_specimen2d_destroy(out);
-            gp_spec_2d_free(&spec);
+            gp_spec2d_free(&spec);
             result_not_built(&ctx);
             return;
         }
@@ -500,7 +500,7 @@ static void run_2d(slot *s, const char *id, json_t *spec_json)
         if (out) gp_specimen2d_destroy(out);
         finish_not_ok(&ctx, st, &err, NULL);
     }
-    gp_spec_2d_free(&spec);
+    gp_spec2d_free(&spec);
 #else
     (void)s;
     (void)spec_json;
@@ -514,8 +514,8 @@ static void run_3d(slot *s, const char *id, json_t *spec_json)
     gp_spec3d spec;
     gp_spec_problem prob;
     memset(&prob, 0, sizeof prob);
-    if (gp_spec_parse_3d(spec_json, &spec, &prob) != 0) {
-        gp_spec_3d_free(&spec);
+    if (gp_spec3d_read(spec_json, &spec, &prob) != 0) {
+        gp_spec3d_free(&spec);
         finish_failed(id, "invalid_spec", prob.message);
         return;
     }
@@ -533,7 +533,7 @@ static void run_3d(slot *s, const char *id, json_t *spec_json)
         if (!r || __atomic_load_n(&s->cancel, __ATOMIC_RELAXED)) { /* (r: partial) */
             reap_later(r);
             gp_specimen3d_destroy(out);
-            gp_spec_3d_free(&spec);
+            gp_spec3d_free(&spec);
             result_not_built(&ctx);
             return;
         }
@@ -553,7 +553,7 @@ static void run_3d(slot *s, const char *id, json_t *spec_json)
         if (out) gp_specimen3d_destroy(out);
         finish_not_ok(&ctx, st, &err, extra);
     }
-    gp_spec_3d_free(&spec);
+    gp_spec3d_free(&spec);
 #else
     (void)s;
     (void)spec_json;

@@ -96,9 +96,9 @@ static void expect_bad_code(const char *base, const char *ptr, const char *value
     if (strstr(base, "fourier")) {
         gp_spec2d s;
         gp_spec_problem q;
-        CHECK(gp_spec_parse_2d(doc, &s, &q) != 0);
+        CHECK(gp_spec2d_read(doc, &s, &q) != 0);
         CHECK(!strcmp(q.pointer, p.pointer));
-        gp_spec_2d_free(&s);
+        gp_spec2d_free(&s);
     }
     json_decref(doc);
 }
@@ -129,7 +129,7 @@ static void test_examples(void)
     gp_spec_problem p;
     CHECK(gp_spec_validate(j, &p) == 0);
     gp_spec2d s;
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     CHECK(s.seed == 42);
     CHECK(s.container == GP_CONTAINER_POLYGON);
     CHECK(s.outer.n == 4);
@@ -157,7 +157,7 @@ static void test_examples(void)
     CHECK(s.imc_classes == 0);
     CHECK(s.contour_points == 128);
     CHECK(s.outputs == (GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS | GP_OUT_CELLS));
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
     CHECK(s.outer.pts == NULL);
     json_decref(j);
 
@@ -168,7 +168,7 @@ static void test_examples(void)
     CHECK(json_equal(full, j)); /* every field was given */
     json_decref(full);
     gp_spec3d t;
-    CHECK(gp_spec_parse_3d(j, &t, &p) == 0);
+    CHECK(gp_spec3d_read(j, &t, &p) == 0);
     CHECK(t.seed == 7);
     CHECK_NEAR(t.box[0], 0.5, 0);
     CHECK_NEAR(t.box[2], 0.5, 0);
@@ -185,27 +185,27 @@ static void test_examples(void)
     CHECK_NEAR(t.material.damping, 0.2, 0);
     CHECK(t.tiling[0] == 4 && t.tiling[1] == 4 && t.tiling[2] == 4);
     CHECK(t.outputs == (GP_OUT3_SPHERES | GP_OUT3_CONTACTS | GP_OUT3_FABRIC | GP_OUT3_STRESS));
-    gp_spec_3d_free(&t);
+    gp_spec3d_free(&t);
     CHECK(t.sieve == NULL);
     json_decref(j);
 
     /* defaults and metres */
     j = load("{\"kind\": \"spheres-3d\", \"sieve\": [[0.01, 0], [0.02, 100]], \"sieve_units\": \"m\"}");
-    CHECK(gp_spec_parse_3d(j, &t, &p) == 0);
+    CHECK(gp_spec3d_read(j, &t, &p) == 0);
     CHECK_NEAR(t.sieve[1].diameter, 0.02, 0);
     CHECK(t.tiling[0] == 1 && t.tiling[1] == 1 && t.tiling[2] == 1);
     CHECK(t.outputs == GP_OUT3_SPHERES);
     CHECK_NEAR(t.box[1], 0.5, 0);
-    gp_spec_3d_free(&t);
+    gp_spec3d_free(&t);
     json_decref(j);
     /* a 2D spec is not a 3D one */
     j = load(EX2D);
-    CHECK(gp_spec_parse_3d(j, &t, &p) != 0 && !strcmp(p.pointer, "/kind"));
-    gp_spec_3d_free(&t);
+    CHECK(gp_spec3d_read(j, &t, &p) != 0 && !strcmp(p.pointer, "/kind"));
+    gp_spec3d_free(&t);
     json_decref(j);
     j = load("{\"kind\": \"spheres-3d\", \"porosity\": 2}");
-    CHECK(gp_spec_parse_3d(j, &t, &p) != 0 && !strcmp(p.pointer, "/porosity"));
-    gp_spec_3d_free(&t);
+    CHECK(gp_spec3d_read(j, &t, &p) != 0 && !strcmp(p.pointer, "/porosity"));
+    gp_spec3d_free(&t);
     json_decref(j);
 }
 
@@ -214,7 +214,7 @@ static void test_defaults(void)
     json_t *j = load("{\"kind\": \"fourier-voronoi-2d\"}");
     gp_spec_problem p;
     gp_spec2d s;
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     CHECK(s.seed == 0);
     CHECK(s.container == GP_CONTAINER_POLYGON && s.outer.n == 4 && s.nholes == 0);
     CHECK(s.particles == 100);
@@ -235,7 +235,7 @@ static void test_defaults(void)
     CHECK(s.contour_points == 128);
     CHECK(s.outputs == GP_OUT_GRAINS);
     CHECK(s.threads == 0);
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
 
     json_t *full = gp_spec_with_defaults(j, &p);
     CHECK(full && json_is_object(json_object_get(full, "imc")));
@@ -257,7 +257,7 @@ static void test_defaults(void)
     j = load("{\"kind\": \"fourier-voronoi-2d\", \"particles\": 120, \"imc\": {\"error\": \"E1\", \"classes\": 12},"
              " \"shape\": {\"D2\": 0.3}, \"container\": {\"circle\": {\"center\": [1, 2], \"radius\": 3}},"
              " \"seed\": 5.0}");
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     CHECK(s.imc_error == GP_IMC_E1 && s.imc_classes == 12);
     CHECK_NEAR(s.imc_threshold, 0.002, 0);
     CHECK_NEAR(s.D2, 0.3, 0);
@@ -268,23 +268,23 @@ static void test_defaults(void)
     CHECK_NEAR(s.circle_radius, 3, 0);
     CHECK(s.outer.pts == NULL);
     CHECK(s.seed == 5);
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
     json_decref(j);
 
     /* spectrum */
     j = load("{\"kind\": \"fourier-voronoi-2d\", \"shape\": {\"spectrum\": [1, 0, 0.2, 0.05, 0.01]}}");
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     CHECK(s.has_spectrum && s.nspectrum == 5);
     CHECK_NEAR(s.spectrum[2], 0.2, 0);
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
     json_decref(j);
 
     /* a hole, a closing point that repeats the first */
     j = load("{\"kind\": \"fourier-voronoi-2d\", \"container\": {\"polygon\": [[0,0],[4,0],[4,4],[0,4],[0,0]],"
              " \"holes\": [[[1,1],[1,2],[2,2],[2,1]], [[3,3],[3.5,3],[3.5,3.5]]]}}");
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     CHECK(s.outer.n == 4 && s.nholes == 2 && s.holes[0].n == 4 && s.holes[1].n == 3);
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
     json_decref(j);
 
     j = load("{\"kind\": \"spheres-3d\"}");
@@ -443,11 +443,11 @@ static void test_size_laws(void)
     json_t *j = patched(EX2D, "/size", "{\"law\": \"uniform\", \"cov\": 0.3, \"of\": \"grains\"}");
     gp_spec2d s;
     gp_spec_problem p;
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     CHECK(s.size_law == GP_LAW_UNIFORM && s.size_of_grains == 1 && s.particles == 500);
     CHECK_NEAR(s.cov, 0.3, 0);
     CHECK(s.nsieve == 0 && s.sieve_d == NULL);
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
     json_t *full = gp_spec_with_defaults(j, &p);
     CHECK(full && json_object_get(json_object_get(full, "size"), "sieve_units") == NULL);
     json_decref(full);
@@ -460,7 +460,7 @@ static void test_sieve_2d(void)
     gp_spec_problem p;
     gp_spec2d s;
     CHECK(gp_spec_validate(j, &p) == 0);
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     CHECK(s.size_law == GP_LAW_SIEVE);
     CHECK(s.particles == 0);          /* derived */
     CHECK(s.size_of_grains == 1);
@@ -474,7 +474,7 @@ static void test_sieve_2d(void)
     CHECK(gp_spec2d_cell_count(&s, &area, &n, NULL) == GP_OK);
     CHECK_NEAR(area, 1, 1e-12);
     CHECK(n > 500 && n < 5000);
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
     CHECK(s.sieve_d == NULL && s.sieve_pass == NULL);
 
     /* the effective spec invents neither particles nor cov; the sieve is a law of the grains */
@@ -492,9 +492,9 @@ static void test_sieve_2d(void)
     /* metres */
     j = patched(SV2D, "/size/sieve_units", "\"m\"");
     json_object_set_new(json_object_get(j, "size"), "sieve", load("[[0.01, 0], [0.02, 50], [0.04, 100]]"));
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     CHECK_NEAR(s.sieve_d[1], 0.02, 0);
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
     json_decref(j);
 
     /* fields that a sieve law excludes or needs; particles is checked as posted */
@@ -545,8 +545,8 @@ static void test_imc_threshold(void)
     CHECK(!strcmp(p.pointer, "/imc/threshold"));
     CHECK(strncmp(p.message, "/imc/threshold: 0.002 is below the least error ", 47) == 0);
     CHECK(strstr(p.message, "20 cells") && strstr(p.message, "the default error AD"));
-    CHECK(gp_spec_parse_2d(j, &s, &p) != 0 && !strcmp(p.pointer, "/imc/threshold"));
-    gp_spec_2d_free(&s);
+    CHECK(gp_spec2d_read(j, &s, &p) != 0 && !strcmp(p.pointer, "/imc/threshold"));
+    gp_spec2d_free(&s);
     if (g_verbose) fprintf(stderr, "%s\n", p.message);
     /* the floor itself, as the core computes it */
     gp_imc_params q;
@@ -569,10 +569,10 @@ static void test_imc_threshold(void)
     json_object_set_new(json_object_get(j, "imc"), "threshold", json_real(1e-6));
     CHECK(gp_spec_validate(j, &p) == 0);
     json_object_del(json_object_get(j, "imc"), "threshold");
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     CHECK(s.imc_error == GP_IMC_AD);
     CHECK_NEAR(s.imc_threshold, gp_imc_default_threshold(GP_IMC_ERROR_AD), 0);
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
     json_decref(j);
 
     /* the threshold default follows the kind, and the effective spec shows it */
@@ -585,8 +585,8 @@ static void test_imc_threshold(void)
         double want = gp_imc_default_threshold(k < 3 ? k + 1 : GP_IMC_ERROR_AD);
         CHECK_NEAR(json_number_value(json_object_get(json_object_get(full, "imc"), "threshold")), want, 0);
         CHECK_NEAR(want, k < 3 ? 0.002 : gp_imc_default_threshold(GP_IMC_ERROR_AD), 0);
-        CHECK(gp_spec_parse_2d(j, &s, &p) == 0 && (int)s.imc_error == (k < 3 ? k + 1 : GP_IMC_AD));
-        gp_spec_2d_free(&s);
+        CHECK(gp_spec2d_read(j, &s, &p) == 0 && (int)s.imc_error == (k < 3 ? k + 1 : GP_IMC_AD));
+        gp_spec2d_free(&s);
         json_decref(full);
         json_decref(j);
     }
@@ -607,11 +607,11 @@ static void test_imc_threshold(void)
     /* a sieve law: the floor of the derived count (7 classes: a count that 7 does not divide
      * has a floor > 0) */
     j = load(SV2D);
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     double area;
     size_t n = 0;
     CHECK(gp_spec2d_cell_count(&s, &area, &n, NULL) == GP_OK);
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
     q.error_kind = 2;
     q.threshold = 1e-9;
     q.classes_size = q.classes_orient = 7;
@@ -630,10 +630,10 @@ static void test_real_spelling(void)
     json_t *j = load("{\"kind\": \"fourier-voronoi-2d\", \"particles\": 1e6, \"contour_points\": 1.28e2}");
     gp_spec2d s;
     gp_spec_problem p;
-    CHECK(gp_spec_parse_2d(j, &s, &p) == 0);
+    CHECK(gp_spec2d_read(j, &s, &p) == 0);
     CHECK(s.particles == 1000000);
     CHECK(s.contour_points == 128);
-    gp_spec_2d_free(&s);
+    gp_spec2d_free(&s);
     json_decref(j);
     BAD2("/particles", "1.0000001e6", "/particles", 400, "[1, 1000000]");
 }
@@ -701,8 +701,8 @@ static void test_bad_3d(void)
     json_t *j = load(EX3D);
     gp_spec2d s;
     gp_spec_problem p;
-    CHECK(gp_spec_parse_2d(j, &s, &p) != 0 && !strcmp(p.pointer, "/kind"));
-    gp_spec_2d_free(&s);
+    CHECK(gp_spec2d_read(j, &s, &p) != 0 && !strcmp(p.pointer, "/kind"));
+    gp_spec2d_free(&s);
     json_decref(j);
 }
 
@@ -928,8 +928,8 @@ static void test_work_bounds_2d(void)
     CHECK(gp_spec_validate(k, &p) != 0 && !strcmp(p.code, "too_large") && !strcmp(p.pointer, "/container"));
     gp_spec2d s2;
     gp_spec_problem q;
-    CHECK(gp_spec_parse_2d(k, &s2, &q) != 0 && !strcmp(q.pointer, "/container")); /* the worker too */
-    gp_spec_2d_free(&s2);
+    CHECK(gp_spec2d_read(k, &s2, &q) != 0 && !strcmp(q.pointer, "/container")); /* the worker too */
+    gp_spec2d_free(&s2);
     json_decref(k);
 
     /* the server's result bound (gp_spec_check_result, --max-result-mb 1024): the same
