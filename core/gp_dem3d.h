@@ -139,6 +139,31 @@ gp_status gp_dem3d_fabric_ex(const gp_dem3d_contact *c, size_t nc, double F[3][3
 gp_status gp_dem3d_stress_ex(const gp_dem3d_contact *c, size_t nc, const double *xyzr,
                              double volume, double S[3][3], const volatile int *cancel);
 
+/* The same measures as accumulators, for contacts that come in chunks (gp_flip_contacts_each
+ * streams the contacts of a tiled packing without building their array): _init, _add for
+ * each chunk in order, _finish. The sums run over the contacts in the order they are added,
+ * one by one, exactly as the array functions run over their array (which are built on
+ * these): any chunking of the same sequence gives the same bits as the array function on it.
+ * Plain structs owned by the caller, no allocation; one per thread. */
+typedef struct gp_dem3d_fabric_acc {
+    double sum[3][3]; /* sum of w n n^T */
+    double wsum;      /* sum of the weights w (2 per pair, 1 per wall contact) */
+} gp_dem3d_fabric_acc;
+
+typedef struct gp_dem3d_stress_acc {
+    const double *xyzr; /* the spheres the contacts refer to (not owned) */
+    double sum[3][3];   /* sum of l (x) f */
+} gp_dem3d_stress_acc;
+
+void gp_dem3d_fabric_acc_init(gp_dem3d_fabric_acc *a);
+void gp_dem3d_fabric_acc_add(gp_dem3d_fabric_acc *a, const gp_dem3d_contact *c, size_t nc);
+/* F = sum / wsum (zero without contacts) */
+void gp_dem3d_fabric_acc_finish(const gp_dem3d_fabric_acc *a, double F[3][3]);
+void gp_dem3d_stress_acc_init(gp_dem3d_stress_acc *a, const double *xyzr);
+void gp_dem3d_stress_acc_add(gp_dem3d_stress_acc *a, const gp_dem3d_contact *c, size_t nc);
+/* S = -sum / volume (volume <= 0: -sum) */
+void gp_dem3d_stress_acc_finish(const gp_dem3d_stress_acc *a, double volume, double S[3][3]);
+
 /* Solid volume of the spheres inside the box [lo, hi] (each sphere clipped by the six planes;
  * caps of one sphere at two walls are assumed disjoint). */
 double gp_dem3d_solid_volume(const double *xyzr, size_t n, const double lo[3], const double hi[3]);

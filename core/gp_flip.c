@@ -74,11 +74,156 @@ gp_status gp_flip_tile_ex(const double *xyzr, size_t n, const double box[3], con
     return GP_OK;
 }
 
-static int cmp_contact(const void *pa, const void *pb)
+/* A sample contact's place in every tile's sorted run (see gp_flip.h): (i, j) of the
+ * contact it makes there, less the tile's offset t n; q is its index in the sample. */
+typedef struct flip_key {
+    size_t i, j, q;
+} flip_key;
+
+static int cmp_key(const void *pa, const void *pb)
 {
-    const gp_dem3d_contact *a = pa, *b = pb;
+    const flip_key *a = pa, *b = pb;
     if (a->i != b->i) return a->i < b->i ? -1 : 1;
-    return a->j < b->j ? -1 : a->j > b->j;
+    if (a->j != b->j) return a->j < b->j ? -1 : 1;
+    /* equal keys: the two walls of one axis, never both made in the same tile */
+    return a->q < b->q ? -1 : a->q > b->q;
+}
+
+static void tile_strides(const int tiles[3], size_t stride[3])
+{
+    stride[0] = 1;
+    stride[1] = (size_t)tiles[0];
+    stride[2] = (size_t)tiles[0] * (size_t)tiles[1];
+}
+
+/* the sample's contacts in the order of every tile's run; *ord is malloc'ed (nc entries) */
+static gp_status sort_keys(const gp_dem3d_contact *c, size_t nc, size_t n, const int tiles[3],
+                           flip_key **ord, gp_error *err)
+{
+    size_t stride[3];
+    tile_strides(tiles, stride);
+    flip_key *o = malloc((nc ? nc : 1) * sizeof *o);
+    if (!o)
+        return gp_error_set(err, GP_ERR_NOMEM, "flip: out of memory (%zu contacts)", nc);
+    for (size_t q = 0; q < nc; q++) {
+        o[q].i = c[q].i;
+        o[q].q = q;
+        if (c[q].j >= 0)
+            o[q].j = (size_t)c[q].j;
+        else /* the image pair this wall contact makes, where it makes one */
+            o[q].j = stride[(-1 - c[q].j) / 2] * n + c[q].i;
+    }
+    qsort(o, nc, sizeof *o, cmp_key);
+    *ord = o;
+    return GP_OK;
+}
+
+enum { MADE_NONE = 0, MADE_PAIR = 1, MADE_WALL = 2 };
+
+/* Maps sample contact s into tile t (indices k) as *e. Returns MADE_PAIR for a sphere pair or
+ * an image pair (across an inner face, made by the lower of the two tiles so that it is listed
+ * once), MADE_WALL for a contact with an outer wall, MADE_NONE where the image pair is the
+ * lower neighbour's. */
+static int map_contact(const gp_dem3d_contact *s, const int k[3], size_t t, size_t n,
+                       const int tiles[3], const size_t stride[3], gp_dem3d_contact *e)
+{
+    int side = 0, a = 0, kn = 0;
+    if (s->j < 0) {
+        int wall = (int)(-1 - s->j);
+        a = wall / 2;
+        side = (wall & 1) ^ (k[a] & 1); /* 1: the wall is on this tile's high face */
+        kn = k[a] + (side ? 1 : -1);    /* the neighbour across it */
+        if (kn >= 0 && kn < tiles[a] && !side)
+            return MADE_NONE;
+    }
+    *e = *s;
+    for (int b = 0; b < 3; b++)
+        if (k[b] & 1) {
+            e->normal[b] = -e->normal[b];
+            e->force[b] = -e->force[b];
+        }
+    e->i = t * n + s->i;
+    if (s->j >= 0) {
+        e->j = (long)(t * n + (size_t)s->j);
+        return MADE_PAIR;
+    }
+    if (kn < 0 || kn >= tiles[a]) {
+        e->j = -1 - (2 * a + side);
+        return MADE_WALL;
+    }
+    /* inner face: the sphere meets its own image in the next tile (Eq. 13): normal +a
+     * (towards the image), force unchanged (-f e_a), full overlap 2 delta */
+    e->j = (long)((t + stride[a]) * n + s->i);
+    e->overlap = 2 * s->overlap;
+    return MADE_PAIR;
+}
+
+typedef struct emitter {
+    gp_dem3d_contact *buf;
+    size_t cap, k;
+    gp_flip_visit_fn visit;
+    void *user;
+    gp_error *err;
+} emitter;
+
+static gp_status flush(emitter *m)
+{
+    size_t k = m->k;
+    m->k = 0;
+    return k ? m->visit(m->user, m->buf, k, m->err) : GP_OK;
+}
+
+/* One pass over the tiles in index order: MADE_PAIR walks the sorted keys, MADE_WALL the
+ * sample's wall contacts in their order. */
+static gp_status walk(const gp_dem3d_contact *c, const flip_key *ord, size_t nc, size_t n,
+                      const int tiles[3], int made, const volatile int *cancel, emitter *m)
+{
+    size_t stride[3];
+    tile_strides(tiles, stride);
+    for (int kz = 0; kz < tiles[2]; kz++)
+        for (int ky = 0; ky < tiles[1]; ky++)
+            for (int kx = 0; kx < tiles[0]; kx++) {
+                if (cancel_raised(cancel)) /* a tile: the sample's contacts, a few million */
+                    return gp_error_set(m->err, GP_ERR_CANCELLED, "flip: cancelled");
+                int k[3] = {kx, ky, kz};
+                size_t t = ((size_t)kz * (size_t)tiles[1] + (size_t)ky) * (size_t)tiles[0] + (size_t)kx;
+                for (size_t r = 0; r < nc; r++) {
+                    const gp_dem3d_contact *s = made == MADE_PAIR ? c + ord[r].q : c + r;
+                    if (made == MADE_WALL && s->j >= 0)
+                        continue;
+                    if (map_contact(s, k, t, n, tiles, stride, m->buf + m->k) != made)
+                        continue;
+                    gp_status st;
+                    if (++m->k == m->cap && (st = flush(m)))
+                        return st;
+                }
+            }
+    return GP_OK;
+}
+
+gp_status gp_flip_contacts_each(const gp_dem3d_contact *c, size_t nc, const double *xyzr,
+                                size_t n, const int tiles[3], const volatile int *cancel,
+                                gp_dem3d_contact *buf, size_t cap, gp_flip_visit_fn visit,
+                                void *user, gp_error *err)
+{
+    (void)xyzr;
+    size_t nt = 0;
+    gp_status st = check_tiles(tiles, n, &nt, err);
+    if (st)
+        return st;
+    if (!buf || cap == 0 || !visit || (nc && !c))
+        return gp_error_set(err, GP_ERR_INVALID, "flip: need a buffer (cap >= 1) and a visitor");
+    flip_key *ord = NULL;
+    if ((st = sort_keys(c, nc, n, tiles, &ord, err)))
+        return st;
+    emitter m = {buf, cap, 0, visit, user, err};
+    st = walk(c, ord, nc, n, tiles, MADE_PAIR, cancel, &m);
+    if (!st)
+        st = walk(c, ord, nc, n, tiles, MADE_WALL, cancel, &m);
+    if (!st)
+        st = flush(&m);
+    free(ord);
+    return st;
 }
 
 gp_status gp_flip_contacts(const gp_dem3d_contact *c, size_t nc, const double *xyzr, size_t n,
@@ -87,6 +232,22 @@ gp_status gp_flip_contacts(const gp_dem3d_contact *c, size_t nc, const double *x
 {
     return gp_flip_contacts_ex(c, nc, xyzr, n, tiles, NULL, out, nout, err);
 }
+
+typedef struct collector {
+    gp_dem3d_contact *o;
+    size_t m;
+} collector;
+
+static gp_status collect(void *user, const gp_dem3d_contact *chunk, size_t k, gp_error *err)
+{
+    (void)err;
+    collector *cl = user;
+    memcpy(cl->o + cl->m, chunk, k * sizeof *chunk);
+    cl->m += k;
+    return GP_OK;
+}
+
+#define COLLECT_CHUNK 4096
 
 gp_status gp_flip_contacts_ex(const gp_dem3d_contact *c, size_t nc, const double *xyzr, size_t n,
                               const int tiles[3], const volatile int *cancel,
@@ -98,64 +259,26 @@ gp_status gp_flip_contacts_ex(const gp_dem3d_contact *c, size_t nc, const double
     gp_status st = check_tiles(tiles, n, &nt, err);
     if (st)
         return st;
-    (void)xyzr;
+    if (nc && nt > ((size_t)-1) / sizeof(gp_dem3d_contact) / nc)
+        return gp_error_set(err, GP_ERR_INVALID, "tiling: too many contacts");
+    /* every sample contact makes at most one contact per tile: nt nc bounds the count (pages
+     * past the end are never touched, and the block is shrunk to fit) */
     size_t cap = nt * nc;
-    gp_dem3d_contact *o = malloc((cap ? cap : 1) * sizeof *o);
-    gp_dem3d_contact *w = malloc((cap ? cap : 1) * sizeof *w);
-    if (!o || !w) {
-        free(o); free(w);
+    collector cl = {malloc((cap ? cap : 1) * sizeof *cl.o), 0};
+    gp_dem3d_contact *buf = malloc(COLLECT_CHUNK * sizeof *buf);
+    if (!cl.o || !buf) {
+        free(cl.o); free(buf);
         return gp_error_set(err, GP_ERR_NOMEM, "flip: out of memory (%zu contacts)", cap);
     }
-    size_t m = 0, mw = 0;
-    for (int kz = 0; kz < tiles[2]; kz++)
-        for (int ky = 0; ky < tiles[1]; ky++)
-            for (int kx = 0; kx < tiles[0]; kx++) {
-                if (cancel_raised(cancel)) {
-                    free(o);
-                    free(w);
-                    return gp_error_set(err, GP_ERR_CANCELLED, "flip: cancelled");
-                }
-                int k[3] = {kx, ky, kz};
-                size_t t = ((size_t)kz * (size_t)tiles[1] + (size_t)ky) * (size_t)tiles[0] + (size_t)kx;
-                size_t m0 = m; /* this tile's sphere contacts start here */
-                size_t stride[3] = {1, (size_t)tiles[0], (size_t)tiles[0] * (size_t)tiles[1]};
-                for (size_t q = 0; q < nc; q++) {
-                    gp_dem3d_contact e = c[q];
-                    for (int a = 0; a < 3; a++)
-                        if (k[a] & 1) {
-                            e.normal[a] = -e.normal[a];
-                            e.force[a] = -e.force[a];
-                        }
-                    e.i = t * n + c[q].i;
-                    if (c[q].j >= 0) {
-                        e.j = (long)(t * n + (size_t)c[q].j);
-                        o[m++] = e;
-                        continue;
-                    }
-                    int wall = (int)(-1 - c[q].j), a = wall / 2;
-                    int side = (wall & 1) ^ (k[a] & 1);
-                    int kn = k[a] + (side ? 1 : -1);
-                    if (kn < 0 || kn >= tiles[a]) {
-                        e.j = -1 - (2 * a + side);
-                        w[mw++] = e;
-                    } else if (side) {
-                        /* inner face: the sphere meets its own image in the next tile (Eq. 13) */
-                        size_t t2 = t + stride[a];
-                        e.j = (long)(t2 * n + c[q].i);
-                        e.overlap = 2 * c[q].overlap;
-                        o[m++] = e; /* normal +a (towards the image), force unchanged (-f e_a) */
-                    }
-                }
-                /* Every contact made here has its i in this tile's range [t n, (t + 1) n), and
-                 * tiles come in increasing t: sorting each tile's run sorts them all, the same
-                 * order as one sort of the whole (a sort by (i, j), which no two contacts share),
-                 * in runs short enough to look at the cancel flag between them. */
-                qsort(o + m0, m - m0, sizeof *o, cmp_contact);
-            }
-    for (size_t q = 0; q < mw; q++)
-        o[m + q] = w[q];
-    free(w);
-    *out = o;
-    *nout = m + mw;
+    st = gp_flip_contacts_each(c, nc, xyzr, n, tiles, cancel, buf, COLLECT_CHUNK, collect, &cl,
+                               err);
+    free(buf);
+    if (st) {
+        free(cl.o);
+        return st;
+    }
+    gp_dem3d_contact *fit = realloc(cl.o, (cl.m ? cl.m : 1) * sizeof *fit);
+    *out = fit ? fit : cl.o;
+    *nout = cl.m;
     return GP_OK;
 }

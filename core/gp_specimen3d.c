@@ -227,19 +227,177 @@ static int place(const double *diam, size_t n, double lam, const double L[3], gp
     return ok < 0 ? 2 : (ok ? 0 : 1);
 }
 
-/* statistics of a contact list over n spheres */
-static void contact_stats(const gp_dem3d_contact *c, size_t nc, size_t n, double *z, double *zs,
-                          size_t *npair, size_t *nwall)
+/* ---- measures over the final packing's contacts ----
+ * One pass feeds every measure: contact counts (always reported), fabric and stress (when
+ * asked), and the contact list (only with GP_OUT3_CONTACTS). A tiled packing's contacts come
+ * in chunks from gp_flip_contacts_each and are never all held at once unless the list is
+ * asked for (it was ~2 GB for 7.5 million spheres); an untiled or relaxed packing's array goes
+ * through the same code. The sums run in the contacts' order whatever the chunks, so the
+ * numbers do not depend on how the contacts arrive, nor on GP_OUT3_CONTACTS. */
+#define MEASURE_CHUNK 4096 /* contacts per chunk (288 KB); the cancel flag is read per chunk */
+
+typedef struct measure_acc {
+    unsigned outputs;
+    size_t pairs, walls;
+    gp_dem3d_fabric_acc fabric;
+    gp_dem3d_stress_acc stress;
+    gp_contact3d *out; /* GP_OUT3_CONTACTS: room for cap contacts, nout of them filled */
+    size_t nout, cap;
+    const volatile int *cancel;
+} measure_acc;
+
+/* cap: an upper bound on the number of contacts (the list is allocated once, then shrunk) */
+static gp_status measure_init(measure_acc *m, unsigned outputs, const double *xyzr, size_t cap,
+                              const volatile int *cancel, gp_error *err)
 {
-    size_t p = 0, w = 0;
-    for (size_t k = 0; k < nc; k++) {
-        if (c[k].j >= 0) p++;
-        else w++;
+    memset(m, 0, sizeof *m);
+    m->outputs = outputs;
+    m->cancel = cancel;
+    gp_dem3d_fabric_acc_init(&m->fabric);
+    gp_dem3d_stress_acc_init(&m->stress, xyzr);
+    if (outputs & GP_OUT3_CONTACTS) {
+        m->out = malloc((cap ? cap : 1) * sizeof *m->out);
+        if (!m->out)
+            return gp_error_set(err, GP_ERR_NOMEM, "out of memory (%zu contacts)", cap);
+        m->cap = cap;
     }
-    *npair = p;
-    *nwall = w;
-    *z = n ? (2.0 * (double)p + (double)w) / (double)n : 0;
-    *zs = n ? 2.0 * (double)p / (double)n : 0;
+    return GP_OK;
+}
+
+/* gp_flip_visit_fn: one chunk into every measure */
+static gp_status measure_add(void *user, const gp_dem3d_contact *c, size_t k, gp_error *err)
+{
+    measure_acc *m = user;
+    if (cancel_raised(m->cancel))
+        return gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+    for (size_t q = 0; q < k; q++) {
+        if (c[q].j >= 0) m->pairs++;
+        else m->walls++;
+    }
+    if (m->outputs & GP_OUT3_FABRIC)
+        gp_dem3d_fabric_acc_add(&m->fabric, c, k);
+    if (m->outputs & GP_OUT3_STRESS)
+        gp_dem3d_stress_acc_add(&m->stress, c, k);
+    if (m->out) {
+        if (k > m->cap - m->nout) /* cannot happen: cap bounds the count */
+            return gp_error_set(err, GP_ERR_INTERNAL, "contacts: more than %zu", m->cap);
+        for (size_t q = 0; q < k; q++) {
+            gp_contact3d *o = m->out + m->nout++;
+            o->i = c[q].i;
+            o->j = c[q].j;
+            memcpy(o->normal, c[q].normal, sizeof o->normal);
+            o->overlap = c[q].overlap;
+            memcpy(o->force, c[q].force, sizeof o->force);
+        }
+    }
+    return GP_OK;
+}
+
+/* the same, over an array, chunk by chunk (the cancel flag is looked at between them) */
+static gp_status measure_array(measure_acc *m, const gp_dem3d_contact *c, size_t nc,
+                               gp_error *err)
+{
+    gp_status st = GP_OK;
+    for (size_t k = 0; k < nc && !st; k += MEASURE_CHUNK)
+        st = measure_add(m, c + k, nc - k < MEASURE_CHUNK ? nc - k : MEASURE_CHUNK, err);
+    return st;
+}
+
+/* statistics over n spheres and a box of the given volume into res; the list (if any) moves
+ * to res */
+static void measure_finish(measure_acc *m, size_t n, double volume, gp_specimen3d *res)
+{
+    gp_stats3d *S = &res->stats;
+    S->contacts = m->pairs;
+    S->wall_contacts = m->walls;
+    S->coordination_number = n ? (2.0 * (double)m->pairs + (double)m->walls) / (double)n : 0;
+    S->coordination_spheres = n ? 2.0 * (double)m->pairs / (double)n : 0;
+    if (m->outputs & GP_OUT3_FABRIC)
+        gp_dem3d_fabric_acc_finish(&m->fabric, S->fabric);
+    if (m->outputs & GP_OUT3_STRESS)
+        gp_dem3d_stress_acc_finish(&m->stress, volume, S->stress);
+    if (m->out) {
+        gp_contact3d *fit = realloc(m->out, (m->nout ? m->nout : 1) * sizeof *fit);
+        res->contacts = fit ? fit : m->out;
+        res->ncontacts = m->nout;
+        m->out = NULL;
+    }
+}
+
+/* The measures of the final packing (nf spheres fx). stream: the contacts are the sample's
+ * (c, nc; n spheres xyzr), mapped to the tiling on the fly; else c is the final list. */
+static gp_status measure(const gp_spec3d *spec, int stream, const gp_dem3d_contact *c,
+                         size_t nc, const double *xyzr, size_t n, const double *fx, size_t nf,
+                         const volatile int *cancel, gp_specimen3d *res, gp_error *err)
+{
+    size_t ntile = (size_t)spec->tiling[0] * (size_t)spec->tiling[1] * (size_t)spec->tiling[2];
+    measure_acc m;
+    gp_status st = measure_init(&m, spec->outputs, fx, stream ? ntile * nc : nc, cancel, err);
+    if (!st && stream) {
+        gp_dem3d_contact *buf = malloc(MEASURE_CHUNK * sizeof *buf);
+        st = buf ? gp_flip_contacts_each(c, nc, xyzr, n, spec->tiling, cancel, buf,
+                                         MEASURE_CHUNK, measure_add, &m, err)
+                 : gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+        free(buf);
+    } else if (!st) {
+        st = measure_array(&m, c, nc, err);
+    }
+    if (!st)
+        measure_finish(&m, nf, res->box[0] * res->box[1] * res->box[2], res);
+    free(m.out);
+    return st;
+}
+
+/* the optional DEM relaxation of the tiled packing (tile_relax_steps): moves the spheres of
+ * tiled in the box [0, hi], and gives the DEM's own contacts (*tcon, malloc'ed), which the
+ * measures then use */
+static gp_status relax_tiled(const gp_spec3d *spec, const gp_dem3d_params *dp, run_ctx *rc,
+                             gp_stats3d *S, double *tiled, size_t ntiled, const double hi[3],
+                             gp_dem3d_contact **tcon, size_t *ntcon, gp_error *err)
+{
+    const double lo[3] = {0, 0, 0};
+    gp_dem3d *dem = NULL;
+    gp_dem3d_state ds;
+    memset(&ds, 0, sizeof ds);
+    gp_status st = gp_dem3d_create(dp, tiled, ntiled, lo, hi, &dem, err);
+    if (!st)
+        gp_dem3d_set_cancel(dem, rc->cancel);
+    for (long s = 0; !st && s < spec->tile_relax_steps; s += CHUNK) {
+        st = gp_dem3d_run(dem, CHUNK, err);
+        gp_dem3d_get_state(dem, &ds);
+        if (!st && report(rc, "tiling", 0.9 + 0.1 * s / spec->tile_relax_steps,
+                          S->steps + ds.steps, spec->porosity, ds.stability, 0))
+            st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+        if (ds.stability <= STABILITY)
+            break;
+    }
+    if (!st) {
+        S->tiled_stability = ds.stability;
+        gp_dem3d_spheres(dem, tiled);
+        st = gp_dem3d_contacts(dem, tcon, ntcon, err);
+    }
+    gp_dem3d_destroy(dem);
+    return st;
+}
+
+/* porosity of the tiled packing (box: the tiled box, sb: the sample's) from its true solid
+ * volume: each copy clipped to its own tile (inner faces are not walls) */
+static gp_status tiled_porosity(const int tiling[3], const double sb[3], const double box[3],
+                                const double *tiled, size_t n, const volatile int *cancel,
+                                double *porosity, gp_error *err)
+{
+    size_t nx = (size_t)tiling[0], ny = (size_t)tiling[1], ntile = nx * ny * (size_t)tiling[2];
+    double solid = 0;
+    for (size_t t = 0; t < ntile; t++) {
+        if (cancel_raised(cancel))
+            return gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+        size_t kx = t % nx, ky = (t / nx) % ny, kz = t / (nx * ny);
+        double tlo[3] = {kx * sb[0], ky * sb[1], kz * sb[2]};
+        double thi[3] = {tlo[0] + sb[0], tlo[1] + sb[1], tlo[2] + sb[2]};
+        solid += gp_dem3d_solid_volume(tiled + 4 * t * n, n, tlo, thi);
+    }
+    *porosity = 1 - solid / (box[0] * box[1] * box[2]);
+    return GP_OK;
 }
 
 static gp_status validate(const gp_spec3d *s, gp_error *err)
@@ -644,13 +802,10 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
 
     /* ---- phase 2: flip tiling ---- */
     t_phase = now();
-    const gp_dem3d_contact *fc = con;
-    size_t nfc = ncon;
-    const double *fx = xyzr;
-    size_t nf = n;
     for (int a = 0; a < 3; a++)
         res->box[a] = res->sample_box[a];
     int tile = ntile > 1 && (ret == GP_OK || ret == GP_ERR_NOT_CONVERGED);
+    int relaxed = tile && spec->tile_relax_steps > 0; /* measured on the DEM's contacts */
     if (tile) {
         report(&rc, "tiling", 0.9, S->steps, p, S->stability, 1);
         st = gp_flip_tile_ex(xyzr, n, res->sample_box, spec->tiling, MAX_TILED_SPHERES, cancel,
@@ -659,95 +814,38 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
          * seconds, and the first report may have come too soon after the last to be shown) */
         if (!st && report(&rc, "tiling", 0.93, S->steps, p, S->stability, 0))
             st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+        for (int a = 0; a < 3; a++)
+            res->box[a] = res->sample_box[a] * spec->tiling[a];
+        if (!st && relaxed)
+            st = relax_tiled(spec, &dp, &rc, S, tiled, ntiled, res->box, &tcon, &ntcon, err);
         if (!st)
-            st = gp_flip_contacts_ex(con, ncon, xyzr, n, spec->tiling, cancel, &tcon, &ntcon,
-                                     err);
-        if (!st && report(&rc, "tiling", 0.96, S->steps, p, S->stability, 0))
-            st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+            st = tiled_porosity(spec->tiling, res->sample_box, res->box, tiled, n, cancel,
+                                &S->porosity, err);
         if (st) {
             ret = st;
             goto fail;
         }
-        for (int a = 0; a < 3; a++)
-            res->box[a] = res->sample_box[a] * spec->tiling[a];
-        if (spec->tile_relax_steps > 0) {
-            gp_dem3d_params tp = dp;
-            tp.scaled_radius = dp.scaled_radius;
-            double thi[3] = {res->box[0], res->box[1], res->box[2]};
-            st = gp_dem3d_create(&tp, tiled, ntiled, lo, thi, &dem, err);
-            if (!st)
-                gp_dem3d_set_cancel(dem, cancel);
-            for (long s = 0; !st && s < spec->tile_relax_steps; s += CHUNK) {
-                st = gp_dem3d_run(dem, CHUNK, err);
-                gp_dem3d_get_state(dem, &ds);
-                if (!st && report(&rc, "tiling", 0.9 + 0.1 * s / spec->tile_relax_steps, S->steps + ds.steps, p, ds.stability, 0))
-                    st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-                if (ds.stability <= STABILITY)
-                    break;
-            }
-            if (!st) {
-                S->tiled_stability = ds.stability;
-                gp_dem3d_spheres(dem, tiled);
-                free(tcon);
-                tcon = NULL;
-                st = gp_dem3d_contacts(dem, &tcon, &ntcon, err);
-            }
-            gp_dem3d_destroy(dem);
-            dem = NULL;
-            if (st) {
-                ret = st;
-                goto fail;
-            }
-        }
-        fc = tcon;
-        nfc = ntcon;
-        fx = tiled;
-        nf = ntiled;
-        /* true solid volume: each copy clipped to its own tile (inner faces are not walls) */
-        double solid = 0;
-        for (size_t t = 0; t < ntile; t++) {
-            if (cancel_raised(cancel)) {
-                ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-                goto fail;
-            }
-            size_t kx = t % (size_t)spec->tiling[0], ky = (t / (size_t)spec->tiling[0]) % (size_t)spec->tiling[1],
-                   kz = t / ((size_t)spec->tiling[0] * (size_t)spec->tiling[1]);
-            double tlo[3] = {kx * res->sample_box[0], ky * res->sample_box[1], kz * res->sample_box[2]};
-            double thi[3] = {tlo[0] + res->sample_box[0], tlo[1] + res->sample_box[1], tlo[2] + res->sample_box[2]};
-            solid += gp_dem3d_solid_volume(tiled + 4 * t * n, n, tlo, thi);
-        }
-        S->porosity = 1 - solid / (res->box[0] * res->box[1] * res->box[2]);
     } else {
         S->porosity = S->sample_porosity;
     }
-    res->t_tiling = now() - t_phase;
 
     /* ---- measures on the final packing ---- */
-    /* Each measure is one pass over the contacts (up to ~50 million after a tiling of 20
-     * million spheres, a fraction of a second each): the flag is looked at between them. */
-#define CANCEL_POINT()                                                                    \
-    do {                                                                                  \
-        if (cancel_raised(cancel)) {                                                      \
-            ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");                       \
-            goto fail;                                                                    \
-        }                                                                                 \
-    } while (0)
-    if (report(&rc, "tiling", 0.98, S->steps, p, S->stability, 0)) {
+    /* Without a tiled relaxation the tiled contacts are the sample's, mapped by the flip as
+     * they are measured (never all held unless the list is an output); t_tiling counts that
+     * pass too. */
+    if (report(&rc, "tiling", 0.96, S->steps, p, S->stability, 0)) {
         ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
         goto fail;
     }
-    contact_stats(fc, nfc, nf, &S->coordination_number, &S->coordination_spheres, &S->contacts,
-                  &S->wall_contacts);
-    S->particles = nf;
-    res->count = nf;
-    CANCEL_POINT();
-    if ((spec->outputs & GP_OUT3_FABRIC) && gp_dem3d_fabric_ex(fc, nfc, S->fabric, cancel))
-        CANCEL_POINT();
-    if ((spec->outputs & GP_OUT3_STRESS) &&
-        gp_dem3d_stress_ex(fc, nfc, fx, res->box[0] * res->box[1] * res->box[2], S->stress,
-                           cancel))
-        CANCEL_POINT();
-    CANCEL_POINT();
+    S->particles = tile ? ntiled : n;
+    res->count = S->particles;
+    st = measure(spec, tile && !relaxed, relaxed ? tcon : con, relaxed ? ntcon : ncon, xyzr, n,
+                 tile ? tiled : xyzr, S->particles, cancel, res, err);
+    if (st) {
+        ret = st;
+        goto fail;
+    }
+    res->t_tiling = now() - t_phase;
     if (spec->outputs & GP_OUT3_SPHERES) {
         if (tile) {
             res->spheres = tiled;
@@ -757,24 +855,6 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, 
             xyzr = NULL;
         }
     }
-    if (spec->outputs & GP_OUT3_CONTACTS) {
-        res->contacts = malloc((nfc ? nfc : 1) * sizeof *res->contacts);
-        if (!res->contacts) {
-            ret = gp_error_set(err, GP_ERR_NOMEM, "out of memory (contacts)");
-            goto fail;
-        }
-        for (size_t k = 0; k < nfc; k++) {
-            if (k % 65536 == 0)
-                CANCEL_POINT();
-            res->contacts[k].i = fc[k].i;
-            res->contacts[k].j = fc[k].j;
-            memcpy(res->contacts[k].normal, fc[k].normal, sizeof fc[k].normal);
-            res->contacts[k].overlap = fc[k].overlap;
-            memcpy(res->contacts[k].force, fc[k].force, sizeof fc[k].force);
-        }
-        res->ncontacts = nfc;
-    }
-#undef CANCEL_POINT
     report(&rc, "tiling", 1.0, S->steps, S->porosity, S->stability, 1);
     free(con); free(tcon); free(tiled); free(xyzr); free(diam); free(sd); free(sw);
     gp_rng_destroy(rng);

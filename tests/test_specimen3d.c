@@ -202,6 +202,82 @@ static void test_errors(void)
     CHECK(gp_specimen3d_build(&s, NULL, NULL, &flag, &r, &e) == GP_ERR_CANCELLED);
 }
 
+/* the measures of a tiled packing are summed over its contacts as they are streamed from the
+ * flip: asking for the contact list (which is then collected too) changes no bit of them;
+ * untiled, tiled (3 x 2 x 2), and with a raised cancel flag in the tiling phase */
+static int raise_at_tiling(void *user, const gp_progress3d *p)
+{
+    if (strcmp(p->phase, "tiling") == 0)
+        __atomic_store_n((int *)user, 1, __ATOMIC_RELAXED);
+    return 0;
+}
+
+static void test_contacts_output_invariant(void)
+{
+    gp_spec3d s;
+    gp_spec3d_defaults(&s);
+    s.seed = 5;
+    s.box[0] = s.box[1] = s.box[2] = 0.045;
+    s.sieve = SMALL;
+    s.nsieve = 3;
+    s.porosity = 0.44;
+    s.max_steps = 6000; /* NOT_CONVERGED is fine: the specimen is still tiled and measured */
+    const int tilings[2][3] = {{1, 1, 1}, {3, 2, 2}};
+    for (int k = 0; k < 2; k++) {
+        memcpy(s.tiling, tilings[k], sizeof s.tiling);
+        gp_specimen3d *a = NULL, *b = NULL;
+        gp_error e;
+        s.outputs = GP_OUT3_FABRIC | GP_OUT3_STRESS;
+        gp_status sa = gp_specimen3d_build(&s, NULL, NULL, NULL, &a, &e);
+        s.outputs = GP_OUT3_FABRIC | GP_OUT3_STRESS | GP_OUT3_CONTACTS | GP_OUT3_SPHERES;
+        gp_status sb = gp_specimen3d_build(&s, NULL, NULL, NULL, &b, &e);
+        CHECK(sa == sb && a && b);
+        if (!a || !b) {
+            gp_specimen3d_destroy(a);
+            gp_specimen3d_destroy(b);
+            continue;
+        }
+        const gp_stats3d *A = &a->stats, *B = &b->stats;
+        CHECK(memcmp(A->fabric, B->fabric, sizeof A->fabric) == 0);
+        CHECK(memcmp(A->stress, B->stress, sizeof A->stress) == 0);
+        CHECK(memcmp(&A->coordination_number, &B->coordination_number, sizeof(double)) == 0);
+        CHECK(memcmp(&A->coordination_spheres, &B->coordination_spheres, sizeof(double)) == 0);
+        CHECK(A->contacts == B->contacts && A->wall_contacts == B->wall_contacts);
+        CHECK(a->contacts == NULL && a->ncontacts == 0 && a->spheres == NULL);
+        CHECK(b->ncontacts == B->contacts + B->wall_contacts);
+        CHECK(a->count == b->count && a->count == (k ? 12 : 1) * A->sample_particles);
+        CHECK(A->stress[2][2] > 0 && A->fabric[2][2] > 0.2);
+        /* the list: sphere pairs (i < j, sorted by (i, j)), then wall contacts; indices in
+         * range; z and the counts follow from it */
+        size_t pairs = 0, order = 0, range = 0;
+        for (size_t q = 0; q < b->ncontacts; q++) {
+            const gp_contact3d *c = b->contacts + q;
+            if (c->j >= 0) {
+                pairs++;
+                range += c->i >= (size_t)c->j || (size_t)c->j >= b->count;
+                if (q > 0 && (b->contacts[q - 1].i > c->i ||
+                              (b->contacts[q - 1].i == c->i && b->contacts[q - 1].j >= c->j)))
+                    order++;
+            } else {
+                range += c->j < -6 || c->i >= b->count;
+            }
+        }
+        CHECK(pairs == B->contacts && order == 0 && range == 0);
+        CHECK_NEAR(B->coordination_number,
+                   (2.0 * (double)pairs + (double)(b->ncontacts - pairs)) / (double)b->count,
+                   1e-12);
+        gp_specimen3d_destroy(a);
+        gp_specimen3d_destroy(b);
+    }
+    /* a flag raised in the tiling phase: cancelled, nothing returned (ASan: nothing leaked) */
+    volatile int flag = 0;
+    gp_specimen3d *r = NULL;
+    gp_error e;
+    s.outputs = GP_OUT3_FABRIC | GP_OUT3_STRESS;
+    CHECK(gp_specimen3d_build(&s, raise_at_tiling, (void *)&flag, &flag, &r, &e) == GP_ERR_CANCELLED);
+    CHECK(r == NULL && flag == 1);
+}
+
 #ifndef GP_SANITIZED
 static void test_paper_example(void)
 {
@@ -232,6 +308,7 @@ int main(void)
     test_errors();
     test_small_and_tiled();
     test_threads_deterministic();
+    test_contacts_output_invariant();
     test_one_size();
 #ifndef GP_SANITIZED
     test_paper_example();
