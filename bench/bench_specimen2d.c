@@ -83,16 +83,16 @@ static void run(const row *r)
 int main(int argc, char **argv)
 {
     int quick = argc > 1 && strcmp(argv[1], "quick") == 0;
-    unsigned all = GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS;
+    unsigned all = GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS;
     row rows[] = {
         {"Example 1 (all outputs)", 500, 0.8, 1.0, 0.1, 0.06, 0.03, 1, all, GP_IMC_AD, 0},
         {"Example 1, paper's E3", 500, 0.8, 1.0, 0.1, 0.06, 0.03, 1, all, GP_IMC_E3, 0},
         {"Example 2 (all outputs)", 500, 0.2, 0.1, 0.2, 0.01, 0.0, 1, all, GP_IMC_AD, 0},
         {"Example 2, paper's E3", 500, 0.2, 0.1, 0.2, 0.01, 0.0, 1, all, GP_IMC_E3, 0},
-        {"Example 1, grains only", 500, 0.8, 1.0, 0.1, 0.06, 0.03, 1, GP_OUT_GRAINS, GP_IMC_AD, 0},
+        {"Example 1, grains only", 500, 0.8, 1.0, 0.1, 0.06, 0.03, 1, GP_OUT2_GRAINS, GP_IMC_AD, 0},
         {"Example 1, 2 threads", 500, 0.8, 1.0, 0.1, 0.06, 0.03, 2, all, GP_IMC_AD, 0},
-        {"of grains, COV 0.5", 500, 0.5, 1.0, 0.1, 0.05, 0.02, 2, GP_OUT_GRAINS, GP_IMC_AD, 1},
-        {"sieve 0.5-4 mm, 0.1 m", 0, 0.0, 1.0, 0.1, 0.05, 0.02, 2, GP_OUT_GRAINS, GP_IMC_AD, 2},
+        {"of grains, COV 0.5", 500, 0.5, 1.0, 0.1, 0.05, 0.02, 2, GP_OUT2_GRAINS, GP_IMC_AD, 1},
+        {"sieve 0.5-4 mm, 0.1 m", 0, 0.0, 1.0, 0.1, 0.05, 0.02, 2, GP_OUT2_GRAINS, GP_IMC_AD, 2},
         {"10,000 grains, 2 thr.", 10000, 0.5, 1.0, 0.1, 0.05, 0.02, 2, all, GP_IMC_AD, 0},
     };
     printf("2D Fourier-Voronoi specimen, end to end (F_S = 0.65, Np = 128; AD threshold 0.1, E3 0.002)\n");

@@ -108,7 +108,7 @@ int main(int argc, char **argv)
     free(c);
     gp_specimen3d_destroy(r);
 
-    /* size ratio 20: the sieve and seed of tests/test_specimen3d_wide.c, at its target 0.46
+    /* size ratio 20: the sieve and seed of tests/core/3d/test_specimen3d_wide.c, at its target 0.46
      * (just below the deposit) and at 0.42, and in a 0.15 m cube (~2,600 spheres) */
     static const gp_sieve_row wide[4] = {{0.001, 0}, {0.005, 1}, {0.010, 10}, {0.020, 100}};
     static const double cases[3][2] = {{0.1, 0.46}, {0.1, 0.42}, {0.15, 0.42}};

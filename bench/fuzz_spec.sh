@@ -9,7 +9,7 @@
 # Prints one line: executions, seconds, exec/s, corpus size, crashes found. A crash, leak or
 # timeout stops the run; its input is saved under BUILD/artifacts/ and the script exits 1.
 # Minimise one with: BUILD/fuzz/fuzz_spec -minimize_crash=1 -runs=100000 BUILD/artifacts/crash-...
-# then put it into fuzz/regressions/ (tests/test_spec_regressions.c replays that directory).
+# then put it into fuzz/regressions/ (tests/schema/test_spec_regressions.c replays that directory).
 #
 # usage: bench/fuzz_spec.sh [runs (1000000)]
 # environment: GP_FUZZ_BUILD (build directory, default build-fuzz), GP_FUZZ_TIMEOUT (seconds one

@@ -1,6 +1,6 @@
 /* fuzz_spec_check.h -- one input through the spec validator and parsers, with the contracts of
  * schema/gp_spec.h checked. Shared by the libFuzzer target (fuzz/fuzz_spec.c, which aborts on a
- * broken contract) and the regression ctest (tests/test_spec_regressions.c, which counts it as
+ * broken contract) and the regression ctest (tests/schema/test_spec_regressions.c, which counts it as
  * a failed check), so a reproducer runs the very same calls under the normal build.
  *
  * For every input that jansson reads as JSON (as the daemon reads a POST body: duplicate keys

@@ -1587,10 +1587,10 @@ static unsigned parse_outputs_2d(const json_t *outputs)
     const json_t *o;
     json_array_foreach(outputs, i, o) {
         const char *s = json_string_value(o);
-        if (!strcmp(s, "grains")) bits |= GP_OUT_GRAINS;
-        else if (!strcmp(s, "odec")) bits |= GP_OUT_ODEC;
-        else if (!strcmp(s, "descriptors")) bits |= GP_OUT_DESCRIPTORS;
-        else if (!strcmp(s, "cells")) bits |= GP_OUT_CELLS;
+        if (!strcmp(s, "grains")) bits |= GP_OUT2_GRAINS;
+        else if (!strcmp(s, "odec")) bits |= GP_OUT2_ODEC;
+        else if (!strcmp(s, "descriptors")) bits |= GP_OUT2_DESCRIPTORS;
+        else if (!strcmp(s, "cells")) bits |= GP_OUT2_CELLS;
     }
     return bits;
 }
@@ -1817,7 +1817,7 @@ int gp_spec2d_read(const json_t *spec, gp_spec2d *out, gp_spec_problem *p)
 #define COST_ODEC_S 0.5e-3        /* its ODEC discs, at 128 points */
 #define COST_DESC_S 0.5e-3        /* its descriptors, at 128 points */
 #define DEM_SPHERE_STEPS_PER_S 4e6 /* the 3D DEM, sphere-steps per second (3.9e6 measured) */
-/* The 3D protocol (core/gp_specimen3d.c): its constants, which its header does not export */
+/* The 3D protocol (core/3d/gp_specimen3d.c): its constants, which its header does not export */
 #define DEM_MAX_SAMPLE 400000.0   /* MAX_SAMPLE_SPHERES: spheres of the sample at most */
 #define DEM_MAX_TILED 20000000.0  /* MAX_TILED_SPHERES: spheres after the tiling at most */
 #define DEM_DT_SAFETY 0.3         /* DT_SAFETY, of sqrt(m / 2 E R) */
@@ -1833,10 +1833,10 @@ int gp_spec2d_read(const json_t *spec, gp_spec2d *out, gp_spec_problem *p)
 static double bytes_per_grain(unsigned outputs, double np)
 {
     double per = 400; /* stats, ids, areas, descriptors */
-    if (outputs & GP_OUT_GRAINS) per += 40 * np;
-    if (outputs & GP_OUT_ODEC) per += 40 * np + 60 * 16;
-    if (outputs & GP_OUT_DESCRIPTORS) per += 40 * np + 120;
-    if (outputs & GP_OUT_CELLS) per += 40 * 12 + 100;
+    if (outputs & GP_OUT2_GRAINS) per += 40 * np;
+    if (outputs & GP_OUT2_ODEC) per += 40 * np + 60 * 16;
+    if (outputs & GP_OUT2_DESCRIPTORS) per += 40 * np + 120;
+    if (outputs & GP_OUT2_CELLS) per += 40 * 12 + 100;
     return per;
 }
 
@@ -1857,8 +1857,8 @@ static void bounds_2d(const gp_spec2d *s, size_t n, gp_spec_bounds_t *b)
                  (1 + COST_IMC_PER_DECADE * log10(fmax(cells, 1000) / 1000));
     double imc_edges = b->steps * COST_IMC_EDGE_S * per_bin * sqrt(per_bin);
     double per = COST_FILL_S;
-    if (s->outputs & GP_OUT_ODEC) per += COST_ODEC_S;
-    if (s->outputs & GP_OUT_DESCRIPTORS) per += COST_DESC_S;
+    if (s->outputs & GP_OUT2_ODEC) per += COST_ODEC_S;
+    if (s->outputs & GP_OUT2_DESCRIPTORS) per += COST_DESC_S;
     double grains = cells * per * np / 128;
     b->work_s = imc + imc_edges + grains;
     b->work_pointer = imc_edges > imc && imc_edges > grains ? "/container"

@@ -2,7 +2,7 @@
  *
  * GENERATED from server/dashboard.html by server/dashboard_gen.py: edit the HTML, then run
  *   python3 server/dashboard_gen.py
- * (tests/test_dashboard.c fails when the two differ). */
+ * (tests/server/test_dashboard.c fails when the two differ). */
 #include "dashboard.h"
 
 static const char page[] =

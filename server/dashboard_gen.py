@@ -2,7 +2,7 @@
 """Regenerates server/dashboard.c from server/dashboard.html (the file to edit).
 
 Run from the repository root:  python3 server/dashboard_gen.py
-tests/test_dashboard.c fails when dashboard.c and dashboard.html differ.
+tests/server/test_dashboard.c fails when dashboard.c and dashboard.html differ.
 """
 import os
 
@@ -12,7 +12,7 @@ out = ['/* dashboard.c -- the dashboard page served at GET / (see dashboard.h).\
        ' *\n',
        ' * GENERATED from server/dashboard.html by server/dashboard_gen.py: edit the HTML, then run\n',
        ' *   python3 server/dashboard_gen.py\n',
-       ' * (tests/test_dashboard.c fails when the two differ). */\n',
+       ' * (tests/server/test_dashboard.c fails when the two differ). */\n',
        '#include "dashboard.h"\n\nstatic const char page[] =\n']
 lines = src.split(b'\n')
 if src.endswith(b'\n'):

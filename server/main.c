@@ -26,7 +26,7 @@
 
 #if defined(__SANITIZE_THREAD__)
 /* ThreadSanitizer: the cancel flag handed to the core (const volatile int *, pinned in
- * core/gp_specimen2d.h and gp_specimen3d.h) is raised here with an atomic store but polled by
+ * core/2d/gp_specimen2d.h and gp_specimen3d.h) is raised here with an atomic store but polled by
  * the core with a plain volatile read. That is the documented hand-off, benign on every target
  * we build for; TSan reports it unless the core reads with __atomic_load_n. Suppress exactly
  * the two writers (workers_cancel: DELETE; workers_stop: shutdown) and nothing else. */

@@ -197,7 +197,7 @@ json_t *gpd_result_2d_c(const gp_specimen2d *s, const gp_spec2d *spec, const jso
     json_object_set_new(st, "size_histogram", hist_json(&s->size_hist));
     json_object_set_new(st, "grain_size_histogram", hist_json(&s->grain_size_hist));
     json_object_set_new(st, "orientation_histogram", hist_json(&s->orientation_hist));
-    if (out & GP_OUT_DESCRIPTORS) {
+    if (out & GP_OUT2_DESCRIPTORS) {
         static const char *names[4] = {"elongation", "roundness", "circularity", "regularity"};
         const double means[4] = {s->descriptor_mean.elongation, s->descriptor_mean.roundness,
                                  s->descriptor_mean.circularity, s->descriptor_mean.regularity};
@@ -224,7 +224,7 @@ json_t *gpd_result_2d_c(const gp_specimen2d *s, const gp_spec2d *spec, const jso
                   gpd_jreal(s->t_odec), "descriptors", gpd_jreal(s->t_descriptors), "total",
                   gpd_jreal(s->t_total)));
 
-    if (out & (GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS)) {
+    if (out & (GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS)) {
         json_t *ga = json_array();
         json_object_set_new(r, "grains", ga); /* (filled in place: dropped with r on cancel) */
         for (size_t i = 0; i < s->ngrains; i++) {
@@ -238,9 +238,9 @@ json_t *gpd_result_2d_c(const gp_specimen2d *s, const gp_spec2d *spec, const jso
             json_object_set_new(gj, "area", gpd_jreal(g->area));
             json_object_set_new(gj, "orientation_deg", gpd_jreal(g->orientation_deg));
             json_object_set_new(gj, "cell_fraction", gpd_jreal(g->cell_fraction));
-            if (out & GP_OUT_DESCRIPTORS)
+            if (out & GP_OUT2_DESCRIPTORS)
                 json_object_set_new(gj, "descriptors", descriptors(&g->descriptors));
-            if (out & GP_OUT_ODEC) {
+            if (out & GP_OUT2_ODEC) {
                 json_t *da = json_array();
                 for (size_t k = 0; k < g->ndiscs && g->discs; k++)
                     json_array_append_new(da, json_pack("[o, o, o]", gpd_jreal(g->discs[3 * k]),
@@ -251,7 +251,7 @@ json_t *gpd_result_2d_c(const gp_specimen2d *s, const gp_spec2d *spec, const jso
             json_array_append_new(ga, gj);
         }
     }
-    if ((out & GP_OUT_CELLS) && s->cells) {
+    if ((out & GP_OUT2_CELLS) && s->cells) {
         json_t *ca = json_array();
         json_object_set_new(r, "cells", ca);
         for (size_t i = 0; i < s->ncells; i++) {

@@ -155,7 +155,7 @@ static const char *SCHEMA_SQL =
     " result TEXT,"
     " attempts INTEGER NOT NULL DEFAULT 0);"
     "CREATE INDEX IF NOT EXISTS jobs_status_seq ON jobs(status, seq);"
-    /* the export pack of a succeeded job (core/gp_export.h), keyed by the job's seq so that
+    /* the export pack of a succeeded job (core/export/gp_export.h), keyed by the job's seq so that
      * it can be read with incremental blob I/O */
     "CREATE TABLE IF NOT EXISTS exports(seq INTEGER PRIMARY KEY, pack BLOB NOT NULL);"
     /* the summary of a succeeded job's result (store_get_summary), committed with it; a

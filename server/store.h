@@ -14,7 +14,7 @@
  *                                                  status='succeeded' (durable before it shows)
  *   attempts    INTEGER NOT NULL DEFAULT 0         times a worker claimed the job
  * and exports(seq INTEGER PRIMARY KEY = jobs.seq, pack BLOB NOT NULL): the export pack of a
- * succeeded job (core/gp_export.h), committed with the result;
+ * succeeded job (core/export/gp_export.h), committed with the result;
  * and summaries(seq INTEGER PRIMARY KEY = jobs.seq, summary TEXT NOT NULL, arrays TEXT): the
  * result's summary and where its arrays are in its text (store_get_summary), committed with
  * the result.

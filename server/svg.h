@@ -27,7 +27,7 @@
  *             "grain_area": the same (optional)}   (server/result_json.h)
  *   }
  *   "warnings": ["one line", ...]    (optional; drawn under the size view)
- *   (The histograms mirror gp_hist in core/gp_specimen2d.h: "target" may be absent or null
+ *   (The histograms mirror gp_hist in core/2d/gp_specimen2d.h: "target" may be absent or null
  *   where there is no target; "counts" is accepted in place of "achieved".)
  *   Missing (absent or null) stats histograms are recomputed from grains[] / cells[] where
  *   possible (descriptors from grains[].descriptors).
@@ -110,7 +110,7 @@ gp_svg_items *gp_svg_items_json(const json_t *array, gp_svg_part part);
  * stay valid until the source is closed. NULL on out of memory. */
 gp_svg_items *gp_svg_items_scan(const js_source *text, uint64_t off, gp_svg_part part);
 
-/* The grains (2D) or spheres (3D) of an export pack (core/gp_export.h), which must stay
+/* The grains (2D) or spheres (3D) of an export pack (core/export/gp_export.h), which must stay
  * readable until the source is closed. NULL when pack is not a pack, or not of that part
  * (cells are not in packs). */
 gp_svg_items *gp_svg_items_pack(const gp_export_source *pack, gp_svg_part part);

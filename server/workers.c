@@ -213,7 +213,7 @@ static int on_progress2d(void *user, const gp_progress *p)
 }
 #endif
 #ifdef GPD_HAVE_SPECIMEN3D
-static int on_progress3d(void *user, const gp_progress3d *p)
+static int on_progress3d(void *user, const gp_progress *p)
 {
     return report(user, p->phase, p->fraction, p->steps, 0, 1, p->porosity, p->stability);
 }
@@ -488,7 +488,7 @@ static void run_2d(slot *s, const char *id, json_t *spec_json)
          * answers 409 naming the output to ask for */
         void *pack = NULL;
         size_t pack_len = 0;
-        if (spec.outputs & GP_OUT_ODEC) {
+        if (spec.outputs & GP_OUT2_ODEC) {
             gp_error perr;
             if (gp_export_pack_2d(out, &spec, GP_EXPORT_DEFAULT_DENSITY, &pack, &pack_len, &perr))
                 gpd_log(GPD_LOG_WARN, "job %s: no export pack: %s", id, perr.message);

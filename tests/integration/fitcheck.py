@@ -4,7 +4,7 @@
 Nothing here reads a number the daemon reports about itself: areas come from the returned
 polygons (shoelace), orientations from the polygons' convex hulls (a brute-force minimum
 width over the hull edges, not rotating calipers), and the laws' CDFs are written out here from
-their definitions (api.md "2D size laws", core/gp_law.h):
+their definitions (api.md "2D size laws", core/2d/gp_law.h):
   - lognormal of mean m and coefficient of variation c: sigma^2 = ln(1 + c^2),
     mu = ln m - sigma^2 / 2, F(x) = (1 + erf((ln x - mu) / (sigma sqrt 2))) / 2;
   - the cosine orientation law of mean t and anisotropy a, density proportional to

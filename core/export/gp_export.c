@@ -169,7 +169,7 @@ gp_status gp_export_pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, doubl
     if (!p) return gp_error_set(err, GP_ERR_NOMEM, "out of memory packing %zu grains", s->ngrains);
     pack_header h;
     header_init(&h, 2, density);
-    int with_desc = (spec->outputs & GP_OUT_DESCRIPTORS) != 0;
+    int with_desc = (spec->outputs & GP_OUT2_DESCRIPTORS) != 0;
     h.flags = with_desc ? GP_EXPORT_HAS_DESCRIPTORS : 0;
     h.nitems = s->ngrains;
     h.npoints = npts;

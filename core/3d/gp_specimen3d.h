@@ -17,6 +17,7 @@
 #include <stdint.h>
 
 #include "gp_error.h"
+#include "gp_progress.h"
 
 /* outputs (bit flags); porosity, coordination number, PSD and timings are always reported */
 enum {
@@ -128,20 +129,6 @@ typedef struct gp_specimen3d {
     double t_deposition, t_compaction, t_relaxation, t_tiling, t_total;
 } gp_specimen3d;
 
-/* Progress report: phase ("deposition", "compaction", "relaxation", "tiling"), fraction of the
- * whole job done in [0, 1], DEM steps so far, current porosity (by the top-wall height) and
- * S_c where meaningful (else 0). */
-typedef struct gp_progress3d {
-    const char *phase;
-    double fraction;
-    long steps;
-    double porosity;
-    double stability;
-} gp_progress3d;
-
-/* Called at a bounded rate from the building thread; return non-zero to cancel. */
-typedef int (*gp_progress3d_fn)(void *user, const gp_progress3d *p);
-
 /* Builds the specimen. Returns GP_OK, or an error with a message:
  *   GP_ERR_INVALID     bad spec (names the field), e.g. a box smaller than the largest grain;
  *   GP_ERR_INFEASIBLE  the target porosity cannot be reached (denser than the frictionless
@@ -152,7 +139,7 @@ typedef int (*gp_progress3d_fn)(void *user, const gp_progress3d *p);
  * *out is set (and must be freed with gp_specimen3d_destroy) on GP_OK, GP_ERR_INFEASIBLE and
  * GP_ERR_NOT_CONVERGED; it is NULL on every other return. cancel may be NULL. The same spec and
  * seed give the same specimen bit for bit whatever spec->threads is. */
-gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, void *user,
+gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress_fn progress, void *user,
                               const volatile int *cancel, gp_specimen3d **out, gp_error *err);
 
 void gp_specimen3d_destroy(gp_specimen3d *s);

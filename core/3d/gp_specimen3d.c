@@ -102,7 +102,7 @@ static double now(void)
 }
 
 typedef struct run_ctx {
-    gp_progress3d_fn fn;
+    gp_progress_fn fn;
     void *user;
     const volatile int *cancel;
     double last;
@@ -125,8 +125,11 @@ static int report(run_ctx *c, const char *phase, double fraction, long steps, do
     if (!force && t - c->last < 0.05)
         return 0;
     c->last = t;
-    gp_progress3d p = {phase, fraction < 0 ? 0 : (fraction > 1 ? 1 : fraction), steps,
-                       porosity, isfinite(sc) ? sc : 0};
+    gp_progress p = {.phase = phase,
+                     .fraction = fraction < 0 ? 0 : (fraction > 1 ? 1 : fraction),
+                     .steps = steps,
+                     .porosity = porosity,
+                     .stability = isfinite(sc) ? sc : 0};
     return c->fn(c->user, &p) != 0;
 }
 
@@ -430,7 +433,7 @@ static gp_status validate(const gp_spec3d *s, gp_error *err)
     return GP_OK;
 }
 
-gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress3d_fn progress, void *user,
+gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress_fn progress, void *user,
                               const volatile int *cancel, gp_specimen3d **out, gp_error *err)
 {
     double t0 = now();

@@ -161,7 +161,7 @@ static void test_one_size(void)
     gp_specimen3d_destroy(r);
 }
 
-static int cancel_at_compaction(void *user, const gp_progress3d *p)
+static int cancel_at_compaction(void *user, const gp_progress *p)
 {
     int *seen = user;
     (*seen)++;
@@ -205,7 +205,7 @@ static void test_errors(void)
 /* the measures of a tiled packing are summed over its contacts as they are streamed from the
  * flip: asking for the contact list (which is then collected too) changes no bit of them;
  * untiled, tiled (3 x 2 x 2), and with a raised cancel flag in the tiling phase */
-static int raise_at_tiling(void *user, const gp_progress3d *p)
+static int raise_at_tiling(void *user, const gp_progress *p)
 {
     if (strcmp(p->phase, "tiling") == 0)
         __atomic_store_n((int *)user, 1, __ATOMIC_RELAXED);

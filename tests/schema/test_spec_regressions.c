@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../fuzz/fuzz_spec_check.h"
+#include "../../fuzz/fuzz_spec_check.h"
 #include "gp_test.h"
 
 /* a path relative to this file's directory */
@@ -106,8 +106,8 @@ static int replay(const char *rel, int check_names)
 
 int main(void)
 {
-    int nreg = replay("../fuzz/regressions", 0);
-    int nseed = replay("../fuzz/corpus", 1);
+    int nreg = replay("../../fuzz/regressions", 0);
+    int nseed = replay("../../fuzz/corpus", 1);
     printf("replayed %d regression inputs and %d seeds\n", nreg, nseed);
     CHECK(nseed > 0);
     return gp_test_summary();

@@ -156,7 +156,7 @@ static void test_examples(void)
     CHECK(s.imc_init == GP_INIT_HALTON);
     CHECK(s.imc_classes == 0);
     CHECK(s.contour_points == 128);
-    CHECK(s.outputs == (GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS | GP_OUT_CELLS));
+    CHECK(s.outputs == (GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS | GP_OUT2_CELLS));
     gp_spec2d_free(&s);
     CHECK(s.outer.pts == NULL);
     json_decref(j);
@@ -233,7 +233,7 @@ static void test_defaults(void)
     CHECK(s.imc_max_steps == 1000000);
     CHECK(s.imc_init == GP_INIT_UNIFORM);
     CHECK(s.contour_points == 128);
-    CHECK(s.outputs == GP_OUT_GRAINS);
+    CHECK(s.outputs == GP_OUT2_GRAINS);
     CHECK(s.threads == 0);
     gp_spec2d_free(&s);
 

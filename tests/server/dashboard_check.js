@@ -2,7 +2,7 @@
 // a small stand-in DOM, and checks what a finished 2D job looks like: a job with warnings is
 // amber (status, progress bar, a marker naming the warnings), one without is green; the details
 // show the warnings and the fit table, KS above its critical value marked.
-// Usage: node tests/dashboard_check.js PAGE.html   (tests/test_dashboard.c runs it; exit 0 = ok)
+// Usage: node tests/server/dashboard_check.js PAGE.html   (tests/server/test_dashboard.c runs it; exit 0 = ok)
 "use strict";
 const fs = require("fs");
 const vm = require("vm");

@@ -40,13 +40,14 @@
 #include "gp_geom.h"
 #include "gp_fit.h"
 #include "gp_law.h"
+#include "gp_progress.h"
 
 /* outputs (bit flags) */
 enum {
-    GP_OUT_GRAINS = 1u << 0,
-    GP_OUT_ODEC = 1u << 1,
-    GP_OUT_DESCRIPTORS = 1u << 2,
-    GP_OUT_CELLS = 1u << 3
+    GP_OUT2_GRAINS = 1u << 0,
+    GP_OUT2_ODEC = 1u << 1,
+    GP_OUT2_DESCRIPTORS = 1u << 2,
+    GP_OUT2_CELLS = 1u << 3
 };
 
 typedef enum { GP_CONTAINER_POLYGON = 0, GP_CONTAINER_CIRCLE = 1 } gp_container_kind;
@@ -91,7 +92,7 @@ typedef struct gp_spec2d {
     gp_init_kind imc_init;
     int imc_classes;            /* histogram classes; 0 = automatic (see gp_imc.h) */
     size_t contour_points;
-    unsigned outputs;           /* GP_OUT_* */
+    unsigned outputs;           /* GP_OUT2_* */
     int threads;                /* worker threads for filling; 0 = 1 */
 } gp_spec2d;
 
@@ -142,8 +143,8 @@ typedef struct gp_grain2d {
     double orientation_deg;
     double cell_fraction;       /* grain area / cell area */
     int target_met;             /* cell_fraction reached solid_fraction (within 1e-3) */
-    gp_descriptors descriptors; /* valid with GP_OUT_DESCRIPTORS */
-    double *discs;              /* ndiscs * 3: x, y, r (with GP_OUT_ODEC) */
+    gp_descriptors descriptors; /* valid with GP_OUT2_DESCRIPTORS */
+    double *discs;              /* ndiscs * 3: x, y, r (with GP_OUT2_ODEC) */
     size_t ndiscs;
 } gp_grain2d;
 
@@ -158,7 +159,7 @@ typedef struct gp_cell2d {
 typedef struct gp_specimen2d {
     gp_grain2d *grains;
     size_t ngrains;
-    gp_cell2d *cells;           /* with GP_OUT_CELLS */
+    gp_cell2d *cells;           /* with GP_OUT2_CELLS */
     size_t ncells;
     /* stats */
     double container_area;
@@ -181,23 +182,11 @@ typedef struct gp_specimen2d {
     gp_hist grain_size_hist;    /* grain areas, same classes scaled by solid_fraction */
     gp_hist orientation_hist;   /* cells: degrees in [-90, 90), target cosine law vs achieved */
     gp_hist grain_orientation_hist; /* grains, same classes and target */
-    gp_descriptors descriptor_mean; /* with GP_OUT_DESCRIPTORS */
+    gp_descriptors descriptor_mean; /* with GP_OUT2_DESCRIPTORS */
     gp_hist descriptor_hist[4]; /* elongation, roundness, circularity, regularity */
     /* timings, seconds */
     double t_tessellation, t_imc, t_fill, t_odec, t_descriptors, t_total;
 } gp_specimen2d;
-
-/* Progress report: phase ("tessellation", "imc", "fill", "odec", "descriptors"), fraction of
- * the whole job done in [0, 1], and the IMC step count and error where meaningful. */
-typedef struct gp_progress {
-    const char *phase;
-    double fraction;
-    long steps;
-    double error;
-} gp_progress;
-
-/* Called at a bounded rate from the building thread; return non-zero to cancel. */
-typedef int (*gp_progress_fn)(void *user, const gp_progress *p);
 
 /* Builds the specimen. Returns GP_OK, or an error with a message (GP_ERR_CANCELLED when the
  * progress callback or *cancel asked to stop). On success *out owns everything and is freed

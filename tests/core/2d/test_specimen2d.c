@@ -157,7 +157,7 @@ static gp_specimen2d *paper_example(int which, uint64_t seed, unsigned outputs)
         s.D2 = 0.2; s.D3 = 0.01; s.D8 = 0.0;
     }
     gp_specimen2d *r = build(&s);
-    if (r && (outputs & GP_OUT_CELLS))
+    if (r && (outputs & GP_OUT2_CELLS))
         check_fit(r, &s);
     return r;
 }
@@ -166,7 +166,7 @@ static gp_specimen2d *paper_example(int which, uint64_t seed, unsigned outputs)
  * with no overlaps, every grain inside its cell, and the grains turned like their cells. */
 static void example(int which, uint64_t seed, int full)
 {
-    unsigned outputs = GP_OUT_GRAINS | (full ? GP_OUT_CELLS | GP_OUT_DESCRIPTORS : 0);
+    unsigned outputs = GP_OUT2_GRAINS | (full ? GP_OUT2_CELLS | GP_OUT2_DESCRIPTORS : 0);
     gp_specimen2d *r = paper_example(which, seed, outputs);
     CHECK(r != NULL);
     if (!r) return;
@@ -201,7 +201,7 @@ static void small_n(void)
         gp_spec2d s;
         gp_spec2d_defaults(&s);
         s.particles = ns[k];
-        s.outputs = GP_OUT_GRAINS | GP_OUT_CELLS;
+        s.outputs = GP_OUT2_GRAINS | GP_OUT2_CELLS;
         s.threads = 2;
         gp_specimen2d *r = build(&s);
         CHECK(r != NULL);
@@ -233,7 +233,7 @@ static void law_on_grains(void)
     s.cov = 0.5;
     s.size_of_grains = 1;
     s.threads = 2;
-    s.outputs = GP_OUT_GRAINS | GP_OUT_CELLS;
+    s.outputs = GP_OUT2_GRAINS | GP_OUT2_CELLS;
     gp_specimen2d *r = build(&s);
     CHECK(r != NULL);
     if (!r) return;
@@ -307,7 +307,7 @@ static void d2_trends(void)
         s.solid_fraction = 1.0; /* as in the paper's Fig. 14: fill as much as possible */
         s.imc_max_steps = 20000;
         s.threads = 2;
-        s.outputs = GP_OUT_GRAINS | GP_OUT_DESCRIPTORS;
+        s.outputs = GP_OUT2_GRAINS | GP_OUT2_DESCRIPTORS;
         gp_specimen2d *r = build(&s);
         CHECK(r != NULL);
         if (!r) return;
@@ -329,7 +329,7 @@ static void determinism(void)
     s.seed = 7;
     s.particles = 120;
     s.imc_max_steps = 20000;
-    s.outputs = GP_OUT_GRAINS | GP_OUT_ODEC;
+    s.outputs = GP_OUT2_GRAINS | GP_OUT2_ODEC;
     s.threads = 1;
     gp_specimen2d *a = build(&s);
     s.threads = 2;
@@ -384,7 +384,7 @@ static void infeasible_and_nonconvex(void)
     s.nholes = 1;
     s.particles = 150;
     s.imc_max_steps = 20000;
-    s.outputs = GP_OUT_GRAINS | GP_OUT_CELLS;
+    s.outputs = GP_OUT2_GRAINS | GP_OUT2_CELLS;
     r = build(&s);
     CHECK(r != NULL);
     if (r) {

@@ -58,7 +58,7 @@ void gp_spec2d_defaults(gp_spec2d *s)
     s->imc_init = GP_INIT_UNIFORM;
     s->imc_classes = 0;
     s->contour_points = 128;
-    s->outputs = GP_OUT_GRAINS;
+    s->outputs = GP_OUT2_GRAINS;
     s->threads = 1;
 }
 
@@ -389,11 +389,11 @@ static void finish_one(fill_job *j, double *phases, size_t i, double *to, double
     gp_odec_result od;
     memset(&od, 0, sizeof od);
     gp_status st = GP_OK;
-    if (j->outputs & GP_OUT_ODEC)
+    if (j->outputs & GP_OUT2_ODEC)
         st = odec_one(g, &od, &e);
     double t2 = now_s();
     *to += t2 - t1;
-    if (st == GP_OK && (j->outputs & GP_OUT_DESCRIPTORS))
+    if (st == GP_OK && (j->outputs & GP_OUT2_DESCRIPTORS))
         st = describe_one(j, i, phases, &od, &e);
     gp_odec_result_free(&od);
     *td += now_s() - t2;
@@ -482,9 +482,11 @@ static gp_status run_pass(fill_job *job, int pass, double f0, double f1, gp_prog
         nanosleep(&ts, NULL);
         int stop = cancelled(cancel);
         if (!stop && progress) {
-            gp_progress p = {pass == PASS_FILL ? "fill" : "odec",
-                             f0 + (f1 - f0) * (double)atomic_load(&job->done) / (double)n,
-                             job->out->imc_steps, job->out->imc_error};
+            gp_progress p = {
+                .phase = pass == PASS_FILL ? "fill" : "odec",
+                .fraction = f0 + (f1 - f0) * (double)atomic_load(&job->done) / (double)n,
+                .steps = job->out->imc_steps,
+                .error = job->out->imc_error};
             stop = progress(user, &p);
         }
         if (stop) {
@@ -538,7 +540,7 @@ static int imc_progress(void *user, long steps, double error)
         frac = 1.0;
     else if (r->error0 > threshold && error > 0.0)
         frac = fmin(1.0, fmax(0.0, log(r->error0 / error) / log(r->error0 / threshold)));
-    gp_progress p = {"imc", 0.05 + 0.6 * frac, steps, error};
+    gp_progress p = {.phase = "imc", .fraction = 0.05 + 0.6 * frac, .steps = steps, .error = error};
     return r->fn(r->user, &p);
 }
 
@@ -885,7 +887,7 @@ static gp_status grain_stats(build_ctx *b, gp_error *err)
                                                       : out->grains[i].orientation_deg;
     hist_fill(&out->grain_orientation_hist, v, n);
     free(v);
-    if (b->spec->outputs & GP_OUT_DESCRIPTORS)
+    if (b->spec->outputs & GP_OUT2_DESCRIPTORS)
         return descriptor_stats(out, err);
     return GP_OK;
 }
@@ -999,7 +1001,7 @@ static gp_status build_grains(build_ctx *b, gp_error *err)
         st = scale ? rank_match(b, scale, err) : gp_error_set(err, GP_ERR_NOMEM, "out of memory");
         job.area_scale = scale;
     }
-    if (st == GP_OK && (scale || (b->spec->outputs & (GP_OUT_ODEC | GP_OUT_DESCRIPTORS))))
+    if (st == GP_OK && (scale || (b->spec->outputs & (GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS))))
         st = run_pass(&job, PASS_FINISH, 0.9, 1.0, b->progress, b->user, b->cancel, err);
     b->out->t_fill = job.t_fill;
     b->out->t_odec = job.t_odec;
@@ -1130,7 +1132,7 @@ static gp_status build_steps(build_ctx *b, gp_error *err)
     if (st == GP_OK)
         st = make_laws(spec, area, b->n, &b->cell_law, &b->grain_law, err);
     if (st == GP_OK && b->progress) {
-        gp_progress p = {"tessellation", 0.0, 0, 0.0};
+        gp_progress p = {.phase = "tessellation"};
         if (b->progress(b->user, &p) || cancelled(b->cancel))
             st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
     }
@@ -1138,11 +1140,11 @@ static gp_status build_steps(build_ctx *b, gp_error *err)
         st = run_imc(b, err);
     if (st == GP_OK)
         st = check_cancel(b, err);
-    if (st == GP_OK && (spec->outputs & GP_OUT_CELLS))
+    if (st == GP_OK && (spec->outputs & GP_OUT2_CELLS))
         st = output_cells(b, err);
     if (st == GP_OK)
         st = check_cancel(b, err);
-    if (st == GP_OK && (spec->outputs & (GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS)))
+    if (st == GP_OK && (spec->outputs & (GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS)))
         st = build_grains(b, err);
     if (st == GP_OK)
         st = check_cancel(b, err);
@@ -1183,7 +1185,8 @@ gp_status gp_specimen2d_build(const gp_spec2d *spec, gp_progress_fn progress, vo
     }
     b.out->t_total = now_s() - t_start;
     if (progress) {
-        gp_progress p = {"done", 1.0, b.out->imc_steps, b.out->imc_error};
+        gp_progress p = {.phase = "done", .fraction = 1.0, .steps = b.out->imc_steps,
+                         .error = b.out->imc_error};
         progress(user, &p);
     }
     *outp = b.out;

@@ -61,7 +61,7 @@ static void make2d(gp_specimen2d *s, gp_grain2d g[2], gp_spec2d *spec)
     static gp_vec2 box[4] = {{-1, -1}, {4, -1}, {4, 2}, {-1, 2}};
     spec->outer.pts = box;
     spec->outer.n = 4;
-    spec->outputs = GP_OUT_ODEC | GP_OUT_DESCRIPTORS;
+    spec->outputs = GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS;
 }
 
 /* ---- helpers ---- */

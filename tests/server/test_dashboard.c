@@ -1,13 +1,13 @@
 /* test_dashboard.c -- the dashboard page: self-contained HTML that polls the job list, submits,
  * cancels and shows SVG views and exports; a finished job's warnings (amber) and fit table; and
  * dashboard.c is in sync with dashboard.html. With node installed, the page's script also runs
- * against a stand-in DOM (tests/dashboard_check.js) to check how a finished job is drawn. */
+ * against a stand-in DOM (tests/server/dashboard_check.js) to check how a finished job is drawn. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "../server/dashboard.c"
+#include "../../server/dashboard.c"
 #include "gp_test.h"
 
 /* a path relative to this file's directory */
@@ -18,11 +18,11 @@ static void here(char *path, size_t n, const char *rel)
     snprintf(path, n, "%.*s/%s", slash ? (int)(slash - me) : 1, slash ? me : ".", rel);
 }
 
-/* server/dashboard.html next to this file's ../server */
+/* server/dashboard.html, two levels up from this file */
 static char *read_html(void)
 {
     char path[1024];
-    here(path, sizeof path, "../server/dashboard.html");
+    here(path, sizeof path, "../../server/dashboard.html");
     FILE *f = fopen(path, "rb");
     if (!f) {
         fprintf(stderr, "cannot open %s\n", path);
@@ -37,7 +37,7 @@ static char *read_html(void)
     return buf;
 }
 
-/* the page's script in node (tests/dashboard_check.js); skipped without node */
+/* the page's script in node (tests/server/dashboard_check.js); skipped without node */
 static void run_in_node(const char *page)
 {
     if (system("node --version >/dev/null 2>&1") != 0) {

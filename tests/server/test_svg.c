@@ -1,6 +1,6 @@
 /* test_svg.c -- the SVG views of a hand-made 2D and 3D result: well-formed XML, one
  * <polygon>/<circle> per grain, cell part, seed or cut sphere, axes and labels, errors for
- * unknown views and missing parts, and a 10,000-grain packing drawn quickly and compactly.
+ * unknown views and missing parts, and a 10,000-grain packing drawn compactly.
  * The size view from stats.fit (CDF curves, KS lines, warnings), and stats.fit / warnings as
  * server/result_json.c writes them from a specimen, drawn by the size view.
  * Compact reading (what GET /svg does): server/json_scan.c (member spans, array walks, the
@@ -15,9 +15,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "../server/json_scan.c"
-#include "../server/result_json.c"
-#include "../server/svg.c"
+#include "../../server/json_scan.c"
+#include "../../server/result_json.c"
+#include "../../server/svg.c"
 #include "gp_test.h"
 
 static size_t count(const char *hay, const char *needle)
@@ -535,14 +535,11 @@ static void test_large(void)
     size_t len;
     int status;
     char err[256];
-    clock_t t0 = clock();
+    /* (its speed is measured by bench/bench_svg.py, not asserted here) */
     char *s = render(r, "fourier-voronoi-2d", "packing", NULL, &len, &status, err);
-    double dt = (double)(clock() - t0) / CLOCKS_PER_SEC;
-    printf("10000 grains: %.3f s, %zu bytes\n", dt, len);
     CHECK(s != NULL);
     CHECK(s && count(s, "<polygon") == 10000);
     CHECK(len < 8u * 1024 * 1024);
-    CHECK(dt < 5.0);
     CHECK(s && well_formed(s, len));
     free(s);
     json_decref(r);
@@ -755,7 +752,7 @@ static void test_compact_2d(void)
     spec.container = GP_CONTAINER_POLYGON;
     spec.outer = (gp_ring){outer, 4};
     spec.particles = NG;
-    spec.outputs = GP_OUT_GRAINS | GP_OUT_ODEC | GP_OUT_DESCRIPTORS | GP_OUT_CELLS;
+    spec.outputs = GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS | GP_OUT2_CELLS;
     json_error_t e;
     json_t *sj = json_loads("{\"container\": {\"polygon\": [[0,0],[1,0],[1,0.69],[0,0.69]]}}", 0, &e);
     json_t *r = gpd_result_2d(&s, &spec, sj);
