@@ -81,6 +81,19 @@ def call(url, method="GET", body=None):
         return e.code, json.loads(e.read() or b"null")
 
 
+def download(url):
+    """GET url, reading the body in 1 MB pieces without keeping it: (status, bytes)."""
+    n = 0
+    with urllib.request.urlopen(url, timeout=600) as r:
+        status = r.status
+        while True:
+            b = r.read(1 << 20)
+            if not b:
+                break
+            n += len(b)
+    return status, n
+
+
 def submit(base, spec):
     st, j = call(base + "/v1/jobs", "POST", spec)
     if st != 201:
@@ -126,16 +139,9 @@ def measure(pid, url):
 
     th = threading.Thread(target=sample)
     th.start()
-    n = 0
     t0 = time.perf_counter()
     try:
-        with urllib.request.urlopen(url, timeout=600) as r:
-            status = r.status
-            while True:
-                b = r.read(1 << 20)
-                if not b:
-                    break
-                n += len(b)
+        status, n = download(url)
     finally:
         dt = time.perf_counter() - t0
         done.set()

@@ -29,12 +29,11 @@ import shutil
 import sys
 import tempfile
 import time
-import urllib.request
 from concurrent.futures import ThreadPoolExecutor
 
 # the daemon harness is bench_export.py's
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_export import call, proc_status, start, stop, submit  # noqa: E402
+from bench_export import call, download, proc_status, start, stop, submit  # noqa: E402
 
 SPEC_3D = {"kind": "spheres-3d", "box": [0.5, 0.5, 0.5], "porosity": 0.38,
            "outputs": ["spheres"]}
@@ -58,14 +57,7 @@ def wait(base, jid, what):
 
 def fetch(url):
     t0 = time.perf_counter()
-    n = 0
-    with urllib.request.urlopen(url, timeout=600) as r:
-        status = r.status
-        while True:
-            b = r.read(1 << 20)
-            if not b:
-                break
-            n += len(b)
+    status, n = download(url)
     assert status == 200, (url, status)
     return n, time.perf_counter() - t0
 

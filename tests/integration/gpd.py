@@ -9,6 +9,7 @@ import os
 import select
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -147,6 +148,41 @@ class Daemon:
                 return r.status, r.headers, r.read()
         except urllib.error.HTTPError as e:
             return e.code, e.headers, e.read()
+
+    def port(self):
+        return int(self.url.rsplit(":", 1)[1])
+
+    def raw(self, head, body_chunks=(), timeout=20):
+        """Sends bytes on a raw socket (for what urllib will not send: an oversized body, a
+        70 KB request line) and reads the answer until its Content-Length or the close;
+        returns (status, headers with lower-case names, body)."""
+        s = socket.create_connection(("127.0.0.1", self.port()), timeout=timeout)
+        try:
+            s.sendall(head)
+            try:
+                for c in body_chunks:
+                    s.sendall(c)
+            except (BrokenPipeError, ConnectionResetError):
+                pass  # the daemon answered and closed before the whole body was sent
+            data = b""
+            while True:
+                head_end = data.find(b"\r\n\r\n")
+                if head_end >= 0:
+                    lines = data[:head_end].decode("latin-1").split("\r\n")
+                    hdrs = {k.lower(): v for k, v in (l.split(": ", 1) for l in lines[1:])}
+                    length = hdrs.get("content-length")
+                    if length is not None and len(data) >= head_end + 4 + int(length):
+                        break
+                chunk = s.recv(65536)
+                if not chunk:
+                    break
+                data += chunk
+        finally:
+            s.close()
+        head_part, _, body = data.partition(b"\r\n\r\n")
+        lines = head_part.decode("latin-1").split("\r\n")
+        hdrs = {k.lower(): v for k, v in (l.split(": ", 1) for l in lines[1:])}
+        return int(lines[0].split(" ")[1]), hdrs, body
 
     def json(self, method, path, body=None, **kw):
         st, h, b = self.request(method, path, body, **kw)

@@ -1,7 +1,6 @@
 """Bad inputs get the right 4xx and the error body {"error": {"code", "message", "pointer"}}."""
 import json
 import os
-import socket
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -83,30 +82,9 @@ def test_spec_errors(env):
     assert d.stop() == 0, d.read_log()
 
 
-def raw_http(d, head, body_chunks=(), read_timeout=20):
-    """Sends a request on a raw socket (for oversized bodies); returns (status, json body)."""
-    host, port = d.url[len("http://"):].split(":")
-    s = socket.create_connection((host, int(port)), timeout=read_timeout)
-    try:
-        s.sendall(head)
-        try:
-            for c in body_chunks:
-                s.sendall(c)
-        except (BrokenPipeError, ConnectionResetError):
-            pass
-        data = b""
-        while b"\r\n\r\n" not in data or len(data) < data.index(b"\r\n\r\n") + 4 + int(
-                dict(l.split(b": ", 1) for l in data.split(b"\r\n\r\n")[0].split(b"\r\n")[1:])
-                .get(b"Content-Length", b"0")):
-            chunk = s.recv(65536)
-            if not chunk:
-                break
-            data += chunk
-    finally:
-        s.close()
-    head_part, _, body = data.partition(b"\r\n\r\n")
-    status = int(head_part.split(b" ")[1])
-    return status, json.loads(body)
+def raw_http(d, head, body_chunks=()):
+    st, _, body = d.raw(head, body_chunks)
+    return st, json.loads(body)
 
 
 def test_body_limit(env):

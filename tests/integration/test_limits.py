@@ -153,22 +153,29 @@ def test_second_daemon_refused(env):
     assert d3.stop() == 0, d3.read_log()
 
 
-def test_result_too_big_fails(env):
-    # SQLite's length limit lowered to 20 kB (a testing hook): SMALL_2D's result is larger, so
-    # it cannot be stored -- the job fails saying so, it never shows succeeded without a result
-    d = env.daemon(workers=1, env={"GRAINPACK_TEST_SQLITE_MAX_LENGTH": "20000"})
+def run_unstorable(d, code, what):
+    """Runs SMALL_2D on a daemon whose store cannot keep its result: the job fails with code,
+    its result is 409, no worker stays busy. Returns (the job's error, /v1/health)."""
     jid = d.submit(gpd.SMALL_2D)
     j = d.wait(jid, timeout=60)
     gpd.check_job_object(j)
     assert j["status"] == "failed", j
     e = j["error"]
-    assert e["code"] == "too_large", e
-    assert "result" in e["message"] and "20000 bytes" in e["message"], e
-    print("  too big: %s" % e["message"])
+    assert e["code"] == code, e
+    print("  %s: %s" % (what, e["message"]))
     st, _, b = d.json("GET", "/v1/jobs/%s/result" % jid)
     assert st == 409, (st, b)
     _, h = health_latency(d)
     assert h["running"] == 0 and h["workers_busy"] == 0, h
+    return e, h
+
+
+def test_result_too_big_fails(env):
+    # SQLite's length limit lowered to 20 kB (a testing hook): SMALL_2D's result is larger, so
+    # it cannot be stored -- the job fails saying so, it never shows succeeded without a result
+    d = env.daemon(workers=1, env={"GRAINPACK_TEST_SQLITE_MAX_LENGTH": "20000"})
+    e, h = run_unstorable(d, "too_large", "too big")
+    assert "result" in e["message"] and "20000 bytes" in e["message"], e
     # a result over SQLite's value limit is the job's problem, not the database's
     assert h["status"] == "ok" and h["database"] == "ok", h
     assert d.stop() == 0, d.read_log()
@@ -179,18 +186,9 @@ def test_disk_full_fails_visibly(env):
     # full disk): the job is small, its result is not; the commit is tried twice, then the job
     # fails with code store_error -- not left running
     d = env.daemon(workers=1, env={"GRAINPACK_TEST_SQLITE_MAX_PAGES": "10"})
-    jid = d.submit(gpd.SMALL_2D)
-    j = d.wait(jid, timeout=60)
-    gpd.check_job_object(j)
-    assert j["status"] == "failed", j
-    e = j["error"]
-    assert e["code"] == "store_error", e
+    e, h = run_unstorable(d, "store_error", "disk full")
     assert "full" in e["message"] and "tried twice" in e["message"], e
-    print("  disk full: %s" % e["message"])
     assert "retrying once" in d.read_log(), d.read_log()
-    assert d.json("GET", "/v1/jobs/%s/result" % jid)[0] == 409
-    _, h = health_latency(d)
-    assert h["running"] == 0 and h["workers_busy"] == 0, h
     # health says that writes fail, though reads (and the small status update) pass
     assert h["status"] == "degraded" and h["database"] == "write_failed", h
     we = h["database_error"]

@@ -19,10 +19,6 @@ import gpd  # noqa: E402
 EVIL = "http://evil.example"
 
 
-def port_of(d):
-    return int(d.url.rsplit(":", 1)[1])
-
-
 def post(d, headers, body=None):
     raw = json.dumps(body or gpd.SMALL_2D).encode()
     st, h, b = d.request("POST", "/v1/jobs", raw=raw, headers=headers)
@@ -37,7 +33,7 @@ def jobs(d):
 
 def test_cross_origin_refused(env):
     d = env.daemon(workers=1)
-    port = port_of(d)
+    port = d.port()
     # the CSRF of the issue: a page on another site posts text/plain (no preflight)
     for origin in (EVIL, EVIL + ":%d" % port, "null", "http://127.0.0.1:%d" % (port + 1),
                    "http://localhost", "https://evil.example", "http://127.0.0.1.evil.example:%d"
@@ -70,7 +66,7 @@ def test_cross_origin_refused(env):
 
 def test_same_origin_accepted(env):
     d = env.daemon(workers=1)
-    port = port_of(d)
+    port = d.port()
     # the dashboard's own page (as reached: Origin equals the Host it sent), and a page at
     # localhost calling 127.0.0.1 (both the daemon)
     for origin, host in ((d.url, None), ("http://localhost:%d" % port, None),
@@ -149,7 +145,7 @@ def test_allow_origin(env):
 
 def test_host_checked(env):
     d = env.daemon(workers=1)
-    port = port_of(d)
+    port = d.port()
     jid = d.submit(gpd.LONG_2D)
     # DNS rebinding: the page's name is in Host, whatever address it resolves to
     for host in ("evil.example", "evil.example:%d" % port, "rebind.evil.example:%d" % port,
@@ -181,7 +177,7 @@ def test_host_wildcard(env):
     except (RuntimeError, AssertionError) as e:
         print("cannot listen on 0.0.0.0 here (%s): skipped" % str(e).splitlines()[0])
         return
-    port = port_of(d)
+    port = d.port()
     for host in ("192.0.2.7:%d" % port, "0.0.0.0:%d" % port, "[2001:db8::1]:%d" % port,
                  socket.gethostname().lower(), "localhost"):
         st, _, j = d.json("GET", "/v1/jobs", headers={"Host": host})
@@ -203,23 +199,8 @@ def test_host_wildcard(env):
 
 def raw_get(d, target, extra=b""):
     """GET on a raw socket; returns (status, headers dict, body)."""
-    port = port_of(d)
-    s = socket.create_connection(("127.0.0.1", port), timeout=20)
-    try:
-        s.sendall(b"GET " + target + b" HTTP/1.1\r\nHost: 127.0.0.1:%d\r\n" % port + extra +
-                  b"Connection: close\r\n\r\n")
-        data = b""
-        while True:
-            chunk = s.recv(65536)
-            if not chunk:
-                break
-            data += chunk
-    finally:
-        s.close()
-    head, _, body = data.partition(b"\r\n\r\n")
-    lines = head.decode("latin-1").split("\r\n")
-    hdrs = {k.lower(): v for k, v in (l.split(": ", 1) for l in lines[1:])}
-    return int(lines[0].split(" ")[1]), hdrs, body
+    return d.raw(b"GET " + target + b" HTTP/1.1\r\nHost: 127.0.0.1:%d\r\n" % d.port() + extra +
+                 b"Connection: close\r\n\r\n")
 
 
 def test_long_url(env):
