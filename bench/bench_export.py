@@ -152,13 +152,19 @@ def measure(pid, url):
             "anon0": before["RssAnon"], "anon_peak": peak_anon[0]}
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def job_args(doc):
+    """The arguments bench_export and bench_svg share: the daemon, and the jobs to build."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("binary")
-    ap.add_argument("--tiling", default="4,4,6", help="3D tiling (default 4,4,6: ~233k spheres)")
+    ap.add_argument("--tiling", default="4,4,6", help="3D tiling (default 4,4,6: 233,280 spheres)")
     ap.add_argument("--seed", type=int, default=7)
     ap.add_argument("--grains", type=int, default=10000, help="2D grains (0: no 2D job)")
     ap.add_argument("--workers", type=int, default=2)
+    return ap
+
+
+def main():
+    ap = job_args(__doc__)
     ap.add_argument("--no-restart", action="store_true",
                     help="measure in the daemon that ran the jobs (its freed heap stays resident)")
     ap.add_argument("--keep", action="store_true", help="keep the temporary database")

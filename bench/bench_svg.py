@@ -23,7 +23,6 @@ a database (e.g. one kept with --keep, or built by an older daemon: rows stored 
 result summary existed take the fallback path). Linux only (/proc); Python standard library
 only; not part of `cmake --build build --target bench` (no C to build).
 """
-import argparse
 import os
 import shutil
 import sys
@@ -33,7 +32,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 # the daemon harness is bench_export.py's
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_export import call, download, proc_status, start, stop, submit  # noqa: E402
+from bench_export import call, download, job_args, proc_status, start, stop, submit  # noqa: E402
 
 SPEC_3D = {"kind": "spheres-3d", "box": [0.5, 0.5, 0.5], "porosity": 0.38,
            "outputs": ["spheres"]}
@@ -79,12 +78,7 @@ def round_(pid, urls):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("binary")
-    ap.add_argument("--tiling", default="4,4,6", help="3D tiling (default 4,4,6: 233,280 spheres)")
-    ap.add_argument("--seed", type=int, default=7)
-    ap.add_argument("--grains", type=int, default=10000, help="2D grains (0: no 2D job)")
-    ap.add_argument("--workers", type=int, default=2)
+    ap = job_args(__doc__)
     ap.add_argument("--db", help="reuse this database (with --job3 and/or --job2)")
     ap.add_argument("--job3", help="id of a succeeded spheres-3d job in --db")
     ap.add_argument("--job2", help="id of a succeeded fourier-voronoi-2d job in --db")
