@@ -24,7 +24,7 @@
  *   zigzag x 0.027 / 0.11 / 0.26; stack y 0.44 / 4.4 / 42; comb y 6.0; stack comb 48;
  *   holes 0.21; stack y, cross 0.42 / 0.88; stack comb, cross 1.0.
  * After: every row at most 0.032 s (100,000 edges: 0.015-0.032 s, about what jansson takes to
- * parse the body), a plane sweep in O(E log E) (schema/gp_spec.c).
+ * parse the body), a plane sweep in O(E log E) (core/2d/gp_rings.c, called by schema/gp_spec2d.c).
  *
  * Usage: bench_validate */
 #include <math.h>
@@ -200,7 +200,9 @@ static void row(const char *name, char *text, size_t edges)
         if (t > 1) break;
     }
     char verdict[300];
-    if (rc) snprintf(verdict, sizeof verdict, "%d %s %s", p.http_status, p.code, p.pointer);
+    /* the status as the server chooses it from the code (server/http.c) */
+    int status = strcmp(p.code, "internal") ? 422 : 500;
+    if (rc) snprintf(verdict, sizeof verdict, "%d %s %s", status, p.code, p.pointer);
     else snprintf(verdict, sizeof verdict, "ok");
     if (rc && getenv("VERBOSE")) fprintf(stderr, "%s\n", p.message);
     printf("| %-17s | %7zu | %7.0f | %8.4f | %8.4f | %-35s |\n", name, edges,

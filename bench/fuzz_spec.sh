@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# fuzz_spec.sh -- fuzzes the spec validator and parsers (schema/gp_spec.c) with libFuzzer.
+# fuzz_spec.sh -- fuzzes the spec validator and parsers (schema/: gp_schema_engine.c, gp_spec.c, gp_spec2d.c, gp_spec3d.c) with libFuzzer.
 #
 # Configures a build directory of its own with clang and -DGP_FUZZ=ON (every library under
 # -fsanitize=fuzzer-no-link,address,undefined; the default gcc build is untouched), builds

@@ -3,6 +3,10 @@
  * Every core function that can fail returns a gp_status (GP_OK == 0) and, when the caller
  * passes a non-NULL gp_error, fills it with the same code and a one-line human message that
  * names the offending argument. Passing NULL is always allowed.
+ *
+ * Ownership and thread safety: a gp_error is a plain struct the caller owns (usually on its
+ * stack); nothing here allocates or has global state, so threads with their own gp_error
+ * never interfere.
  */
 #ifndef GP_ERROR_H
 #define GP_ERROR_H

@@ -127,7 +127,8 @@ void gp_rng_derive_key(uint64_t seed, uint64_t stream, uint32_t key[4])
     key[3] = (uint32_t)(b >> 32);
 }
 
-gp_rng *gp_rng_create(uint64_t seed, uint64_t stream, gp_error *err)
+/* a stream seeded by init_by_array(key, len) */
+static gp_rng *rng_from_key(const uint32_t *key, int len, gp_error *err)
 {
     gp_rng *r = malloc(sizeof *r);
     if (!r) {
@@ -136,10 +137,15 @@ gp_rng *gp_rng_create(uint64_t seed, uint64_t stream, gp_error *err)
     }
     r->g.type = &gp_mt_type;
     r->g.state = &r->st;
+    mt_init_by_array(&r->st, key, len);
+    return r;
+}
+
+gp_rng *gp_rng_create(uint64_t seed, uint64_t stream, gp_error *err)
+{
     uint32_t key[4];
     gp_rng_derive_key(seed, stream, key);
-    mt_init_by_array(&r->st, key, 4);
-    return r;
+    return rng_from_key(key, 4, err);
 }
 
 gp_rng *gp_rng_create_from_key(const uint32_t *key, size_t len, gp_error *err)
@@ -148,15 +154,7 @@ gp_rng *gp_rng_create_from_key(const uint32_t *key, size_t len, gp_error *err)
         gp_error_set(err, GP_ERR_INVALID, "rng: key must have 1 or more words");
         return NULL;
     }
-    gp_rng *r = malloc(sizeof *r);
-    if (!r) {
-        gp_error_set(err, GP_ERR_NOMEM, "rng: out of memory");
-        return NULL;
-    }
-    r->g.type = &gp_mt_type;
-    r->g.state = &r->st;
-    mt_init_by_array(&r->st, key, (int)len);
-    return r;
+    return rng_from_key(key, (int)len, err);
 }
 
 void gp_rng_destroy(gp_rng *r) { free(r); }

@@ -16,7 +16,9 @@
  * seeded here rather than through it.) Each gp_rng exposes a gsl_rng view, so any gsl_ran_*
  * distribution can draw from the same stream.
  *
- * A gp_rng is not thread-safe; use one per thread / work item. Nothing here has global state.
+ * Ownership: gp_rng_create*() return a stream the caller frees with gp_rng_destroy(); its
+ * gsl_rng view (gp_rng_gsl) lives inside it. A gp_rng is not thread-safe; use one per
+ * thread / work item. Nothing here has global state.
  */
 #ifndef GP_RNG_H
 #define GP_RNG_H

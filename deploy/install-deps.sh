@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages grainpack builds against. With --test, also the tools its tests
 # use: the DEM programs lammps, liggghts and yade, and VTK's Python reader, which prove that the
-# export files load (tests/run.sh passes it).
+# export files load, node (the dashboard's script) and promtool (package prometheus: checks the
+# /metrics text) (tests/run.sh passes it).
 # Idempotent; needs root (or sudo). Usage: bash deploy/install-deps.sh [--test]
 set -euo pipefail
 SUDO=""
@@ -10,7 +11,7 @@ PKGS="build-essential cmake pkg-config \
   libmicrohttpd-dev libjansson-dev libsqlite3-dev libfftw3-dev libgsl-dev \
   python3 curl wrk"
 if [ "${1:-}" = "--test" ]; then
-  PKGS="$PKGS lammps liggghts yade python3-vtk9 nodejs"
+  PKGS="$PKGS lammps liggghts yade python3-vtk9 nodejs prometheus"
 fi
 missing=""
 for p in $PKGS; do

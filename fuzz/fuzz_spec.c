@@ -27,8 +27,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (!res.json_ok) fprintf(stderr, "fuzz_spec: not JSON\n");
         else if (res.valid) fprintf(stderr, "fuzz_spec: valid\n");
         else
-            fprintf(stderr, "fuzz_spec: %d %s: %s\n", res.problem.http_status, res.problem.code,
-                    res.problem.message);
+            fprintf(stderr, "fuzz_spec: %s: %s\n", res.problem.code, res.problem.message);
     }
     if (broken) {
         fprintf(stderr, "fuzz_spec: contract broken: %s\n", broken);

@@ -1,47 +1,58 @@
-/* gp_spec.h -- the JSON Schemas of a job spec, a validator that interprets them, and the
- * parsers from a valid spec to the core's spec structs.
+/* gp_spec.h -- the spec layer of the service: the JSON Schemas of a job spec, a validator
+ * that interprets them, the semantic checks the schemas cannot express, the defaults, the
+ * parsers from an effective spec to the core's spec structs, and the work and result bounds.
  *
- * Single source of truth: schema/fourier-voronoi-2d.schema.json and
- * schema/spheres-3d.schema.json (JSON Schema 2020-12), embedded into the library at build
+ * Single source of truth: schema/<kind>.schema.json (JSON Schema 2020-12, one per kind: the
+ * 2D Fourier-Voronoi specimen and the 3D sphere packing), embedded into the library at build
  * time. The validator interprets those documents (type, properties, required,
  * additionalProperties, minimum/maximum/exclusiveMinimum/exclusiveMaximum, minItems/maxItems,
- * items, prefixItems, enum, const, oneOf, uniqueItems, minLength/maxLength, local $ref) and
- * the defaults are read from their "default" keywords.
+ * items, prefixItems, enum, const, oneOf, uniqueItems, minLength/maxLength, local $ref) and the
+ * defaults are read from their "default" keywords.
+ *
+ * Layout (schema/): gp_schema_engine.c, the generic JSON Schema interpreter; gp_spec.c, the
+ * table of kinds and what they share (dispatch, defaults, problems, bounds entry points);
+ * gp_spec2d.c and gp_spec3d.c, each kind's parser, semantic checks and bounds. The polygon
+ * rings of a 2D container are checked by the core (core/2d/gp_rings.h: exact plane sweep).
+ *
+ * The life of a spec: POST /v1/jobs calls gp_spec_with_defaults() once (schema, semantic
+ * checks, work budget; the result is the effective spec the daemon stores), then
+ * gp_spec_check_result(); the worker reads the stored effective spec with gp_spec2d_read() /
+ * gp_spec3d_read(), which do NOT validate again.
  *
  * GET /v1/schema serves gp_schema_document(): one document
  *   {"$schema": ".../2020-12/schema", "$id": "...", "title": ..., "description": ...,
- *    "oneOf": [{"$ref": "#/$defs/fourier-voronoi-2d"}, {"$ref": "#/$defs/spheres-3d"}],
- *    "$defs": {"fourier-voronoi-2d": <2D schema>, "spheres-3d": <3D schema>}}
+ *    "oneOf": [{"$ref": "#/$defs/<2D kind>"}, {"$ref": "#/$defs/<3D kind>"}],
+ *    "$defs": {"<2D kind>": <2D schema>, "<3D kind>": <3D schema>}}
  * (each kind's schema is a complete embedded schema resource with its own $id).
  *
  * Problems. The FIRST problem found (instance keys in document order, then missing required
- * fields) is reported:
- *   http_status 400, code "invalid_spec"  -- the spec breaks its schema (wrong type, range,
- *                                            unknown field, missing field, bad enum, unknown
- *                                            kind, ...);
- *   http_status 422, code "invalid_spec"  -- the spec fits the schema but is not meaningful
- *                                            (self-intersecting polygon, hole outside the
- *                                            container, sieve rows not increasing, largest
- *                                            sieve diameter larger than the box, a size.cov
- *                                            out of its law's range, a field that size.law
- *                                            excludes or needs, an E1-E3 imc.threshold below
- *                                            the integer-count floor of the cell count, ...);
- *   http_status 422, code "too_large"     -- a 2D sieve law whose derived cell count exceeds
- *                                            the schema's particles maximum (/size/sieve);
- *                                            a 3D sample of more spheres than the DEM takes
- *                                            (/box) or a tiling beyond its sphere limit
- *                                            (/tiling); a spec whose estimated work is over
- *                                            GP_SPEC_WORK_BUDGET_S (see gp_spec_bounds), at
- *                                            the field that drives it;
- *   http_status 500, code "internal"      -- out of memory, broken embedded schema.
+ * fields) is reported, with a code; the HTTP layer chooses the status (server/http.c: 500 for
+ * "internal", 422 for the others):
+ *   "invalid_spec" -- the spec breaks its schema (wrong type, range, unknown field, missing
+ *                     field, bad enum, unknown kind, ...), or fits it but is not meaningful
+ *                     (self-intersecting polygon, hole outside the container, sieve rows not
+ *                     increasing, largest sieve diameter larger than the box, a size.cov out of
+ *                     its law's range, a field that size.law excludes or needs, an E1-E3
+ *                     imc.threshold below the integer-count floor of the cell count, ...);
+ *   "too_large"    -- a 2D sieve law whose derived cell count exceeds the schema's particles
+ *                     maximum (/size/sieve); a 3D sample of more spheres than the DEM takes
+ *                     (/box) or a tiling beyond its sphere limit (/tiling); a spec whose
+ *                     estimated work is over GP_SPEC_WORK_BUDGET_S (see gp_spec_bounds), at the
+ *                     field that drives it; a result over the server's bound;
+ *   "internal"     -- out of memory, a broken embedded schema, or a parser given what is not
+ *                     an effective spec (a field missing or malformed).
  * pointer is an RFC 6901 JSON pointer into the spec ("" is the whole document, keys escaped
  * with ~0/~1). For a missing required field the pointer names the missing field itself
  * (e.g. "/imc/error"). message is one human line that starts with the pointer, e.g.
  *   /size/cov: expected a number >= 0, got "abc"
- *   /kind: unknown kind "x"; expected one of "fourier-voronoi-2d", "spheres-3d"
+ *   /kind: unknown kind "x"; expected one of <the kinds, quoted>
  *   /container/polygon: expected at least 3 items, got 2
  *   /particles: unknown field (allowed here: ...)
- * Thread-safe: the embedded schemas are parsed once (pthread_once) and only read afterwards.
+ *
+ * Ownership: the functions only read the specs they are given; what they return is the
+ * caller's (a new JSON reference, or arrays in a struct to free with its _free function).
+ * Thread safety: every function may be called from several threads at once; the embedded
+ * schemas are parsed once (pthread_once) and only read afterwards.
  */
 #ifndef GP_SPEC_H
 #define GP_SPEC_H
@@ -52,13 +63,13 @@
 #include "gp_specimen3d.h"
 
 typedef struct gp_spec_problem {
-    int http_status;            /* 400, 422 or 500 (0 when no problem) */
-    char code[32];              /* "invalid_spec" or "internal" */
+    char code[32];              /* "invalid_spec", "too_large" or "internal" ("" when none) */
     char pointer[256];          /* RFC 6901 pointer of the first bad field */
     char message[512];          /* "<pointer>: expected ..., got ..." */
 } gp_spec_problem;
 
-/* The kinds, NULL-terminated: {"fourier-voronoi-2d", "spheres-3d", NULL}. */
+/* The kinds' names, NULL-terminated: {<2D kind>, <3D kind>, NULL} (the "kind" of a spec;
+ * schema/<kind>.schema.json). */
 const char *const *gp_spec_kinds(void);
 
 /* The combined schema document served at GET /v1/schema (static, NUL-terminated JSON). */
@@ -81,30 +92,34 @@ int gp_spec_validate(const json_t *spec, gp_spec_problem *p);
  * read-only: change neither in place while the other is in use. */
 json_t *gp_spec_with_defaults(const json_t *spec, gp_spec_problem *p);
 
-/* Validates and parses a spec of kind "fourier-voronoi-2d" into *out, defaults applied
- * (out->threads is set to 0: the caller picks; out->particles is 0 with a sieve law, whose
- * sieve_d are in metres, converted from size.sieve_units). Returns 0 on success; *out then
- * owns its arrays (outer.pts, holes[*].pts, holes, spectrum, sieve_d, sieve_pass) and must be
- * released with gp_spec2d_free(). On failure returns -1, fills *p, and *out owns nothing
- * (freeing it is still allowed). */
-int gp_spec2d_read(const json_t *spec, gp_spec2d *out, gp_spec_problem *p);
+/* Parses an effective spec of the 2D kind -- one that gp_spec_with_defaults() returned (or
+ * its JSON text read back) -- into *out, WITHOUT validating it again: the input must come from
+ * gp_spec_with_defaults. out->threads is 0 (the caller picks); out->particles
+ * is 0 with a sieve law, whose sieve_d are in metres, converted from size.sieve_units. A cheap
+ * guard only: another kind is refused with invalid_spec at /kind, a field missing or of the
+ * wrong form with "internal" at that field. Returns 0 on success; *out then owns its arrays
+ * (outer.pts, holes[*].pts, holes, spectrum, sieve_d, sieve_pass) and must be released with
+ * gp_spec2d_free(). On failure returns -1, fills *p, and *out owns nothing (freeing it is still
+ * allowed). */
+int gp_spec2d_read(const json_t *effective_spec, gp_spec2d *out, gp_spec_problem *p);
 void gp_spec2d_free(gp_spec2d *s);
 
-/* The same for kind "spheres-3d": sieve diameters converted to metres (sieve_units), tiling
- * {1, 1, 1} when absent; threads, max_steps and tile_relax_steps are set to 0 (the caller
- * picks). *out owns its sieve array; release with gp_spec3d_free(). */
-int gp_spec3d_read(const json_t *spec, gp_spec3d *out, gp_spec_problem *p);
+/* The same for the 3D kind (from gp_spec_with_defaults, not validated again): sieve
+ * diameters converted to metres (sieve_units), tiling {1, 1, 1} when absent; threads,
+ * max_steps and tile_relax_steps are set to 0 (the caller picks). *out owns its sieve array;
+ * release with gp_spec3d_free(). */
+int gp_spec3d_read(const json_t *effective_spec, gp_spec3d *out, gp_spec_problem *p);
 void gp_spec3d_free(gp_spec3d *s);
 
 /* ---- work and result bounds (api.md "Limits and origin") ---- */
 
 /* What a job of a valid effective spec will cost, estimated from its numbers whatever their
  * spelling (1e6 is the integer 1000000), in one place per kind:
- *   fourier-voronoi-2d: cells = particles, or the count a sieve law derives; the IMC at its cap
+ *   2D: cells = particles, or the count a sieve law derives; the IMC at its cap
  *     (imc.max_steps moves, each costing a little more on more cells), the filling, ODEC and
  *     descriptors per grain in proportion to contour_points; the result as server/http.c has
  *     always estimated it (bytes per grain by outputs and contour_points);
- *   spheres-3d: the sample's spheres (gp_sieve_expected_count, the count the DEM draws), its
+ *   3D: the sample's spheres (gp_sieve_expected_count, the count the DEM draws), its
  *     time step (gp_dem3d.h: 0.3 sqrt(m / 2 E R) at the density-scaling radius of
  *     gp_specimen3d.c) and the steps its protocol needs (durations are multiples of
  *     sqrt(d50 / g)); the result by spheres and contacts of the tiled packing.
@@ -121,8 +136,8 @@ typedef struct gp_spec_bounds {
     const char *result_pointer; /* the field that drives the result size (static string) */
 } gp_spec_bounds_t;
 
-/* The fixed work budget: a spec whose work_s is over it is refused at validation (422
- * too_large at work_pointer), by gp_spec_validate, gp_spec_with_defaults and the parsers.
+/* The fixed work budget: a spec whose work_s is over it is refused at validation (too_large at
+ * work_pointer), by gp_spec_validate and gp_spec_with_defaults.
  * Two days of one core. The paper's 3D example is estimated at ~30 s and a 10,000-grain 2D
  * specimen with every output at ~2 min, three orders of magnitude below; the test suite's long
  * job (40,000 cells, E3 at 1e-9, imc.max_steps 1e9: ~1.4 days at its cap) passes. Refused:
@@ -137,7 +152,7 @@ typedef struct gp_spec_bounds {
 int gp_spec_bounds(const json_t *effective_spec, gp_spec_bounds_t *out, gp_spec_problem *p);
 
 /* The server's result bound: 0 when the estimated result of a valid effective spec is at most
- * max_bytes, else -1 with *p = 422 too_large at result_pointer ("/particles", "/size/sieve",
+ * max_bytes, else -1 with *p = too_large at result_pointer ("/particles", "/size/sieve",
  * "/box" or "/tiling") and a message that gives both sizes in MB and names
  * --max-result-mb; -1 with *p from gp_spec_bounds when it fails. */
 int gp_spec_check_result(const json_t *effective_spec, double max_bytes, gp_spec_problem *p);

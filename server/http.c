@@ -1,8 +1,6 @@
 /* http.c -- libmicrohttpd front: routing, request bodies, JSON errors (see http.h). */
 #include "http.h"
 
-#include <arpa/inet.h>
-#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <netdb.h>
@@ -20,23 +18,13 @@
 #include <microhttpd.h>
 
 #include "gp_export.h"
-#include "offload.h"
-#include "store.h"
-#include "workers.h"
-#ifdef GPD_HAVE_SCHEMA
 #include "gp_spec.h"
-#endif
-#ifdef GPD_HAVE_SVG
-#include "svg.h"
+#include "kind.h"
+#include "offload.h"
+#include "page.h"
+#include "store.h"
 #include "svg_job.h"
-#endif
-#ifdef GPD_HAVE_DASHBOARD
-#include "dashboard.h"
-#endif
-
-#ifndef GPD_VERSION
-#define GPD_VERSION "0.1.0"
-#endif
+#include "workers.h"
 
 #define LIST_DEFAULT_LIMIT 50
 #define HEALTH_WRITE_WINDOW_S 300.0
@@ -71,9 +59,8 @@ typedef struct req {
 /* *con_cls before the access handler has run: the length of the request target (on_uri) */
 #define URI_LEN_TAGGED(p) (((uintptr_t)(p)) & 1u)
 
-/* Content-Security-Policy of GET / (built at start from the page's inline blocks) and of
- * everything else (JSON, SVG, exports: nothing runs, nothing frames them) */
-static char csp_dashboard[3072];
+/* Content-Security-Policy of everything but GET / (JSON, SVG, exports: nothing runs, nothing
+ * frames them); the page has its own (page.h) */
 #define CSP_OTHER "default-src 'none'; frame-ancestors 'none'"
 
 /* the headers every response carries */
@@ -83,8 +70,9 @@ static void std_headers(struct MHD_Response *resp, const req *r, const char *cty
     MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
     MHD_add_response_header(resp, "X-Frame-Options", "DENY");
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
-    int html = !strncmp(ctype, "text/html", 9) && csp_dashboard[0];
-    MHD_add_response_header(resp, "Content-Security-Policy", html ? csp_dashboard : CSP_OTHER);
+    const char *page_csp = !strncmp(ctype, "text/html", 9) ? gpd_page_csp() : NULL;
+    int html = page_csp != NULL;
+    MHD_add_response_header(resp, "Content-Security-Policy", html ? page_csp : CSP_OTHER);
     if (html) MHD_add_response_header(resp, "Referrer-Policy", "no-referrer");
     if (r && r->acao[0]) {
         MHD_add_response_header(resp, "Access-Control-Allow-Origin", r->acao);
@@ -217,23 +205,6 @@ static int valid_status(const char *s)
     return 0;
 }
 
-/* 1 when word is one of the comma-separated items of list */
-static int in_list(const char *list, const char *word)
-{
-    size_t wl = strlen(word);
-    const char *p = list;
-    while (p && *p) {
-        while (*p == ' ' || *p == ',') p++;
-        const char *e = p;
-        while (*e && *e != ',') e++;
-        const char *t = e;
-        while (t > p && t[-1] == ' ') t--;
-        if ((size_t)(t - p) == wl && !strncmp(p, word, wl)) return 1;
-        p = e;
-    }
-    return 0;
-}
-
 /* ------------------------------------------------------------------ handlers */
 
 static enum MHD_Result h_health(struct MHD_Connection *c, req *r)
@@ -269,30 +240,80 @@ static enum MHD_Result h_health(struct MHD_Connection *c, req *r)
 
 static enum MHD_Result h_schema(struct MHD_Connection *c, req *r)
 {
-#ifdef GPD_HAVE_SCHEMA
     const char *kind = qarg(c, "kind");
     const char *doc = kind ? gp_schema_text(kind) : gp_schema_document();
-    if (!doc)
+    if (!doc) {
+        char kinds[256];
+        gpd_kind_names(kinds, sizeof kinds, "", " or ");
         return send_error(c, r, 400, "invalid_parameter", NULL,
-                          "unknown kind \"%s\"; expected fourier-voronoi-2d or spheres-3d", kind);
+                          "unknown kind \"%s\"; expected %s", kind, kinds);
+    }
     return send_buf(c, r, 200, "application/schema+json", (char *)doc, strlen(doc),
                     MHD_RESPMEM_PERSISTENT, NULL);
-#else
-    return send_error(c, r, 501, "not_implemented", NULL,
-                      "the schema module is not part of this build yet");
-#endif
 }
 
 static enum MHD_Result h_dashboard(struct MHD_Connection *c, req *r)
 {
-#ifdef GPD_HAVE_DASHBOARD
-    const char *html = gp_dashboard_html();
+    const char *html = gpd_page_html();
+    if (!html) return send_error(c, r, 500, "internal", NULL, "out of memory");
     return send_buf(c, r, 200, "text/html; charset=utf-8", (char *)html, strlen(html),
                     MHD_RESPMEM_PERSISTENT, NULL);
-#else
-    return send_error(c, r, 501, "not_implemented", NULL,
-                      "the dashboard is not part of this build yet; see /v1/jobs");
-#endif
+}
+
+/* A spec problem (schema/gp_spec.h) as the client sees it: code "internal" is a 500, any other
+ * (invalid_spec, too_large) a 422 at its pointer; 400 is kept for unreadable bodies. dflt_code
+ * and dflt_msg stand in for an empty code or message. */
+static enum MHD_Result send_problem(struct MHD_Connection *c, req *r, const gp_spec_problem *p,
+                                    const char *dflt_code, const char *dflt_msg)
+{
+    if (!strcmp(p->code, "internal"))
+        return send_error(c, r, 500, "internal", NULL, "%s", p->message);
+    return send_error(c, r, 422, p->code[0] ? p->code : dflt_code, p->pointer, "%s",
+                      p->message[0] ? p->message : dflt_msg);
+}
+
+/* The body as a spec with its defaults filled in, of a kind this daemon runs, within the
+ * result bound; NULL when it has been answered (400, 422, 500). */
+static json_t *effective_spec(struct MHD_Connection *c, req *r, const gpd_kind **kind,
+                              enum MHD_Result *ret)
+{
+    json_error_t je;
+    json_t *spec = json_loadb(r->body, r->len, JSON_REJECT_DUPLICATES, &je);
+    if (!spec) {
+        *ret = send_error(c, r, 400, "invalid_json", NULL,
+                          "malformed JSON at line %d, column %d: %s", je.line, je.column,
+                          je.text);
+        return NULL;
+    }
+    if (!json_is_object(spec)) {
+        json_decref(spec);
+        *ret = send_error(c, r, 422, "invalid_spec", "",
+                          ": expected a JSON object with a \"kind\"");
+        return NULL;
+    }
+    gp_spec_problem prob;
+    memset(&prob, 0, sizeof prob);
+    json_t *eff = gp_spec_with_defaults(spec, &prob);
+    json_decref(spec);
+    if (!eff) {
+        *ret = send_problem(c, r, &prob, "invalid_spec", "invalid spec");
+        return NULL;
+    }
+    *kind = gpd_kind_find(json_string_value(json_object_get(eff, "kind")));
+    if (!*kind) {
+        json_decref(eff);
+        char kinds[256];
+        gpd_kind_names(kinds, sizeof kinds, "\"", ", ");
+        *ret = send_error(c, r, 422, "invalid_spec", "/kind", "/kind: expected one of %s", kinds);
+        return NULL;
+    }
+    /* the kind's result bound, from the spec's numbers whatever their spelling */
+    if ((*kind)->bounds(eff, max_result_mb * 1e6, &prob)) {
+        json_decref(eff);
+        *ret = send_problem(c, r, &prob, "too_large", "");
+        return NULL;
+    }
+    return eff;
 }
 
 static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
@@ -300,61 +321,13 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
     if (r->len == 0)
         return send_error(c, r, 400, "invalid_json", NULL,
                           "the request body is empty; expected a JSON spec object");
-    json_error_t je;
-    json_t *spec = json_loadb(r->body, r->len, JSON_REJECT_DUPLICATES, &je);
-    if (!spec)
-        return send_error(c, r, 400, "invalid_json", NULL,
-                          "malformed JSON at line %d, column %d: %s", je.line, je.column,
-                          je.text);
-    if (!json_is_object(spec)) {
-        json_decref(spec);
-        return send_error(c, r, 422, "invalid_spec", "",
-                          ": expected a JSON object with a \"kind\"");
-    }
-    json_t *eff = NULL;
-#ifdef GPD_HAVE_SCHEMA
-    gp_spec_problem prob;
-    memset(&prob, 0, sizeof prob);
-    eff = gp_spec_with_defaults(spec, &prob);
-    json_decref(spec);
-    if (!eff) {
-        if (!strcmp(prob.code, "internal"))
-            return send_error(c, r, 500, prob.code[0] ? prob.code : "internal", NULL, "%s",
-                              prob.message);
-        /* every spec problem is a 422, invalid_spec (or too_large: a sieve law that derives
-         * more grains than particles allows); 400 is kept for unreadable bodies */
-        return send_error(c, r, 422, prob.code[0] ? prob.code : "invalid_spec", prob.pointer,
-                          "%s", prob.message[0] ? prob.message : "invalid spec");
-    }
-#else
-    eff = spec;
-#endif
-    const char *kind = json_string_value(json_object_get(eff, "kind"));
-    if (!kind || (strcmp(kind, "fourier-voronoi-2d") && strcmp(kind, "spheres-3d"))) {
-        json_decref(eff);
-        return send_error(c, r, 422, "invalid_spec", "/kind",
-                          "/kind: expected one of \"fourier-voronoi-2d\", \"spheres-3d\"");
-    }
-#ifndef GPD_HAVE_SPECIMEN3D
-    if (!strcmp(kind, "spheres-3d")) {
-        json_decref(eff);
-        return send_error(c, r, 501, "not_implemented", "/kind",
-                          "/kind: \"spheres-3d\" is not available in this build yet");
-    }
-#endif
-#ifdef GPD_HAVE_SCHEMA
-    /* the result bound of both kinds, from the spec's numbers whatever their spelling */
-    if (gp_spec_check_result(eff, max_result_mb * 1e6, &prob)) {
-        json_decref(eff);
-        if (!strcmp(prob.code, "internal"))
-            return send_error(c, r, 500, "internal", NULL, "%s", prob.message);
-        return send_error(c, r, 422, prob.code[0] ? prob.code : "too_large", prob.pointer, "%s",
-                          prob.message);
-    }
-#endif
+    const gpd_kind *k = NULL;
+    enum MHD_Result ret = MHD_NO;
+    json_t *eff = effective_spec(c, r, &k, &ret);
+    if (!eff) return ret;
     char *text = json_dumps(eff, JSON_COMPACT);
     char id[33];
-    store_rc rc = text ? store_insert(kind, text, id) : STORE_ERROR;
+    store_rc rc = text ? store_insert(k->name, text, id) : STORE_ERROR;
     free(text);
     json_decref(eff);
     if (rc != STORE_OK) return send_store_error(c, r);
@@ -508,7 +481,6 @@ static enum MHD_Result h_spec(struct MHD_Connection *c, req *r, const char *id)
                     NULL);
 }
 
-#ifdef GPD_HAVE_SVG
 static ssize_t read_svg(void *cls, uint64_t pos, char *buf, size_t max)
 {
     (void)pos; /* read in order, once */
@@ -521,80 +493,93 @@ static void free_svg(void *cls)
 {
     svg_job_close(cls);
 }
-#endif
 
-static enum MHD_Result h_svg(struct MHD_Connection *c, req *r, const char *id)
+/* a handler of a job's resource that depends on its kind (svg, export): st is its status */
+typedef enum MHD_Result (*kind_handler)(struct MHD_Connection *c, req *r, const char *id,
+                                        const gpd_kind *k, const char *st);
+
+/* Looks up the kind of job id once and answers by h: 404 for an unknown job, 500 when the store
+ * fails or the job is of a kind this daemon does not run. */
+static enum MHD_Result with_kind(struct MHD_Connection *c, req *r, const char *id,
+                                 kind_handler h)
 {
-    char *kind = NULL;
-    char st[16];
-    store_rc rc = store_get_text(id, "kind", &kind, st);
-    if (rc == STORE_NOT_FOUND) return not_found(c, r, id);
-    if (rc != STORE_OK || !kind) {
-        free(kind);
-        return send_store_error(c, r);
-    }
-#ifdef GPD_HAVE_SVG
-    const char *view = qarg(c, "view");
-    const char *views = gp_svg_views(kind);
-    if (!view || !*view || (views && !in_list(views, view))) {
-        enum MHD_Result ret =
-            send_error(c, r, 400, "invalid_parameter", NULL,
-                       "view: expected one of %s for kind %s%s%.64s%s", views ? views : "?",
-                       kind, view ? "; got \"" : "", view ? view : "", view ? "\"" : "");
-        free(kind);
-        return ret;
-    }
-    gp_svg_options opt;
-    memset(&opt, 0, sizeof opt);
-    opt.color = qarg(c, "color");
+    char *name = NULL, st[16];
+    store_rc rc = store_get_text(id, "kind", &name, st);
+    const gpd_kind *k = rc == STORE_OK ? gpd_kind_find(name) : NULL;
+    enum MHD_Result ret;
+    if (rc == STORE_NOT_FOUND) ret = not_found(c, r, id);
+    else if (rc != STORE_OK || !name) ret = send_store_error(c, r);
+    else if (!k)
+        ret = send_error(c, r, 500, "internal", NULL, "job %s is of kind \"%.64s\", which "
+                         "this daemon does not run", id, name);
+    else ret = h(c, r, id, k, st);
+    free(name);
+    return ret;
+}
+
+/* The options of ?view= (color, width, z); -1 when a bad one has been answered (400). */
+static int svg_options(struct MHD_Connection *c, req *r, gp_svg_options *opt,
+                       enum MHD_Result *ret)
+{
+    memset(opt, 0, sizeof *opt);
+    opt->color = qarg(c, "color");
     const char *w = qarg(c, "width"), *z = qarg(c, "z");
     if (w) {
         char *end;
         long v = strtol(w, &end, 10);
         if (*end || v < 16 || v > 16384) {
-            free(kind);
-            return send_error(c, r, 400, "invalid_parameter", NULL,
+            *ret = send_error(c, r, 400, "invalid_parameter", NULL,
                               "width: expected an integer in [16, 16384]");
+            return -1;
         }
-        opt.width = (int)v;
+        opt->width = (int)v;
     }
     if (z) {
         char *end;
         double v = strtod(z, &end);
         if (*end || end == z) {
-            free(kind);
-            return send_error(c, r, 400, "invalid_parameter", NULL,
+            *ret = send_error(c, r, 400, "invalid_parameter", NULL,
                               "z: expected a number (metres)");
+            return -1;
         }
-        opt.has_z = 1;
-        opt.z = v;
+        opt->has_z = 1;
+        opt->z = v;
     }
+    return 0;
+}
+
+static enum MHD_Result h_svg(struct MHD_Connection *c, req *r, const char *id,
+                            const gpd_kind *k, const char *st)
+{
+    enum MHD_Result ret = MHD_NO;
+    const char *view = qarg(c, "view");
+    if (!view || !*view || !gpd_kind_view(k, view)) {
+        char views[256];
+        gpd_kind_view_list(k, views, sizeof views);
+        return send_error(c, r, 400, "invalid_parameter", NULL,
+                          "view: expected one of %s for kind %s%s%.64s%s", views, k->name,
+                          view ? "; got \"" : "", view ? view : "", view ? "\"" : "");
+    }
+    gp_svg_options opt;
+    if (svg_options(c, r, &opt, &ret)) return ret;
     /* drawn from the job's summary and its items read one at a time (the export pack or the
      * stored result walked element by element), streamed: bounded memory (svg_job.h) */
     svg_job *sj = NULL;
-    int status = 500;
-    char err[512] = "";
-    svg_job_rc jr = svg_job_open(id, kind, view, &opt, &sj, st, &status, err, sizeof err);
-    free(kind);
+    gpd_err err;
+    char now[16]; /* the status as the picture finds it */
+    svg_job_rc jr = svg_job_open(id, k->name, view, &opt, &sj, now, &err);
     if (jr == SVG_JOB_NOT_FOUND) return not_found(c, r, id);
-    if (jr == SVG_JOB_NOT_READY) return not_ready(c, r, id, st);
+    if (jr == SVG_JOB_NOT_READY) return not_ready(c, r, id, now);
     if (jr == SVG_JOB_STORE_ERROR) return send_store_error(c, r);
     if (jr != SVG_JOB_OK) {
-        if (status < 400 || status > 599) status = 500;
+        int status = err.status < 400 || err.status > 599 ? 500 : err.status;
         return send_error(c, r, (unsigned)status,
                           status == 400 ? "invalid_parameter"
                           : status == 409 ? "not_available"
                                           : "internal",
-                          NULL, "%s", err[0] ? err : "cannot render this view");
+                          NULL, "%s", err.msg[0] ? err.msg : "cannot render this view");
     }
     return send_stream(c, r, "image/svg+xml", MHD_SIZE_UNKNOWN, read_svg, sj, free_svg, NULL);
-#else
-    (void)in_list;
-    free(kind);
-    if (strcmp(st, "succeeded")) return not_ready(c, r, id, st);
-    return send_error(c, r, 501, "not_implemented", NULL,
-                      "the SVG renderer is not part of this build yet");
-#endif
 }
 
 /* An export being downloaded: the pack (in memory when small, else an SQLite stream) and the
@@ -604,11 +589,6 @@ typedef struct export_dl {
     char *pack;
     gp_export *e;
 } export_dl;
-
-static int export_src_read(void *user, uint64_t off, void *dst, size_t n)
-{
-    return store_stream_read(user, off, dst, n);
-}
 
 static ssize_t read_export(void *cls, uint64_t pos, char *buf, size_t max)
 {
@@ -633,52 +613,47 @@ static void free_export(void *cls)
     free(d);
 }
 
-static enum MHD_Result h_export(struct MHD_Connection *c, req *r, const char *id)
+/* The pack of job id opened into d (export_dl: in memory or streamed) and the export of it in
+ * format f; -1 when it has been answered (404, 409 without a pack, 500). */
+static int export_open(struct MHD_Connection *c, req *r, const char *id, const gpd_kind *k,
+                       int f, export_dl *d, enum MHD_Result *ret)
 {
-    char *kind = NULL;
     char st[16];
-    store_rc rc = store_get_text(id, "kind", &kind, st);
-    if (rc == STORE_NOT_FOUND) return not_found(c, r, id);
-    if (rc != STORE_OK || !kind) {
-        free(kind);
-        return send_store_error(c, r);
-    }
-    int dim = !strcmp(kind, "spheres-3d") ? 3 : 2;
-    free(kind);
-    const char *format = qarg(c, "format");
-    int f = gp_export_format_parse(format);
-    if (f < 0 || !gp_export_format_supports(f, dim))
-        return send_error(c, r, 400, "invalid_parameter", NULL,
-                          "format: expected one of %s%s%.64s%s", gp_export_format_list(dim),
-                          format ? "; got \"" : "", format ? format : "", format ? "\"" : "");
-    if (strcmp(st, "succeeded")) return not_ready(c, r, id, st);
-
-    export_dl *d = calloc(1, sizeof *d);
-    if (!d) return send_error(c, r, 500, "internal", NULL, "out of memory");
     size_t len = 0;
-    rc = store_stream_open(id, "pack", STREAM_SMALL, &d->stream, &d->pack, &len, st);
-    if (rc == STORE_NOT_FOUND) {
-        free_export(d);
-        return not_found(c, r, id);
-    }
-    if (rc != STORE_OK) {
-        free_export(d);
-        return send_store_error(c, r);
-    }
-    if (!d->pack && !d->stream) {
-        free_export(d);
-        return send_error(c, r, 409, "missing_output", "/outputs",
+    store_rc rc = store_stream_open(id, "pack", STREAM_SMALL, &d->stream, &d->pack, &len, st);
+    if (rc == STORE_NOT_FOUND) *ret = not_found(c, r, id);
+    else if (rc != STORE_OK) *ret = send_store_error(c, r);
+    else if (!d->pack && !d->stream)
+        *ret = send_error(c, r, 409, "missing_output", "/outputs",
                           "job %s has no %s to export (its spec did not ask for it): submit "
                           "the spec again with \"%s\" in outputs",
-                          id, dim == 3 ? "sphere list" : "ODEC discs", dim == 3 ? "spheres" : "odec");
-    }
-    gp_export_source src = d->pack ? gp_export_memory_source(d->pack, len)
-                                   : (gp_export_source){export_src_read, d->stream,
-                                                        store_stream_size(d->stream)};
+                          id, k->pack_what, k->pack_output);
+    if (rc != STORE_OK || (!d->pack && !d->stream)) return -1;
+    js_source v = store_value_source(d->pack, len, d->stream);
+    gp_export_source src = {v.read, v.user, v.size};
     gp_error err;
-    if (gp_export_open(f, &src, &d->e, &err)) {
+    if (gp_export_open(f, &src, &d->e, &err) == GP_OK) return 0;
+    *ret = send_error(c, r, 500, "internal", NULL, "cannot export: %s", err.message);
+    return -1;
+}
+
+static enum MHD_Result h_export(struct MHD_Connection *c, req *r, const char *id,
+                               const gpd_kind *k, const char *st)
+{
+    enum MHD_Result ret = MHD_NO;
+    const char *format = qarg(c, "format");
+    int f = gp_export_format_parse(format);
+    if (f < 0 || !gp_export_format_supports(f, k->export_dim))
+        return send_error(c, r, 400, "invalid_parameter", NULL,
+                          "format: expected one of %s%s%.64s%s",
+                          gp_export_format_list(k->export_dim), format ? "; got \"" : "",
+                          format ? format : "", format ? "\"" : "");
+    if (strcmp(st, "succeeded")) return not_ready(c, r, id, st);
+    export_dl *d = calloc(1, sizeof *d);
+    if (!d) return send_error(c, r, 500, "internal", NULL, "out of memory");
+    if (export_open(c, r, id, k, f, d, &ret)) {
         free_export(d);
-        return send_error(c, r, 500, "internal", NULL, "cannot export: %s", err.message);
+        return ret;
     }
     char disp[160];
     snprintf(disp, sizeof disp, "attachment; filename=\"%s-%s.%s\"", id,
@@ -687,402 +662,53 @@ static enum MHD_Result h_export(struct MHD_Connection *c, req *r, const char *id
                        free_export, disp);
 }
 
-/* ------------------------------------------------------------------ origin and host */
-
-/* Names this daemon answers to in a Host header (lower case, IPv6 in brackets); "own" ones are
- * also its own origin (http://NAME:PORT), the others come from --allow-origin. */
-#define MAX_NAMES 64
-#define MAX_ALLOWED 32
-typedef struct host_name {
-    char name[264];
-    int own;
-} host_name;
-static host_name names[MAX_NAMES];
-static size_t n_names = 0;
-static char allowed[MAX_ALLOWED][300]; /* normalized origins given with --allow-origin */
-static size_t n_allowed = 0;
-static int own_port = 0;
-static int any_ip = 0;          /* listening on 0.0.0.0 / [::]: any IP literal is ours */
-static char own_url[300] = "";  /* http://HOST:PORT, for messages */
-
-static void add_name(const char *name, int own)
+/* a CORS preflight of an accepted origin: 204 with what it may send */
+static enum MHD_Result preflight(struct MHD_Connection *c, req *r)
 {
-    for (size_t i = 0; i < n_names; i++)
-        if (!strcmp(names[i].name, name)) {
-            names[i].own |= own;
-            return;
-        }
-    if (n_names == MAX_NAMES || strlen(name) >= sizeof names[0].name) return;
-    snprintf(names[n_names].name, sizeof names[0].name, "%s", name);
-    names[n_names++].own = own;
+    struct MHD_Response *resp =
+        MHD_create_response_from_buffer(0, (void *)"", MHD_RESPMEM_PERSISTENT);
+    if (!resp) return MHD_NO;
+    std_headers(resp, r, "text/plain");
+    MHD_add_response_header(resp, "Access-Control-Allow-Methods", "GET, HEAD, POST, DELETE");
+    MHD_add_response_header(resp, "Access-Control-Allow-Headers", "Content-Type");
+    MHD_add_response_header(resp, "Access-Control-Max-Age", "600");
+    return queue_response(c, r, 204, resp);
 }
 
-/* "host[:port]" (an authority: a Host header, the end of an origin, --listen) into a lower-case
- * host (IPv6 canonical, in brackets; a trailing dot dropped) and *port (-1 when absent).
- * 0, or -1 when malformed. */
-static int parse_authority(const char *s, size_t n, char *host, size_t hostlen, int *port)
-{
-    *port = -1;
-    if (n == 0 || hostlen < 3) return -1;
-    const char *end = s + n, *rest;
-    if (s[0] == '[') {
-        const char *rb = memchr(s, ']', n);
-        if (!rb || rb - s < 3 || rb - s > 64) return -1;
-        char in6[72];
-        memcpy(in6, s + 1, (size_t)(rb - s - 1));
-        in6[rb - s - 1] = '\0';
-        struct in6_addr a6;
-        char canon[INET6_ADDRSTRLEN];
-        if (inet_pton(AF_INET6, in6, &a6) != 1 || !inet_ntop(AF_INET6, &a6, canon, sizeof canon))
-            return -1;
-        if (strlen(canon) + 3 > hostlen) return -1;
-        snprintf(host, hostlen, "[%s]", canon);
-        rest = rb + 1;
-    } else {
-        const char *colon = memchr(s, ':', n);
-        size_t hl = colon ? (size_t)(colon - s) : n;
-        if (hl == 0 || hl >= hostlen) return -1;
-        for (size_t i = 0; i < hl; i++) {
-            unsigned char ch = (unsigned char)s[i];
-            if (!isalnum(ch) && ch != '-' && ch != '.' && ch != '_') return -1;
-            host[i] = (char)tolower(ch);
-        }
-        host[hl] = '\0';
-        if (hl > 1 && host[hl - 1] == '.') host[hl - 1] = '\0';
-        rest = s + hl;
-    }
-    if (rest < end) {
-        if (*rest != ':') return -1;
-        long v = 0;
-        for (const char *q = rest + 1; q < end; q++) {
-            if (!isdigit((unsigned char)*q)) return -1;
-            v = v * 10 + (*q - '0');
-            if (v > 65535) return -1;
-        }
-        if (rest + 1 < end) *port = (int)v; /* "host:" is the default port (RFC 3986) */
-    }
-    return 0;
-}
-
-/* "scheme://host[:port]" into its parts (port: -1 = the scheme's default) and its normalized
- * form, as a browser sends it: lower case, no default port. 0, or -1 when malformed. */
-static int parse_origin(const char *s, char *scheme, size_t slen, char *host, size_t hostlen,
-                        int *port, char *norm, size_t normlen)
-{
-    const char *sep = strstr(s, "://");
-    size_t sl = sep ? (size_t)(sep - s) : 0;
-    if (!sep || sl == 0 || sl >= slen || !isalpha((unsigned char)s[0])) return -1;
-    for (size_t i = 0; i < sl; i++) {
-        unsigned char ch = (unsigned char)s[i];
-        if (!isalnum(ch) && ch != '+' && ch != '-' && ch != '.') return -1;
-        scheme[i] = (char)tolower(ch);
-    }
-    scheme[sl] = '\0';
-    if (parse_authority(sep + 3, strlen(sep + 3), host, hostlen, port)) return -1;
-    int dflt = !strcmp(scheme, "http") ? 80 : !strcmp(scheme, "https") ? 443 : -1;
-    if (*port == dflt) *port = -1;
-    if (*port > 0)
-        snprintf(norm, normlen, "%s://%s:%d", scheme, host, *port);
-    else
-        snprintf(norm, normlen, "%s://%s", scheme, host);
-    return 0;
-}
-
-int gpd_allow_origins(const char *list)
-{
-    const char *p = list;
-    while (p && *p) {
-        while (*p == ' ' || *p == ',') p++;
-        const char *e = p;
-        while (*e && *e != ',') e++;
-        const char *t = e;
-        while (t > p && t[-1] == ' ') t--;
-        if (t > p && t[-1] == '/') t--; /* "http://lab.example:3000/" is the same origin */
-        if (t > p) {
-            char item[300], scheme[32], host[264], norm[300];
-            int port;
-            size_t il = (size_t)(t - p);
-            if (il >= sizeof item ||
-                (memcpy(item, p, il), item[il] = '\0',
-                 parse_origin(item, scheme, sizeof scheme, host, sizeof host, &port, norm,
-                              sizeof norm))) {
-                fprintf(stderr,
-                        "grainpackd: --allow-origin expects scheme://host[:port] (e.g. "
-                        "http://lab.example:3000), got \"%.*s\"\n",
-                        (int)(il < 200 ? il : 200), p);
-                return -1;
-            }
-            if (n_allowed == MAX_ALLOWED) {
-                fprintf(stderr, "grainpackd: at most %d origins may be allowed\n", MAX_ALLOWED);
-                return -1;
-            }
-            size_t k = 0;
-            while (k < n_allowed && strcmp(allowed[k], norm)) k++;
-            if (k == n_allowed) snprintf(allowed[n_allowed++], sizeof allowed[0], "%s", norm);
-            add_name(host, 0);
-        }
-        p = e;
-    }
-    return 0;
-}
-
-static int is_ip_literal(const char *name)
-{
-    struct in_addr a4;
-    return name[0] == '[' || inet_pton(AF_INET, name, &a4) == 1;
-}
-
-/* the names this daemon answers to: loopback, the --listen host as given and as bound, and on
- * a wildcard address the machine's host name (any IP literal is accepted there as well) */
-static void setup_names(const gpd_http_config *cfg)
-{
-    char h[264];
-    int port;
-    add_name("localhost", 1);
-    add_name("127.0.0.1", 1);
-    add_name("[::1]", 1);
-    if (cfg->listen && !parse_authority(cfg->listen, strlen(cfg->listen), h, sizeof h, &port))
-        add_name(h, 1);
-    if (cfg->host && !parse_authority(cfg->host, strlen(cfg->host), h, sizeof h, &port)) {
-        add_name(h, 1);
-        any_ip = !strcmp(h, "0.0.0.0") || !strcmp(h, "[::]");
-    }
-    if (any_ip) {
-        char hn[256];
-        if (gethostname(hn, sizeof hn) == 0) {
-            hn[sizeof hn - 1] = '\0';
-            if (!parse_authority(hn, strlen(hn), h, sizeof h, &port) && port < 0) add_name(h, 1);
-        }
-    }
-    own_port = cfg->port;
-    snprintf(own_url, sizeof own_url, "http://%s:%d", cfg->host ? cfg->host : "127.0.0.1",
-             cfg->port);
-}
-
-static int host_accepted(const char *name)
-{
-    for (size_t i = 0; i < n_names; i++)
-        if (!strcmp(names[i].name, name)) return 1;
-    return any_ip && is_ip_literal(name);
-}
-
-/* An Origin is accepted when it was given with --allow-origin, when it is the authority the
- * request was sent to (same origin: the page came from this daemon, as the browser reached it),
- * or when it is http://NAME:PORT with NAME one of the daemon's own names and PORT its port
- * (a page at http://localhost:8080 calling http://127.0.0.1:8080). */
-static int origin_accepted(const char *origin, const char *hname, int hport)
-{
-    char scheme[32], oh[264], norm[300];
-    int op;
-    if (parse_origin(origin, scheme, sizeof scheme, oh, sizeof oh, &op, norm, sizeof norm))
-        return 0;
-    for (size_t i = 0; i < n_allowed; i++)
-        if (!strcmp(norm, allowed[i])) return 1;
-    int http = !strcmp(scheme, "http"), https = !strcmp(scheme, "https");
-    if (!http && !https) return 0;
-    int dflt = https ? 443 : 80;
-    int oport = op > 0 ? op : dflt;
-    if (hname && !strcmp(oh, hname) && oport == (hport > 0 ? hport : dflt)) return 1;
-    if (http && oport == own_port)
-        for (size_t i = 0; i < n_names; i++)
-            if (names[i].own && !strcmp(names[i].name, oh)) return 1;
-    return 0;
-}
-
-/* Checks made before routing: the length of the request target, Host and Origin. Returns 1
- * when a response has been queued (in *ret), 0 to go on. */
+/* Checks made before routing: the length of the request target, Host and Origin (origin.h).
+ * Returns 1 when a response has been queued (in *ret), 0 to go on. */
 static int gate(struct MHD_Connection *c, req *r, const char *method, enum MHD_Result *ret)
 {
-    if (r->url_len > GPD_MAX_URL) {
+    const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
+    const char *origin = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Origin");
+    char hname[264];
+    int hport = -1;
+    int have_host = host && *host && origin_host_ok(host, hname, sizeof hname, &hport);
+    if (r->url_len > GPD_MAX_URL)
         *ret = send_error(c, r, 414, "uri_too_long", NULL,
                           "the request target (path and query) is %zu bytes, over the limit of "
                           "%d bytes",
                           r->url_len, GPD_MAX_URL);
-        return 1;
-    }
-    const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
-    char hname[264];
-    int hport = -1, have_host = 0;
-    if (host && *host) {
-        if (parse_authority(host, strlen(host), hname, sizeof hname, &hport) ||
-            !host_accepted(hname)) {
-            *ret = send_error(c, r, 403, "forbidden_host", NULL,
-                              "Host \"%.100s\" is not a name of this server (%s); use "
-                              "localhost, 127.0.0.1 or the address it listens on",
-                              host, own_url);
-            return 1;
-        }
-        have_host = 1;
-    }
-    const char *origin = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Origin");
-    if (origin && *origin) {
-        if (!origin_accepted(origin, have_host ? hname : NULL, hport)) {
-            *ret = send_error(c, r, 403, "forbidden_origin", NULL,
-                              "Origin \"%.100s\" may not call this server: only pages it "
-                              "serves itself (%s) and origins given with --allow-origin may",
-                              origin, own_url);
-            return 1;
-        }
+    else if (host && *host && !have_host)
+        *ret = send_error(c, r, 403, "forbidden_host", NULL,
+                          "Host \"%.100s\" is not a name of this server (%s); use "
+                          "localhost, 127.0.0.1 or the address it listens on",
+                          host, origin_own_url());
+    else if (origin && *origin && !origin_ok(origin, have_host ? hname : NULL, hport))
+        *ret = send_error(c, r, 403, "forbidden_origin", NULL,
+                          "Origin \"%.100s\" may not call this server: only pages it "
+                          "serves itself (%s) and origins given with --allow-origin may",
+                          origin, origin_own_url());
+    else if (!origin || !*origin)
+        return 0;
+    else {
         if (strlen(origin) < sizeof r->acao) snprintf(r->acao, sizeof r->acao, "%s", origin);
-        /* a CORS preflight of an accepted origin */
-        if (!strcmp(method, "OPTIONS") &&
-            MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Access-Control-Request-Method")) {
-            struct MHD_Response *resp =
-                MHD_create_response_from_buffer(0, (void *)"", MHD_RESPMEM_PERSISTENT);
-            if (!resp) {
-                *ret = MHD_NO;
-                return 1;
-            }
-            std_headers(resp, r, "text/plain");
-            MHD_add_response_header(resp, "Access-Control-Allow-Methods",
-                                    "GET, HEAD, POST, DELETE");
-            MHD_add_response_header(resp, "Access-Control-Allow-Headers", "Content-Type");
-            MHD_add_response_header(resp, "Access-Control-Max-Age", "600");
-            r->status = 204;
-            *ret = MHD_queue_response(c, 204, resp);
-            MHD_destroy_response(resp);
-            return 1;
-        }
+        if (strcmp(method, "OPTIONS") ||
+            !MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Access-Control-Request-Method"))
+            return 0;
+        *ret = preflight(c, r);
     }
-    return 0;
-}
-
-/* ------------------------------------------------------------------ dashboard CSP */
-
-/* SHA-256 (FIPS 180-4), for the hashes of the dashboard's inline script and style */
-static const uint32_t sha_k[64] = {
-    0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4,
-    0xab1c5ed5, 0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3, 0x72be5d74, 0x80deb1fe,
-    0x9bdc06a7, 0xc19bf174, 0xe49b69c1, 0xefbe4786, 0x0fc19dc6, 0x240ca1cc, 0x2de92c6f,
-    0x4a7484aa, 0x5cb0a9dc, 0x76f988da, 0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7,
-    0xc6e00bf3, 0xd5a79147, 0x06ca6351, 0x14292967, 0x27b70a85, 0x2e1b2138, 0x4d2c6dfc,
-    0x53380d13, 0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85, 0xa2bfe8a1, 0xa81a664b,
-    0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070, 0x19a4c116,
-    0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a, 0x5b9cca4f, 0x682e6ff3,
-    0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7,
-    0xc67178f2};
-
-#define ROR32(x, n) (((x) >> (n)) | ((x) << (32 - (n))))
-
-static void sha256_block(uint32_t h[8], const unsigned char *p)
-{
-    uint32_t w[64];
-    for (int i = 0; i < 16; i++)
-        w[i] = (uint32_t)p[4 * i] << 24 | (uint32_t)p[4 * i + 1] << 16 |
-               (uint32_t)p[4 * i + 2] << 8 | p[4 * i + 3];
-    for (int i = 16; i < 64; i++) {
-        uint32_t s0 = ROR32(w[i - 15], 7) ^ ROR32(w[i - 15], 18) ^ (w[i - 15] >> 3);
-        uint32_t s1 = ROR32(w[i - 2], 17) ^ ROR32(w[i - 2], 19) ^ (w[i - 2] >> 10);
-        w[i] = w[i - 16] + s0 + w[i - 7] + s1;
-    }
-    uint32_t a = h[0], b = h[1], c = h[2], d = h[3], e = h[4], f = h[5], g = h[6], hh = h[7];
-    for (int i = 0; i < 64; i++) {
-        uint32_t t1 = hh + (ROR32(e, 6) ^ ROR32(e, 11) ^ ROR32(e, 25)) + ((e & f) ^ (~e & g)) +
-                      sha_k[i] + w[i];
-        uint32_t t2 = (ROR32(a, 2) ^ ROR32(a, 13) ^ ROR32(a, 22)) + ((a & b) ^ (a & c) ^ (b & c));
-        hh = g;
-        g = f;
-        f = e;
-        e = d + t1;
-        d = c;
-        c = b;
-        b = a;
-        a = t1 + t2;
-    }
-    h[0] += a, h[1] += b, h[2] += c, h[3] += d, h[4] += e, h[5] += f, h[6] += g, h[7] += hh;
-}
-
-/* 'sha256-BASE64' of n bytes at s, into out (at least 60 bytes) */
-static void csp_hash(const char *s, size_t n, char *out)
-{
-    uint32_t h[8] = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
-                     0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
-    const unsigned char *p = (const unsigned char *)s;
-    size_t left = n;
-    for (; left >= 64; left -= 64, p += 64) sha256_block(h, p);
-    unsigned char last[128];
-    memset(last, 0, sizeof last);
-    memcpy(last, p, left);
-    last[left] = 0x80;
-    size_t nb = left + 9 <= 64 ? 64 : 128;
-    uint64_t bits = (uint64_t)n * 8;
-    for (int i = 0; i < 8; i++) last[nb - 1 - i] = (unsigned char)(bits >> (8 * i));
-    sha256_block(h, last);
-    if (nb == 128) sha256_block(h, last + 64);
-    unsigned char dg[33];
-    for (int i = 0; i < 8; i++)
-        for (int j = 0; j < 4; j++) dg[4 * i + j] = (unsigned char)(h[i] >> (24 - 8 * j));
-    dg[32] = 0;
-    static const char b64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    char *o = out + sprintf(out, "'sha256-");
-    for (int i = 0; i < 33; i += 3) {
-        uint32_t v = (uint32_t)dg[i] << 16 | (uint32_t)dg[i + 1] << 8 | dg[i + 2];
-        *o++ = b64[v >> 18 & 63];
-        *o++ = b64[v >> 12 & 63];
-        *o++ = i + 1 < 32 ? b64[v >> 6 & 63] : '=';
-        *o++ = i + 2 < 32 ? b64[v & 63] : '=';
-    }
-    *o++ = '\'';
-    *o = '\0';
-}
-
-/* appends ' item' to a source list, unless it is there already */
-static void csp_add(char *list, size_t cap, const char *item)
-{
-    if (strstr(list, item)) return;
-    size_t n = strlen(list);
-    snprintf(list + n, cap - n, " %s", item);
-}
-
-/* The dashboard is one static page with an inline <script> and <style> and a few style=""
- * attributes: the policy allows exactly those (by their SHA-256, computed here from the page
- * served, so it follows any edit of dashboard.html) and nothing from elsewhere. */
-static void build_dashboard_csp(void)
-{
-#ifdef GPD_HAVE_DASHBOARD
-    const char *html = gp_dashboard_html();
-    char scripts[1024] = "", styles[1024] = "", attrs[1024] = "", hash[64];
-    const char *p = html;
-    const char *tag;
-    while ((tag = strchr(p, '<')) != NULL) {
-        const char *gt = strchr(tag, '>');
-        if (!gt) break;
-        int is_script = !strncmp(tag, "<script", 7) &&
-                        (tag[7] == '>' || isspace((unsigned char)tag[7]));
-        int is_style = !strncmp(tag, "<style", 6) &&
-                       (tag[6] == '>' || isspace((unsigned char)tag[6]));
-        /* the style="..." attributes of this tag */
-        for (const char *a = tag; a < gt; a++) {
-            if (isspace((unsigned char)a[0]) && !strncmp(a + 1, "style=\"", 7)) {
-                const char *v = a + 8, *ve = memchr(v, '"', (size_t)(gt - v));
-                if (ve) {
-                    csp_hash(v, (size_t)(ve - v), hash);
-                    csp_add(attrs, sizeof attrs, hash);
-                    a = ve;
-                }
-            }
-        }
-        if (is_script || is_style) {
-            const char *close = strstr(gt + 1, is_script ? "</script>" : "</style>");
-            if (!close) break;
-            csp_hash(gt + 1, (size_t)(close - gt - 1), hash);
-            csp_add(is_script ? scripts : styles, is_script ? sizeof scripts : sizeof styles,
-                    hash);
-            p = close + 2;
-        } else {
-            p = gt + 1;
-        }
-    }
-    if (attrs[0]) {
-        csp_add(styles, sizeof styles, "'unsafe-hashes'");
-        csp_add(styles, sizeof styles, attrs + 1);
-    }
-    snprintf(csp_dashboard, sizeof csp_dashboard,
-             "default-src 'self'; script-src%s; style-src%s; img-src 'self'; "
-             "connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'self'; "
-             "frame-ancestors 'none'",
-             scripts[0] ? scripts : " 'none'", styles[0] ? styles : " 'none'");
-#endif
+    return 1;
 }
 
 /* ------------------------------------------------------------------ routing */
@@ -1168,14 +794,16 @@ static enum MHD_Result route(struct MHD_Connection *c, req *r, const char *url,
             return h_job(c, r, id);
         }
         enum MHD_Result (*h)(struct MHD_Connection *, req *, const char *) = NULL;
+        kind_handler hk = NULL;
         if (!strcmp(sub, "result")) h = h_result;
-        else if (!strcmp(sub, "svg")) h = h_svg;
-        else if (!strcmp(sub, "export")) h = h_export;
+        else if (!strcmp(sub, "svg")) hk = h_svg;
+        else if (!strcmp(sub, "export")) hk = h_export;
         else if (!strcmp(sub, "spec")) h = h_spec;
-        if (!h) return send_error(c, r, 404, "not_found", NULL, "no such resource: %.128s", path);
+        if (!h && !hk)
+            return send_error(c, r, 404, "not_found", NULL, "no such resource: %.128s", path);
         if (!is_get(method)) return method_not_allowed(c, r, method, path, "GET, HEAD");
         if (!gpd_id_is_plausible(id)) return not_found(c, r, id);
-        return h(c, r, id);
+        return h ? h(c, r, id) : with_kind(c, r, id, hk);
     }
     return send_error(c, r, 404, "not_found", NULL, "no such resource: %.128s", path);
 }
@@ -1282,7 +910,7 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
         *con_cls = NULL;
         return;
     }
-    if (gpd_log_threshold >= GPD_LOG_DEBUG) {
+    if (gpd_log_enabled(GPD_LOG_DEBUG)) {
         gpd_log(GPD_LOG_DEBUG, "http %s %s %d %.3f ms%s", r->method, r->url, r->status,
                 1e3 * (gpd_monotonic_s() - r->t0),
                 toe == MHD_REQUEST_TERMINATED_COMPLETED_OK ? "" : " (aborted)");
@@ -1388,8 +1016,11 @@ int gpd_http_start(const gpd_http_config *cfg)
     max_body = cfg->max_body;
     if (cfg->max_result_mb > 0) max_result_mb = cfg->max_result_mb;
     started_at = gpd_monotonic_s();
-    setup_names(cfg);
-    build_dashboard_csp();
+    origin_setup(cfg->listen, cfg->host, cfg->port);
+    if (gpd_page_init() != 0) {
+        gpd_log(GPD_LOG_ERROR, "cannot build the dashboard page (out of memory)");
+        return -1;
+    }
     if (gpd_offload_start(cfg->threads) != 0) {
         gpd_log(GPD_LOG_ERROR, "cannot start the request pool");
         return -1;

@@ -10,7 +10,7 @@
  *   DELETE /v1/jobs/{id}           cancel (200 job object; 409 already_finished)
  *   GET  /v1/jobs/{id}/result      result JSON (409 not_ready)
  *   GET  /v1/jobs/{id}/svg?view=V  image/svg+xml (409 not_ready)
- *   GET  /v1/jobs/{id}/export?format=F   (501 not_implemented for now)
+ *   GET  /v1/jobs/{id}/export?format=F   an export file of the job (api.md formats)
  *   GET  /v1/jobs/{id}/spec        + the effective spec (defaults filled in)
  * HEAD is accepted wherever GET is. Every 4xx/5xx body is
  *   {"error": {"code": "...", "message": "...", "pointer": "/json/pointer"}}
@@ -37,6 +37,8 @@
 
 #include <stddef.h>
 
+#include "origin.h" /* gpd_allow_origins */
+
 typedef struct gpd_http_config {
     int listen_fd;               /* bound and listening (gpd_listen_socket) */
     unsigned threads;            /* MHD thread pool size */
@@ -53,12 +55,6 @@ typedef struct gpd_http_config {
  * (with its own HTML body) only past its per-connection buffer of GPD_CONN_MEMORY bytes */
 #define GPD_MAX_URL 8192
 #define GPD_CONN_MEMORY (256u * 1024u)
-
-/* Adds the comma-separated origins of list ("scheme://host[:port]", e.g.
- * http://lab.example:3000) to those allowed to call the daemon besides its own address.
- * Returns 0, or -1 with a message on stderr when one is malformed. Call before
- * gpd_http_start. */
-int gpd_allow_origins(const char *list);
 
 /* Parses "HOST:PORT" ("[v6]:PORT", ":PORT" = 127.0.0.1), binds and listens. Returns the fd
  * and the bound port in *port (the actual one when PORT was 0), -1 with a message on stderr

@@ -4,14 +4,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "util.h"
+
 #define JS_CACHE (64u * 1024u)
 #define JS_KEEP (1u << 20) /* js_load keeps its buffer up to this size between calls */
 #define JS_ERR UINT64_MAX
 
 struct js_scan {
     js_source src;
-    unsigned char *cache;
-    uint64_t coff;
+    uint64_t coff; /* the cache holds [coff, coff + clen) of the text */
     size_t clen;
     /* array walk */
     uint64_t apos;
@@ -19,6 +20,7 @@ struct js_scan {
     /* js_load */
     char *buf;
     size_t cap;
+    unsigned char cache[]; /* JS_CACHE bytes, allocated with the scanner */
 };
 
 static int mem_read(void *user, uint64_t off, void *dst, size_t n)
@@ -35,22 +37,16 @@ js_source js_memory_source(const char *text, size_t len)
 
 js_scan *js_open(const js_source *src)
 {
-    js_scan *s = calloc(1, sizeof *s);
+    js_scan *s = malloc(sizeof *s + JS_CACHE);
     if (!s) return NULL;
+    memset(s, 0, sizeof *s);
     s->src = *src;
-    s->cache = malloc(JS_CACHE);
-    if (!s->cache) {
-        free(s);
-        return NULL;
-    }
     return s;
 }
 
 void js_close(js_scan *s)
 {
-    if (!s) return;
-    free(s->cache);
-    free(s->buf);
+    if (s) free(s->buf);
     free(s);
 }
 
@@ -257,25 +253,17 @@ typedef struct without_ctx {
     js_scan *s;
     const char *const *skip;
     uint64_t (*spans)[2];
-    char *out;
-    size_t len, cap;
+    gpd_buf out;
     int fail;
 } without_ctx;
 
-static int append(without_ctx *w, uint64_t off, uint64_t end, const char *lit)
+/* appends [off, end) of the text */
+static int append_span(without_ctx *w, uint64_t off, uint64_t end)
 {
-    size_t n = lit ? strlen(lit) : (size_t)(end - off);
-    if (w->len + n + 2 > w->cap) {
-        size_t cap = w->cap ? w->cap : 4096;
-        while (cap < w->len + n + 2) cap *= 2;
-        char *b = realloc(w->out, cap);
-        if (!b) return -1;
-        w->out = b;
-        w->cap = cap;
-    }
-    if (lit) memcpy(w->out + w->len, lit, n);
-    else if (js_copy(w->s, off, end, w->out + w->len)) return -1;
-    w->len += n;
+    size_t n = (size_t)(end - off);
+    if (gpd_buf_reserve(&w->out, n) || js_copy(w->s, off, end, w->out.buf + w->out.len)) return -1;
+    w->out.len += n;
+    w->out.buf[w->out.len] = '\0';
     return 0;
 }
 
@@ -291,7 +279,7 @@ static int without_member(void *user, const char *key, uint64_t moff, uint64_t v
             }
             return 0;
         }
-    if ((w->len > 1 && append(w, 0, 0, ",")) || append(w, moff, vend, NULL)) {
+    if ((w->out.len > 1 && gpd_buf_add(&w->out, ",", 1)) || append_span(w, moff, vend)) {
         w->fail = 1;
         return 1;
     }
@@ -306,15 +294,14 @@ char *js_object_without(const js_source *src, const char *const *skip, size_t *l
         for (const char *const *k = skip; k && *k; k++) spans[k - skip][0] = spans[k - skip][1] = 0;
     js_scan *s = js_open(src);
     if (!s) return NULL;
-    without_ctx w = {s, skip, spans, NULL, 0, 0, 0};
-    int ok = append(&w, 0, 0, "{") == 0 && js_members(s, without_member, &w) == 0 && !w.fail &&
-             append(&w, 0, 0, "}") == 0;
+    without_ctx w = {s, skip, spans, {NULL, 0, 0, 0}, 0};
+    int ok = gpd_buf_add(&w.out, "{", 1) == 0 && js_members(s, without_member, &w) == 0 &&
+             !w.fail && gpd_buf_add(&w.out, "}", 1) == 0;
     js_close(s);
     if (!ok) {
-        free(w.out);
+        free(w.out.buf);
         return NULL;
     }
-    w.out[w.len] = 0;
-    if (len) *len = w.len;
-    return w.out;
+    if (len) *len = w.out.len;
+    return w.out.buf;
 }

@@ -18,24 +18,10 @@
 
 #include "http.h"
 #include "store.h"
+#include "util.h"
 #include "workers.h"
 
-#ifndef GPD_VERSION
-#define GPD_VERSION "0.1.0"
-#endif
-
-#if defined(__SANITIZE_THREAD__)
-/* ThreadSanitizer: the cancel flag handed to the core (const volatile int *, pinned in
- * core/2d/gp_specimen2d.h and gp_specimen3d.h) is raised here with an atomic store but polled by
- * the core with a plain volatile read. That is the documented hand-off, benign on every target
- * we build for; TSan reports it unless the core reads with __atomic_load_n. Suppress exactly
- * the two writers (workers_cancel: DELETE; workers_stop: shutdown) and nothing else. */
-const char *__tsan_default_suppressions(void);
-const char *__tsan_default_suppressions(void)
-{
-    return "race:workers_cancel\nrace:workers_stop\nrace:raise_cancel\n";
-}
-#endif
+/* GPD_VERSION: the project's version, defined by server/CMakeLists.txt */
 
 static void usage(FILE *f)
 {
@@ -100,26 +86,18 @@ static const char *env_or(const char *name, const char *dflt)
     return (v && *v) ? v : dflt;
 }
 
-int main(int argc, char **argv)
-{
-    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-    if (ncpu < 1) ncpu = 1;
-    char ncpu_s[24];
-    snprintf(ncpu_s, sizeof ncpu_s, "%ld", ncpu);
+/* the settings as given: the command line, else the environment, else the defaults */
+typedef struct settings {
+    const char *listen, *db, *workers, *level, *threads, *maxconn, *timeout, *maxbody, *maxres,
+        *jobto;
+} settings;
 
-    const char *listen_s = env_or("GRAINPACK_LISTEN", "127.0.0.1:8080");
-    const char *db = env_or("GRAINPACK_DB", "./grainpack.db");
-    const char *workers_s = env_or("GRAINPACK_WORKERS", ncpu_s);
-    const char *level_s = env_or("GRAINPACK_LOG_LEVEL", "info");
-    const char *threads_s = env_or("GRAINPACK_HTTP_THREADS", "4");
-    const char *maxconn_s = env_or("GRAINPACK_MAX_CONNECTIONS", "1024");
-    const char *timeout_s = env_or("GRAINPACK_TIMEOUT", "30");
-    const char *maxbody_s = env_or("GRAINPACK_MAX_BODY", "1048576");
-    const char *maxres_s = env_or("GRAINPACK_MAX_RESULT_MB", "1024");
+/* Reads the command line over st (the environment's values); -1 to go on, else the exit
+ * status (--help, --version, a bad option or origin). */
+static int read_args(int argc, char **argv, settings *st)
+{
     const char *origins_env = env_or("GRAINPACK_ALLOW_ORIGIN", NULL);
     int origins_flag = 0; /* any --allow-origin replaces GRAINPACK_ALLOW_ORIGIN */
-    const char *jobto_s = env_or("GRAINPACK_JOB_TIMEOUT", "3600");
-
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},       {"db", required_argument, 0, 'd'},
         {"workers", required_argument, 0, 'w'},      {"log-level", required_argument, 0, 'L'},
@@ -133,16 +111,16 @@ int main(int argc, char **argv)
     int ch;
     while ((ch = getopt_long(argc, argv, "l:d:w:L:t:c:T:b:R:J:hV", opts, NULL)) != -1) {
         switch (ch) {
-        case 'l': listen_s = optarg; break;
-        case 'd': db = optarg; break;
-        case 'w': workers_s = optarg; break;
-        case 'L': level_s = optarg; break;
-        case 't': threads_s = optarg; break;
-        case 'c': maxconn_s = optarg; break;
-        case 'T': timeout_s = optarg; break;
-        case 'b': maxbody_s = optarg; break;
-        case 'R': maxres_s = optarg; break;
-        case 'J': jobto_s = optarg; break;
+        case 'l': st->listen = optarg; break;
+        case 'd': st->db = optarg; break;
+        case 'w': st->workers = optarg; break;
+        case 'L': st->level = optarg; break;
+        case 't': st->threads = optarg; break;
+        case 'c': st->maxconn = optarg; break;
+        case 'T': st->timeout = optarg; break;
+        case 'b': st->maxbody = optarg; break;
+        case 'R': st->maxres = optarg; break;
+        case 'J': st->jobto = optarg; break;
         case 1001:
             if (gpd_allow_origins(optarg)) return 2;
             origins_flag = 1;
@@ -158,22 +136,102 @@ int main(int argc, char **argv)
         usage(stderr);
         return 2;
     }
+    return -1;
+}
+
+/* Opens the job store (its lock first, before recovery touches any job) and applies the
+ * restart rule; 0, or -1 (said on stderr). */
+static int open_store(const char *db)
+{
+    int open_rc = store_open(db);
+    if (open_rc == STORE_OPEN_LOCKED) {
+        fprintf(stderr,
+                "grainpackd: the job database %s is in use by another grainpackd process (it "
+                "holds the database lock); refusing to start\n",
+                db);
+        return -1;
+    }
+    if (open_rc != 0) {
+        fprintf(stderr, "grainpackd: cannot open the job database %s\n", db);
+        return -1;
+    }
+    int requeued = 0, failed = 0;
+    if (store_recover(&requeued, &failed) != 0) {
+        fprintf(stderr, "grainpackd: cannot recover interrupted jobs in %s\n", db);
+        store_close();
+        return -1;
+    }
+    if (requeued || failed)
+        gpd_log(GPD_LOG_WARN,
+                "recovered after an unclean stop: %d running job(s) requeued, %d failed after %d "
+                "attempts",
+                requeued, failed, STORE_MAX_ATTEMPTS);
+    return 0;
+}
+
+/* Starts the workers and the HTTP server on the open store; 0, or -1 with everything that
+ * was started stopped and the store closed. */
+static int start(gpd_http_config *cfg, long nworkers, long jobto)
+{
+    static char host[300];
+    int port = 0;
+    int fd = gpd_listen_socket(cfg->listen, host, sizeof host, &port);
+    if (fd < 0) {
+        store_close();
+        return -1;
+    }
+    workers_set_job_timeout(jobto);
+    if (workers_start((int)nworkers) != 0) {
+        workers_stop();
+        store_close();
+        return -1;
+    }
+    cfg->listen_fd = fd;
+    cfg->host = host;
+    cfg->port = port;
+    if (gpd_http_start(cfg) != 0) {
+        close(fd);
+        workers_stop();
+        store_close();
+        return -1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    if (ncpu < 1) ncpu = 1;
+    char ncpu_s[24];
+    snprintf(ncpu_s, sizeof ncpu_s, "%ld", ncpu);
+    settings st = {env_or("GRAINPACK_LISTEN", "127.0.0.1:8080"),
+                   env_or("GRAINPACK_DB", "./grainpack.db"),
+                   env_or("GRAINPACK_WORKERS", ncpu_s),
+                   env_or("GRAINPACK_LOG_LEVEL", "info"),
+                   env_or("GRAINPACK_HTTP_THREADS", "4"),
+                   env_or("GRAINPACK_MAX_CONNECTIONS", "1024"),
+                   env_or("GRAINPACK_TIMEOUT", "30"),
+                   env_or("GRAINPACK_MAX_BODY", "1048576"),
+                   env_or("GRAINPACK_MAX_RESULT_MB", "1024"),
+                   env_or("GRAINPACK_JOB_TIMEOUT", "3600")};
+    int rc = read_args(argc, argv, &st);
+    if (rc >= 0) return rc;
     long nworkers, nthreads, maxconn, timeout, maxbody, maxres, jobto;
-    if (parse_long("--workers", workers_s, 1, 1024, &nworkers) ||
-        parse_long("--http-threads", threads_s, 1, 256, &nthreads) ||
-        parse_long("--max-connections", maxconn_s, 1, 1000000, &maxconn) ||
-        parse_long("--timeout", timeout_s, 1, 86400, &timeout) ||
-        parse_long("--max-body", maxbody_s, 1024, 1L << 30, &maxbody) ||
-        parse_long("--max-result-mb", maxres_s, 1, 1L << 20, &maxres) ||
-        parse_long("--job-timeout", jobto_s, 0, 31622400, &jobto))
+    if (parse_long("--workers", st.workers, 1, 1024, &nworkers) ||
+        parse_long("--http-threads", st.threads, 1, 256, &nthreads) ||
+        parse_long("--max-connections", st.maxconn, 1, 1000000, &maxconn) ||
+        parse_long("--timeout", st.timeout, 1, 86400, &timeout) ||
+        parse_long("--max-body", st.maxbody, 1024, 1L << 30, &maxbody) ||
+        parse_long("--max-result-mb", st.maxres, 1, 1L << 20, &maxres) ||
+        parse_long("--job-timeout", st.jobto, 0, 31622400, &jobto))
         return 2;
-    int level = gpd_log_parse_level(level_s);
+    int level = gpd_log_parse_level(st.level);
     if (level < 0) {
         fprintf(stderr, "grainpackd: --log-level expects error|warn|info|debug, got \"%s\"\n",
-                level_s);
+                st.level);
         return 2;
     }
-    gpd_log_threshold = level;
+    gpd_log_set_level((gpd_log_level)level);
 
     /* Signals are handled by sigwait() in this thread only: block them before any thread. */
     sigset_t set;
@@ -183,63 +241,18 @@ int main(int argc, char **argv)
     pthread_sigmask(SIG_BLOCK, &set, NULL);
     signal(SIGPIPE, SIG_IGN);
 
-    /* store_open locks the database first, before recovery touches any job */
-    int open_rc = store_open(db);
-    if (open_rc == STORE_OPEN_LOCKED) {
-        fprintf(stderr,
-                "grainpackd: the job database %s is in use by another grainpackd process (it "
-                "holds the database lock); refusing to start\n",
-                db);
-        return 1;
-    }
-    if (open_rc != 0) {
-        fprintf(stderr, "grainpackd: cannot open the job database %s\n", db);
-        return 1;
-    }
-    int requeued = 0, failed = 0;
-    if (store_recover(&requeued, &failed) != 0) {
-        fprintf(stderr, "grainpackd: cannot recover interrupted jobs in %s\n", db);
-        store_close();
-        return 1;
-    }
-    if (requeued || failed)
-        gpd_log(GPD_LOG_WARN,
-                "recovered after an unclean stop: %d running job(s) requeued, %d failed after %d "
-                "attempts",
-                requeued, failed, STORE_MAX_ATTEMPTS);
-
-    char host[300];
-    int port = 0;
-    int fd = gpd_listen_socket(listen_s, host, sizeof host, &port);
-    if (fd < 0) {
-        store_close();
-        return 1;
-    }
-    workers_set_job_timeout(jobto);
-    if (workers_start((int)nworkers) != 0) {
-        workers_stop();
-        store_close();
-        return 1;
-    }
-    gpd_http_config cfg = {.listen_fd = fd,
-                           .threads = (unsigned)nthreads,
+    if (open_store(st.db)) return 1;
+    gpd_http_config cfg = {.threads = (unsigned)nthreads,
                            .max_connections = (unsigned)maxconn,
                            .timeout_s = (unsigned)timeout,
                            .max_body = (size_t)maxbody,
                            .max_result_mb = (double)maxres,
-                           .listen = listen_s,
-                           .host = host,
-                           .port = port};
-    if (gpd_http_start(&cfg) != 0) {
-        close(fd);
-        workers_stop();
-        store_close();
-        return 1;
-    }
-    printf("listening on http://%s:%d\n", host, port);
+                           .listen = st.listen};
+    if (start(&cfg, nworkers, jobto)) return 1;
+    printf("listening on http://%s:%d\n", cfg.host, cfg.port);
     fflush(stdout);
     gpd_log(GPD_LOG_INFO, "grainpackd %s: http://%s:%d, db %s, %ld workers, %ld http threads",
-            GPD_VERSION, host, port, db, nworkers, nthreads);
+            GPD_VERSION, cfg.host, cfg.port, st.db, nworkers, nthreads);
 
     int sig = 0;
     while (sigwait(&set, &sig) != 0) {

@@ -6,7 +6,6 @@
 #include <fcntl.h>
 #include <limits.h>
 #include <pthread.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,94 +16,6 @@
 #include <sqlite3.h>
 
 #include "json_scan.h"
-
-/* ------------------------------------------------------------------ logging */
-
-volatile int gpd_log_threshold = GPD_LOG_INFO;
-static pthread_mutex_t log_mu = PTHREAD_MUTEX_INITIALIZER;
-
-int gpd_log_parse_level(const char *s)
-{
-    if (!s) return -1;
-    if (!strcmp(s, "error")) return GPD_LOG_ERROR;
-    if (!strcmp(s, "warn") || !strcmp(s, "warning")) return GPD_LOG_WARN;
-    if (!strcmp(s, "info")) return GPD_LOG_INFO;
-    if (!strcmp(s, "debug")) return GPD_LOG_DEBUG;
-    return -1;
-}
-
-void gpd_log(gpd_log_level level, const char *fmt, ...)
-{
-    static const char *names[] = {"error", "warn", "info", "debug"};
-    if ((int)level > __atomic_load_n(&gpd_log_threshold, __ATOMIC_RELAXED)) return;
-    char ts[40];
-    gpd_now_rfc3339(ts, sizeof ts);
-    char msg[1024];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    pthread_mutex_lock(&log_mu);
-    fprintf(stderr, "%s %-5s %s\n", ts, names[level], msg);
-    fflush(stderr);
-    pthread_mutex_unlock(&log_mu);
-}
-
-/* ------------------------------------------------------------------ time, ids */
-
-void gpd_now_rfc3339(char *buf, size_t len)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    struct tm tm;
-    gmtime_r(&ts.tv_sec, &tm);
-    size_t n = strftime(buf, len, "%Y-%m-%dT%H:%M:%S", &tm);
-    snprintf(buf + n, len - n, ".%03dZ", (int)(ts.tv_nsec / 1000000L));
-}
-
-double gpd_monotonic_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-int gpd_new_id(char out[33])
-{
-    unsigned char b[16];
-    int fd = open("/dev/urandom", O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return -1;
-    size_t got = 0;
-    while (got < sizeof b) {
-        ssize_t r = read(fd, b + got, sizeof b - got);
-        if (r < 0 && errno == EINTR) continue;
-        if (r <= 0) {
-            close(fd);
-            return -1;
-        }
-        got += (size_t)r;
-    }
-    close(fd);
-    static const char hex[] = "0123456789abcdef";
-    for (int i = 0; i < 16; i++) {
-        out[2 * i] = hex[b[i] >> 4];
-        out[2 * i + 1] = hex[b[i] & 15];
-    }
-    out[32] = '\0';
-    return 0;
-}
-
-int gpd_id_is_plausible(const char *s)
-{
-    size_t n = 0;
-    for (; s[n]; n++) {
-        char c = s[n];
-        int ok = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-                 c == '-' || c == '_';
-        if (!ok || n >= 64) return 0;
-    }
-    return n > 0;
-}
 
 /* ------------------------------------------------------------------ connections */
 
@@ -163,15 +74,18 @@ static const char *SCHEMA_SQL =
     "CREATE TABLE IF NOT EXISTS summaries(seq INTEGER PRIMARY KEY, summary TEXT NOT NULL,"
     " arrays TEXT);";
 
-static sqlite3 *conn_open(void)
+/* a copy of the database's path; NULL once the store is closed (or out of memory) */
+static char *path_copy(void)
 {
     pthread_mutex_lock(&path_mu);
-    if (closed || !db_path) {
-        pthread_mutex_unlock(&path_mu);
-        return NULL;
-    }
-    char *path = strdup(db_path);
+    char *path = (closed || !db_path) ? NULL : strdup(db_path);
     pthread_mutex_unlock(&path_mu);
+    return path;
+}
+
+static sqlite3 *conn_open(void)
+{
+    char *path = path_copy();
     if (!path) return NULL;
     sqlite3 *db = NULL;
     int rc = sqlite3_open_v2(path, &db,
@@ -387,7 +301,12 @@ static void note_write_error(const char *what, const char *msg)
     werr.count++;
     werr.when = gpd_monotonic_s();
     gpd_now_rfc3339(werr.at, sizeof werr.at);
-    snprintf(werr.msg, sizeof werr.msg, "%s: %s", what, msg);
+    /* "what: msg", cut to the buffer as snprintf would (msg may be a long gpd_err message) */
+    snprintf(werr.msg, sizeof werr.msg, "%s: ", what);
+    size_t n = strlen(werr.msg), m = strlen(msg);
+    if (m > sizeof werr.msg - 1 - n) m = sizeof werr.msg - 1 - n;
+    memcpy(werr.msg + n, msg, m);
+    werr.msg[n + m] = '\0';
     pthread_mutex_unlock(&werr_mu);
 }
 
@@ -459,6 +378,28 @@ static json_t *job_from_row(sqlite3_stmt *st)
     json_object_set_new(j, "progress", p);
     json_object_set_new(j, "error", json_col(st, 7));
     return j;
+}
+
+/* Prepares sql (a SELECT of one job: ?1 its id, column 0 its status) and steps to the job's
+ * row: STORE_OK with the status copied and *stp at the row (give it back with done()),
+ * STORE_NOT_FOUND, or STORE_ERROR (logged, as what) -- *stp NULL then. */
+static store_rc job_row(sqlite3 *db, const char *sql, const char *id, const char *what,
+                        sqlite3_stmt **stp, char status[16])
+{
+    *stp = NULL;
+    sqlite3_stmt *st = prep(db, sql);
+    if (!st) return STORE_ERROR;
+    bind_text(st, 1, id);
+    int s = sqlite3_step(st);
+    if (s == SQLITE_ROW) {
+        const unsigned char *t = sqlite3_column_text(st, 0);
+        snprintf(status, 16, "%s", t ? (const char *)t : "");
+        *stp = st;
+        return STORE_OK;
+    }
+    if (s != SQLITE_DONE) gpd_log(GPD_LOG_ERROR, "sqlite %s: %s", what, sqlite3_errmsg(db));
+    done(st);
+    return s == SQLITE_DONE ? STORE_NOT_FOUND : STORE_ERROR;
 }
 
 /* ------------------------------------------------------------------ operations */
@@ -559,24 +500,14 @@ store_rc store_get_text(const char *id, const char *column, char **text, char st
         sql = "SELECT status, kind FROM jobs WHERE id=?1";
     else
         return STORE_ERROR;
-    sqlite3_stmt *st = prep(db, sql);
-    if (!st) return STORE_ERROR;
-    bind_text(st, 1, id);
-    store_rc rc = STORE_ERROR;
-    int s = sqlite3_step(st);
-    if (s == SQLITE_ROW) {
-        const unsigned char *stt = sqlite3_column_text(st, 0);
-        snprintf(status, 16, "%s", stt ? (const char *)stt : "");
-        const unsigned char *t = sqlite3_column_text(st, 1);
-        rc = STORE_OK;
-        if (t) {
-            *text = strdup((const char *)t);
-            if (!*text) rc = STORE_ERROR;
-        }
-    } else if (s == SQLITE_DONE) {
-        rc = STORE_NOT_FOUND;
-    } else {
-        gpd_log(GPD_LOG_ERROR, "sqlite get %s: %s", column, sqlite3_errmsg(db));
+    char what[32];
+    snprintf(what, sizeof what, "get %s", column);
+    sqlite3_stmt *st;
+    store_rc rc = job_row(db, sql, id, what, &st, status);
+    const unsigned char *t = st ? sqlite3_column_text(st, 1) : NULL;
+    if (t) {
+        *text = strdup((const char *)t);
+        if (!*text) rc = STORE_ERROR;
     }
     done(st);
     return rc;
@@ -769,36 +700,87 @@ static int spans_parse(const char *text, uint64_t spans[STORE_SUMMARY_NSKIP][2])
     return 0;
 }
 
-store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
-                       const void *pack, size_t pack_len, char *why, size_t why_len)
+/* Runs sql, a write of one row, with ?1 = id, ?2 = the value v of n bytes (text when is_text,
+ * else a blob; bound without a copy: a result may be hundreds of MB, and it outlives the
+ * statement) and ?3, ?4 = the texts a, b where the statement has them. Returns SQLite's code
+ * (SQLITE_OK once done) and the rows changed in *changes. */
+static int write_value(sqlite3 *db, const char *sql, const char *id, const void *v, size_t n,
+                       int is_text, const char *a, const char *b, int *changes)
 {
-    char dummy[8];
-    if (!why || !why_len) {
-        why = dummy;
-        why_len = sizeof dummy;
+    *changes = 0;
+    sqlite3_stmt *st = prep(db, sql);
+    if (!st) return sqlite3_errcode(db);
+    int np = sqlite3_bind_parameter_count(st);
+    int rc = bind_text(st, 1, id);
+    if (rc == SQLITE_OK)
+        rc = is_text ? sqlite3_bind_text64(st, 2, v, (sqlite3_uint64)n, SQLITE_STATIC, SQLITE_UTF8)
+                     : sqlite3_bind_blob64(st, 2, v, (sqlite3_uint64)n, SQLITE_STATIC);
+    if (rc == SQLITE_OK && np >= 3) rc = bind_text(st, 3, a);
+    if (rc == SQLITE_OK && np >= 4) rc = bind_text(st, 4, b);
+    if (rc == SQLITE_OK) {
+        rc = sqlite3_step(st);
+        if (rc == SQLITE_DONE) {
+            rc = SQLITE_OK;
+            *changes = sqlite3_changes(db);
+        }
     }
-    why[0] = '\0';
+    done(st);
+    return rc;
+}
+
+/* A value over SQLite's length limit (1e9 bytes by default) cannot be stored at all: 1 (with
+ * the sizes in why), without trying (binding it would leave the column NULL); else 0. */
+static int too_big(sqlite3 *db, size_t rlen, const void *pack, size_t pack_len, gpd_err *why)
+{
+    long long lim = sqlite3_limit(db, SQLITE_LIMIT_LENGTH, -1);
+    if ((long long)rlen <= lim && !(pack && (long long)pack_len > lim)) return 0;
+    int is_pack = (long long)rlen <= lim;
+    gpd_err_set(why, 500,
+                "the %s is %zu bytes, more than the job database can store in one value "
+                "(%lld bytes)",
+                is_pack ? "export pack" : "result", is_pack ? pack_len : rlen, lim);
+    return 1;
+}
+
+/* The end of store_succeed's transaction: COMMIT when every write passed, else the reason
+ * (before ROLLBACK replaces SQLite's message) in why and the log. src: the last SQLite code. */
+static store_rc succeed_end(sqlite3 *db, const char *id, store_rc rc, int src, gpd_err *why)
+{
+    if (rc == STORE_OK) {
+        src = sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
+        if (src != SQLITE_OK) rc = STORE_ERROR;
+    }
+    if (rc == STORE_ERROR) {
+        if (src == SQLITE_OK) src = sqlite3_errcode(db);
+        const char *em = sqlite3_errmsg(db);
+        int more = em && strcmp(em, sqlite3_errstr(src));
+        if ((src & 0xff) == SQLITE_TOOBIG) rc = STORE_TOOBIG;
+        gpd_err_set(why, 500, "%s%s%s", sqlite3_errstr(src), more ? ": " : "", more ? em : "");
+        gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result: %s", id, why->msg);
+        if (rc != STORE_TOOBIG) note_write_error("storing a result", why->msg);
+    }
+    if (!sqlite3_get_autocommit(db) && sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK)
+        gpd_log(GPD_LOG_ERROR, "sqlite rollback: %s", sqlite3_errmsg(db));
+    return rc;
+}
+
+store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
+                       const void *pack, size_t pack_len, gpd_err *why)
+{
+    gpd_err dummy;
+    if (!why) why = &dummy;
+    gpd_err_set(why, 0, "%s", "");
     if (!result_json) {
-        snprintf(why, why_len, "there is no result to store");
+        gpd_err_set(why, 500, "there is no result to store");
         return STORE_ERROR;
     }
     sqlite3 *db = conn();
     if (!db) {
-        snprintf(why, why_len, "no connection to the database");
+        gpd_err_set(why, 500, "no connection to the database");
         return STORE_ERROR;
     }
     size_t rlen = strlen(result_json);
-    /* A value over SQLite's length limit (1e9 bytes by default) cannot be stored at all:
-     * say so with the sizes, without trying (binding it would leave the column NULL). */
-    long long lim = sqlite3_limit(db, SQLITE_LIMIT_LENGTH, -1);
-    if ((long long)rlen > lim || (pack && (long long)pack_len > lim)) {
-        int is_pack = (long long)rlen <= lim;
-        snprintf(why, why_len,
-                 "the %s is %zu bytes, more than the job database can store in one value "
-                 "(%lld bytes)",
-                 is_pack ? "export pack" : "result", is_pack ? pack_len : rlen, lim);
-        return STORE_TOOBIG;
-    }
+    if (too_big(db, rlen, pack, pack_len, why)) return STORE_TOOBIG;
     /* the summary (the result without its per-item arrays), made before the write lock is
      * taken; a result it cannot be made of (not an object, out of memory) is stored without
      * one, and its readers fall back to scanning the result */
@@ -818,90 +800,27 @@ store_rc store_succeed(const char *id, const char *result_json, const char *prog
     /* The result, the pack and the status change commit together: a job never shows
      * succeeded without its files. Every SQLite code is checked: a failure anywhere rolls the
      * whole transaction back, so the job stays running for the caller to retry or fail. */
-    int src = sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL);
+    int changes = 0, src = sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL);
     store_rc rc = STORE_ERROR;
     if (src == SQLITE_OK) {
-        sqlite3_stmt *u = prep(db, "UPDATE jobs SET status='succeeded', result=?2, progress=?3, "
-                                   "finished_at=?4, error=NULL WHERE id=?1 AND status='running'");
-        if (!u) {
-            src = sqlite3_errcode(db);
-        } else {
-            src = bind_text(u, 1, id);
-            /* no copy of a result that may be hundreds of MB: it outlives the statement */
-            if (src == SQLITE_OK)
-                src = sqlite3_bind_text64(u, 2, result_json, (sqlite3_uint64)rlen, SQLITE_STATIC,
-                                          SQLITE_UTF8);
-            if (src == SQLITE_OK) src = bind_text(u, 3, progress_json);
-            if (src == SQLITE_OK) src = bind_text(u, 4, now);
-            if (src == SQLITE_OK) {
-                src = sqlite3_step(u);
-                if (src == SQLITE_DONE) {
-                    src = SQLITE_OK;
-                    rc = sqlite3_changes(db) > 0 ? STORE_OK : STORE_CONFLICT;
-                }
-            }
-            done(u);
-        }
+        src = write_value(db, "UPDATE jobs SET status='succeeded', result=?2, progress=?3, "
+                              "finished_at=?4, error=NULL WHERE id=?1 AND status='running'",
+                          id, result_json, rlen, 1, progress_json, now, &changes);
+        if (src == SQLITE_OK) rc = changes > 0 ? STORE_OK : STORE_CONFLICT;
     }
     if (rc == STORE_OK && pack) {
-        rc = STORE_ERROR;
-        sqlite3_stmt *x = prep(db, "INSERT OR REPLACE INTO exports(seq, pack) "
-                                   "SELECT seq, ?2 FROM jobs WHERE id=?1");
-        if (!x) {
-            src = sqlite3_errcode(db);
-        } else {
-            src = bind_text(x, 1, id);
-            if (src == SQLITE_OK)
-                src = sqlite3_bind_blob64(x, 2, pack, (sqlite3_uint64)pack_len, SQLITE_STATIC);
-            if (src == SQLITE_OK) {
-                src = sqlite3_step(x);
-                if (src == SQLITE_DONE) {
-                    src = SQLITE_OK;
-                    rc = sqlite3_changes(db) == 1 ? STORE_OK : STORE_ERROR;
-                }
-            }
-            done(x);
-        }
+        src = write_value(db, "INSERT OR REPLACE INTO exports(seq, pack) "
+                              "SELECT seq, ?2 FROM jobs WHERE id=?1",
+                          id, pack, pack_len, 0, NULL, NULL, &changes);
+        rc = src == SQLITE_OK && changes == 1 ? STORE_OK : STORE_ERROR;
     }
     if (rc == STORE_OK && summary) {
-        rc = STORE_ERROR;
-        sqlite3_stmt *x = prep(db, "INSERT OR REPLACE INTO summaries(seq, summary, arrays) "
-                                   "SELECT seq, ?2, ?3 FROM jobs WHERE id=?1");
-        if (!x) {
-            src = sqlite3_errcode(db);
-        } else {
-            src = bind_text(x, 1, id);
-            if (src == SQLITE_OK)
-                src = sqlite3_bind_text64(x, 2, summary, (sqlite3_uint64)slen, SQLITE_STATIC,
-                                          SQLITE_UTF8);
-            if (src == SQLITE_OK) src = bind_text(x, 3, arrays);
-            if (src == SQLITE_OK) {
-                src = sqlite3_step(x);
-                if (src == SQLITE_DONE) {
-                    src = SQLITE_OK;
-                    rc = sqlite3_changes(db) == 1 ? STORE_OK : STORE_ERROR;
-                }
-            }
-            done(x);
-        }
+        src = write_value(db, "INSERT OR REPLACE INTO summaries(seq, summary, arrays) "
+                              "SELECT seq, ?2, ?3 FROM jobs WHERE id=?1",
+                          id, summary, slen, 1, arrays, NULL, &changes);
+        rc = src == SQLITE_OK && changes == 1 ? STORE_OK : STORE_ERROR;
     }
-    if (rc == STORE_OK) {
-        src = sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
-        if (src != SQLITE_OK) rc = STORE_ERROR;
-    }
-    if (rc == STORE_ERROR) {
-        /* the reason before ROLLBACK replaces SQLite's message */
-        if (src == SQLITE_OK) src = sqlite3_errcode(db);
-        const char *em = sqlite3_errmsg(db);
-        if ((src & 0xff) == SQLITE_TOOBIG) rc = STORE_TOOBIG;
-        snprintf(why, why_len, "%s%s%s", sqlite3_errstr(src),
-                 em && strcmp(em, sqlite3_errstr(src)) ? ": " : "",
-                 em && strcmp(em, sqlite3_errstr(src)) ? em : "");
-        gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result: %s", id, why);
-        if (rc != STORE_TOOBIG) note_write_error("storing a result", why);
-    }
-    if (!sqlite3_get_autocommit(db) && sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK)
-        gpd_log(GPD_LOG_ERROR, "sqlite rollback: %s", sqlite3_errmsg(db));
+    rc = succeed_end(db, id, rc, src, why);
     free(summary);
     free(arrays);
     return rc;
@@ -929,66 +848,32 @@ static int blob_open(sqlite3 *db, const char *table, const char *column, sqlite3
     return 1;
 }
 
-store_rc store_stream_open(const char *id, const char *what, size_t small,
-                           store_stream **out, char **text, size_t *text_len, char status[16])
+/* A value of at most small bytes read whole (on this thread's connection; the blob closed at
+ * once): 0 with *text; -1 on a failed read or out of memory. */
+static int read_small(sqlite3_blob *b, uint64_t size, char **text, size_t *text_len)
 {
-    *out = NULL;
-    *text = NULL;
-    *text_len = 0;
-    status[0] = 0;
-    int is_pack = !strcmp(what, "pack");
-    if (!is_pack && strcmp(what, "result")) return STORE_ERROR;
-    sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
-    sqlite3_stmt *st = prep(db, "SELECT seq, status FROM jobs WHERE id=?1");
-    if (!st) return STORE_ERROR;
-    bind_text(st, 1, id);
-    int s = sqlite3_step(st);
-    sqlite3_int64 seq = 0;
-    if (s == SQLITE_ROW) {
-        seq = sqlite3_column_int64(st, 0);
-        const unsigned char *t = sqlite3_column_text(st, 1);
-        snprintf(status, 16, "%s", t ? (const char *)t : "");
+    char *buf = malloc(size + 1);
+    if (!buf || sqlite3_blob_read(b, buf, (int)size, 0) != SQLITE_OK) {
+        free(buf);
+        return -1;
     }
-    done(st);
-    if (s == SQLITE_DONE) return STORE_NOT_FOUND;
-    if (s != SQLITE_ROW) {
-        gpd_log(GPD_LOG_ERROR, "sqlite stream: %s", sqlite3_errmsg(db));
-        return STORE_ERROR;
-    }
-    const char *table = is_pack ? "exports" : "jobs", *column = is_pack ? "pack" : "result";
-    /* Small values are read whole on this thread's connection and the blob closed at once;
-     * only large ones get a private connection that lives as long as the download. */
-    sqlite3_blob *b;
-    if (blob_open(db, table, column, seq, &b)) return STORE_OK; /* no value */
-    uint64_t size = (uint64_t)sqlite3_blob_bytes(b);
-    if (size <= small) {
-        char *buf = malloc(size + 1);
-        store_rc rc = STORE_ERROR;
-        if (buf && sqlite3_blob_read(b, buf, (int)size, 0) == SQLITE_OK) {
-            buf[size] = 0;
-            *text = buf;
-            *text_len = size;
-            rc = STORE_OK;
-        } else {
-            free(buf);
-        }
-        sqlite3_blob_close(b);
-        return rc;
-    }
-    sqlite3_blob_close(b);
+    buf[size] = 0;
+    *text = buf;
+    *text_len = size;
+    return 0;
+}
 
-    pthread_mutex_lock(&path_mu);
-    char *path = (closed || !db_path) ? NULL : strdup(db_path);
-    pthread_mutex_unlock(&path_mu);
-    if (!path) return STORE_ERROR;
-    store_stream *ss = calloc(1, sizeof *ss);
-    if (!ss) {
-        free(path);
-        return STORE_ERROR;
-    }
-    int rc = sqlite3_open_v2(path, &ss->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX, NULL);
+/* A large value streamed on a private connection that lives as long as the download. */
+static store_rc open_private(const char *table, const char *column, sqlite3_int64 seq,
+                             store_stream **out)
+{
+    char *path = path_copy();
+    store_stream *ss = path ? calloc(1, sizeof *ss) : NULL;
+    int rc = ss ? sqlite3_open_v2(path, &ss->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX,
+                                  NULL)
+                : SQLITE_NOMEM;
     free(path);
+    if (!ss) return STORE_ERROR;
     if (rc == SQLITE_OK) {
         sqlite3_busy_timeout(ss->db, 5000);
         /* the blob is read front to back once: a small page cache is enough */
@@ -1002,6 +887,32 @@ store_rc store_stream_open(const char *id, const char *what, size_t small,
     ss->size = (uint64_t)sqlite3_blob_bytes(ss->blob);
     *out = ss;
     return STORE_OK;
+}
+
+store_rc store_stream_open(const char *id, const char *what, size_t small,
+                           store_stream **out, char **text, size_t *text_len, char status[16])
+{
+    *out = NULL;
+    *text = NULL;
+    *text_len = 0;
+    status[0] = 0;
+    int is_pack = !strcmp(what, "pack");
+    if (!is_pack && strcmp(what, "result")) return STORE_ERROR;
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
+    sqlite3_stmt *st;
+    store_rc rc = job_row(db, "SELECT status, seq FROM jobs WHERE id=?1", id, "stream", &st,
+                          status);
+    sqlite3_int64 seq = st ? sqlite3_column_int64(st, 1) : 0;
+    done(st);
+    if (rc != STORE_OK) return rc;
+    const char *table = is_pack ? "exports" : "jobs", *column = is_pack ? "pack" : "result";
+    sqlite3_blob *b;
+    if (blob_open(db, table, column, seq, &b)) return STORE_OK; /* no value */
+    uint64_t size = (uint64_t)sqlite3_blob_bytes(b);
+    if (size <= small) rc = read_small(b, size, text, text_len) ? STORE_ERROR : STORE_OK;
+    sqlite3_blob_close(b);
+    return size <= small ? rc : open_private(table, column, seq, out);
 }
 
 uint64_t store_stream_size(const store_stream *s)
@@ -1025,9 +936,39 @@ void store_stream_close(store_stream *s)
 
 /* ------------------------------------------------------------------ summaries */
 
-static int stream_js_read(void *user, uint64_t off, void *dst, size_t n)
+static int stream_read(void *user, uint64_t off, void *dst, size_t n)
 {
     return store_stream_read(user, off, dst, n);
+}
+
+js_source store_value_source(const char *text, size_t len, store_stream *s)
+{
+    if (text) return js_memory_source(text, len);
+    return (js_source){stream_read, s, store_stream_size(s)};
+}
+
+/* The summary of a job stored before summaries: made by scanning its result (streamed when
+ * large). */
+static store_rc summary_by_scan(const char *id, char **text, size_t *len,
+                                uint64_t spans[STORE_SUMMARY_NSKIP][2])
+{
+    store_stream *ss = NULL;
+    char *small = NULL;
+    size_t small_len = 0;
+    char st[16];
+    store_rc rc = store_stream_open(id, "result", 256u * 1024u, &ss, &small, &small_len, st);
+    if (rc != STORE_OK) return rc;
+    if (!ss && !small) return STORE_OK; /* no result */
+    js_source src = store_value_source(small, small_len, ss);
+    static const char *const skip[] = STORE_SUMMARY_SKIP;
+    uint64_t sp[STORE_SUMMARY_NSKIP][2];
+    *text = js_object_without(&src, skip, len, sp);
+    if (*text && spans) memcpy(spans, sp, sizeof sp);
+    free(small);
+    store_stream_close(ss);
+    if (*text) return STORE_OK;
+    gpd_log(GPD_LOG_ERROR, "job %s: cannot make the summary of its stored result", id);
+    return STORE_ERROR;
 }
 
 store_rc store_get_summary(const char *id, char **text, size_t *len,
@@ -1038,58 +979,26 @@ store_rc store_get_summary(const char *id, char **text, size_t *len,
     status[0] = 0;
     sqlite3 *db = conn();
     if (!db) return STORE_ERROR;
-    sqlite3_stmt *st = prep(db, "SELECT j.status, s.summary, s.arrays FROM jobs j "
-                                "LEFT JOIN summaries s ON s.seq = j.seq WHERE j.id=?1");
-    if (!st) return STORE_ERROR;
-    bind_text(st, 1, id);
-    store_rc rc = STORE_ERROR;
-    int s = sqlite3_step(st);
-    if (s == SQLITE_ROW) {
-        const unsigned char *stt = sqlite3_column_text(st, 0);
-        snprintf(status, 16, "%s", stt ? (const char *)stt : "");
-        const unsigned char *t = sqlite3_column_text(st, 1);
-        rc = STORE_OK;
-        uint64_t sp[STORE_SUMMARY_NSKIP][2];
-        if (t && spans_parse((const char *)sqlite3_column_text(st, 2), sp) == 0) {
-            size_t n = (size_t)sqlite3_column_bytes(st, 1);
-            *text = malloc(n + 1);
-            if (*text) {
-                memcpy(*text, t, n + 1);
-                if (len) *len = n;
-                if (spans) memcpy(spans, sp, sizeof sp);
-            } else {
-                rc = STORE_ERROR;
-            }
+    sqlite3_stmt *st;
+    store_rc rc = job_row(db, "SELECT j.status, s.summary, s.arrays FROM jobs j "
+                              "LEFT JOIN summaries s ON s.seq = j.seq WHERE j.id=?1",
+                          id, "get summary", &st, status);
+    const unsigned char *t = st ? sqlite3_column_text(st, 1) : NULL;
+    uint64_t sp[STORE_SUMMARY_NSKIP][2];
+    if (t && spans_parse((const char *)sqlite3_column_text(st, 2), sp) == 0) {
+        size_t n = (size_t)sqlite3_column_bytes(st, 1);
+        *text = malloc(n + 1);
+        if (*text) {
+            memcpy(*text, t, n + 1);
+            if (len) *len = n;
+            if (spans) memcpy(spans, sp, sizeof sp);
+        } else {
+            rc = STORE_ERROR;
         }
-    } else if (s == SQLITE_DONE) {
-        rc = STORE_NOT_FOUND;
-    } else {
-        gpd_log(GPD_LOG_ERROR, "sqlite get summary: %s", sqlite3_errmsg(db));
     }
     done(st);
     if (rc != STORE_OK || *text || strcmp(status, "succeeded")) return rc;
-
-    /* a job stored before summaries: scan its result (streamed when large) */
-    store_stream *ss = NULL;
-    char *small = NULL;
-    size_t small_len = 0;
-    char st2[16];
-    rc = store_stream_open(id, "result", 256u * 1024u, &ss, &small, &small_len, st2);
-    if (rc != STORE_OK) return rc;
-    if (!ss && !small) return STORE_OK; /* no result */
-    js_source src = small ? js_memory_source(small, small_len)
-                          : (js_source){stream_js_read, ss, store_stream_size(ss)};
-    static const char *const skip[] = STORE_SUMMARY_SKIP;
-    uint64_t sp[STORE_SUMMARY_NSKIP][2];
-    *text = js_object_without(&src, skip, len, sp);
-    if (*text && spans) memcpy(spans, sp, sizeof sp);
-    free(small);
-    store_stream_close(ss);
-    if (!*text) {
-        gpd_log(GPD_LOG_ERROR, "job %s: cannot make the summary of its stored result", id);
-        return STORE_ERROR;
-    }
-    return STORE_OK;
+    return summary_by_scan(id, text, len, spans);
 }
 
 store_rc store_fail(const char *id, const char *code, const char *message)

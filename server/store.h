@@ -1,4 +1,4 @@
-/* store.h -- the SQLite job store of grainpackd, and the daemon's logger.
+/* store.h -- the SQLite job store of grainpackd.
  *
  * One table, jobs (WAL journal, busy_timeout 5 s, synchronous=NORMAL... FULL for the commit of
  * a result, see store.c):
@@ -37,21 +37,8 @@
 
 #include <jansson.h>
 
-/* ---- logging (stderr) ---- */
-typedef enum { GPD_LOG_ERROR = 0, GPD_LOG_WARN, GPD_LOG_INFO, GPD_LOG_DEBUG } gpd_log_level;
-extern volatile int gpd_log_threshold; /* messages above this level are dropped */
-/* Parses "error", "warn", "info", "debug"; -1 when unknown. */
-int gpd_log_parse_level(const char *s);
-void gpd_log(gpd_log_level level, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-
-/* ---- time and ids ---- */
-/* RFC 3339 UTC with milliseconds, e.g. "2026-11-23T17:25:47.123Z" (buf >= 32). */
-void gpd_now_rfc3339(char *buf, size_t len);
-double gpd_monotonic_s(void);
-/* 32 lower-case hex digits from /dev/urandom; 0 on success. */
-int gpd_new_id(char out[33]);
-/* 1 when s looks like a job id (1..64 chars of [0-9a-zA-Z_-]). */
-int gpd_id_is_plausible(const char *s);
+#include "json_scan.h"
+#include "util.h"
 
 /* ---- the store ---- */
 #define STORE_MAX_ATTEMPTS 3
@@ -123,9 +110,9 @@ store_rc store_progress(const char *id, const char *progress_json);
  * back, leaving the job running. STORE_TOOBIG: the result or the pack is larger than the
  * database can store (SQLite's length limit, 1e9 bytes by default), so it never will be;
  * STORE_ERROR: anything else (disk full, I/O error, a failed commit...), which may pass on a
- * retry. On both, why (may be NULL) gets a sentence saying what went wrong. */
+ * retry. On both, why (may be NULL) gets a sentence saying what went wrong (status 500). */
 store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
-                       const void *pack, size_t pack_len, char *why, size_t why_len);
+                       const void *pack, size_t pack_len, gpd_err *why);
 store_rc store_fail(const char *id, const char *code, const char *message);
 /* Back to queued (graceful shutdown): the attempt is not counted. */
 store_rc store_requeue(const char *id);
@@ -146,6 +133,9 @@ typedef struct store_stream store_stream;
 store_rc store_stream_open(const char *id, const char *what, size_t small, store_stream **out,
                            char **text, size_t *text_len, char status[16]);
 uint64_t store_stream_size(const store_stream *s);
+/* What store_stream_open gave (text of len bytes in memory, else the stream s) as a byte source
+ * for the readers of json_scan.h and core/export/gp_export.h (both take this shape). */
+js_source store_value_source(const char *text, size_t len, store_stream *s);
 /* Reads n bytes at off; 0 on success. */
 int store_stream_read(store_stream *s, uint64_t off, void *dst, size_t n);
 void store_stream_close(store_stream *s);

@@ -1,9 +1,11 @@
 /* svg.h -- SVG pictures of a finished job's result (GET /v1/jobs/{id}/svg?view=V).
  *
- * Views: for "fourier-voronoi-2d": packing, cells, size, orientation, descriptors;
- *        for "spheres-3d": section, psd.
+ * Views: each kind lists its own (kind.h: gpd_kind.views): the 2D kind packing, cells, size,
+ * orientation, descriptors (svg_views2d.c); the 3D kind section, psd (svg_views3d.c). The plot
+ * kit they draw with is svg_plot.h.
  * The renderer reads the result JSON exactly as served by GET /v1/jobs/{id}/result. The fields
- * it reads (proposal for server/result_json.c; everything optional unless the view needs it):
+ * it reads (as the kinds write them: kind_fv2d.c, kind_spheres3d.c; everything optional unless
+ * the view needs it):
  *
  * 2D result
  *   "grains": [{"id", "cell", "contour": [[x,y],...], "area", "orientation_deg",
@@ -24,7 +26,7 @@
  *     "fit": {"cell_area":  {"law", "ks", "ks_critical", "w1", "target": {"cov"},
  *                            "achieved": {"cov"}, "cdf": {"x": [k], "target": [k],
  *                            "achieved": [k]}},
- *             "grain_area": the same (optional)}   (server/result_json.h)
+ *             "grain_area": the same (optional)}   (kind_fv2d.c)
  *   }
  *   "warnings": ["one line", ...]    (optional; drawn under the size view)
  *   (The histograms mirror gp_hist in core/2d/gp_specimen2d.h: "target" may be absent or null
@@ -68,6 +70,7 @@
 
 #include "gp_export.h"
 #include "json_scan.h"
+#include "util.h"
 
 typedef struct gp_svg_options {
     const char *color;  /* packing: "size" (default) or "orientation"; NULL = default */
@@ -76,23 +79,19 @@ typedef struct gp_svg_options {
     int width;          /* picture width in px; 0 = default (800) */
 } gp_svg_options;
 
-/* Renders view of a result of the given kind ("fourier-voronoi-2d" or "spheres-3d"; NULL or
- * "" = guess from the result). opt may be NULL (defaults).
+/* Renders view of a result of the given kind (a name of kind.h's table; NULL or "" = the
+ * result's "kind", else guessed from its members: gpd_kind_guess). opt may be NULL (defaults).
  * Returns a malloc'ed NUL-terminated SVG document (length in *len when len is not NULL), or
- * NULL with a one-line message in errbuf and an HTTP status in *status (status may be NULL):
- *   400 -- unknown view (the message lists the valid views of the kind) or a bad option;
+ * NULL with err (may be NULL):
+ *   400 -- unknown kind, unknown view (the message lists the valid views of the kind) or a
+ *          bad option;
  *   409 -- the view needs a part of the result that was not asked for (e.g. "cells" without
  *          output "cells", "packing" without "grains");
  *   500 -- out of memory or a result that is not an object.
  * The caller free()s the returned string. Thread-safe (no global state).
  * (gp_svg_open over the result in memory, read to the end.) */
 char *gp_svg_render(const json_t *result, const char *kind, const char *view,
-                    const gp_svg_options *opt, size_t *len, int *status, char *errbuf,
-                    size_t errlen);
-
-/* The views of a kind as a comma-separated list ("packing, cells, size, orientation,
- * descriptors"), or NULL for an unknown kind. */
-const char *gp_svg_views(const char *kind);
+                    const gp_svg_options *opt, size_t *len, gpd_err *err);
 
 /* ---- item sources: a result's geometry, one item at a time ---- */
 
@@ -133,10 +132,15 @@ typedef struct gp_svg_input {
 
 typedef struct gp_svg gp_svg;
 
-/* Prepares view (reading what it needs: its statistics, its items' bounds and ranges) and
- * returns a stream of the SVG document; NULL with the status and message of gp_svg_render. */
+/* A view of a kind (kind.h: gpd_view.open): prepares g to draw view of in, reading what it
+ * needs (its statistics, its items' bounds and ranges), at width px (320..4000). 0, or -1 with
+ * err (the statuses of gp_svg_render). */
+typedef int (*gp_svg_view_fn)(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
+                              int width, gpd_err *err);
+
+/* Prepares view and returns a stream of the SVG document; NULL with err as gp_svg_render. */
 gp_svg *gp_svg_open(const gp_svg_input *in, const char *view, const gp_svg_options *opt,
-                    int *status, char *errbuf, size_t errlen);
+                    gpd_err *err);
 
 /* Copies up to cap (> 0) bytes of the document into buf; *n = 0 at the end. -1 when an item
  * source failed mid-way or memory ran out (the document is then incomplete: drop it; the

@@ -9,60 +9,72 @@
 
 #include "json_scan.h"
 #include "store.h"
+#include "svg_internal.h"
 
 /* values up to this size are read whole, larger ones through a blob stream (as http.c) */
 #define SVG_JOB_SMALL (256u * 1024u)
+
+/* A value of the job (its export pack, its result text) as the store hands it out: in memory
+ * when small, else a blob stream; opened once, when first needed. */
+typedef struct job_value {
+    int tried, failed;
+    store_stream *stream;
+    char *mem;
+    size_t len;
+} job_value;
 
 struct svg_job {
     char id[65];
     json_t *summary;
     gp_svg *svg;
-    /* the export pack */
-    int pack_tried;
-    store_stream *pack_stream;
-    char *pack_mem;
-    size_t pack_len;
-    /* the result text and where its arrays start */
-    int result_tried, result_failed;
-    store_stream *result_stream;
-    char *result_mem;
-    size_t result_len;
-    js_source rsrc;
+    job_value pack, result;
     uint64_t spans[STORE_SUMMARY_NSKIP][2]; /* where the result's arrays are (store.h) */
 };
 
-static int stream_read(void *user, uint64_t off, void *dst, size_t n)
+/* opens what ("pack" or "result") of the job, the first time; v->failed when the store failed,
+ * or (need) when there is no such value */
+static void value_open(svg_job *j, const char *what, int need, job_value *v)
 {
-    return store_stream_read(user, off, dst, n);
+    if (v->tried) return;
+    v->tried = 1;
+    char st[16];
+    v->failed = store_stream_open(j->id, what, SVG_JOB_SMALL, &v->stream, &v->mem, &v->len, st) !=
+                    STORE_OK ||
+                (need && !v->stream && !v->mem);
 }
 
-static const char *const PART[3] = {"grains", "cells", "spheres"};
+/* the value's bytes, for either reader (json_scan.h, gp_export.h) */
+static js_source value_source(const job_value *v)
+{
+    return store_value_source(v->mem, v->len, v->stream);
+}
 
 /* the index in STORE_SUMMARY_SKIP of a part's array */
 static int skip_index(gp_svg_part part)
 {
     static const char *const skip[] = STORE_SUMMARY_SKIP;
     for (int k = 0; k < STORE_SUMMARY_NSKIP; k++)
-        if (!strcmp(skip[k], PART[part])) return k;
+        if (!strcmp(skip[k], SVG_PART_NAME[part])) return k;
     return -1;
 }
 
-/* opens the result text once; 0 on success */
-static int open_result(svg_job *j)
+/* the items of part from the export pack, when the job has one; NULL else, or with *failed */
+static gp_svg_items *pack_items(svg_job *j, gp_svg_part part, int *failed)
 {
-    if (j->result_tried) return j->result_failed ? -1 : 0;
-    j->result_tried = 1;
-    char st[16];
-    store_rc rc = store_stream_open(j->id, "result", SVG_JOB_SMALL, &j->result_stream,
-                                    &j->result_mem, &j->result_len, st);
-    if (rc != STORE_OK || (!j->result_stream && !j->result_mem)) {
-        j->result_failed = 1;
-        return -1;
+    int first = !j->pack.tried;
+    value_open(j, "pack", 0, &j->pack);
+    if (j->pack.failed) {
+        *failed = first; /* once: later views read the result instead */
+        return NULL;
     }
-    j->rsrc = j->result_mem ? js_memory_source(j->result_mem, j->result_len)
-                            : (js_source){stream_read, j->result_stream,
-                                          store_stream_size(j->result_stream)};
-    return 0;
+    if (!j->pack.stream && !j->pack.mem) return NULL;
+    js_source s = value_source(&j->pack);
+    gp_export_source src = {s.read, s.user, s.size};
+    gp_svg_items *it = gp_svg_items_pack(&src, part);
+    if (!it)
+        gpd_log(GPD_LOG_WARN, "job %s: its export pack has no %s; reading the result", j->id,
+                SVG_PART_NAME[part]);
+    return it;
 }
 
 /* gp_svg_input.open: grains and spheres from the pack when there is one, else (and cells
@@ -72,49 +84,33 @@ static gp_svg_items *job_items(void *user, gp_svg_part part, int *failed)
     svg_job *j = user;
     *failed = 0;
     if (part != GP_SVG_CELLS) {
-        if (!j->pack_tried) {
-            j->pack_tried = 1;
-            char st[16];
-            if (store_stream_open(j->id, "pack", SVG_JOB_SMALL, &j->pack_stream, &j->pack_mem,
-                                  &j->pack_len, st) != STORE_OK) {
-                *failed = 1;
-                return NULL;
-            }
-        }
-        if (j->pack_stream || j->pack_mem) {
-            gp_export_source src =
-                j->pack_mem ? gp_export_memory_source(j->pack_mem, j->pack_len)
-                            : (gp_export_source){stream_read, j->pack_stream,
-                                                 store_stream_size(j->pack_stream)};
-            gp_svg_items *it = gp_svg_items_pack(&src, part);
-            if (it) return it;
-            gpd_log(GPD_LOG_WARN, "job %s: its export pack has no %s; reading the result", j->id,
-                    PART[part]);
-        }
+        gp_svg_items *it = pack_items(j, part, failed);
+        if (it || *failed) return it;
     }
     int k = skip_index(part);
     if (k < 0 || j->spans[k][1] <= j->spans[k][0]) return NULL; /* the result has none */
-    if (open_result(j)) {
+    value_open(j, "result", 1, &j->result);
+    if (j->result.failed) {
         *failed = 1;
         return NULL;
     }
-    if (j->spans[k][1] > j->rsrc.size) {
-        gpd_log(GPD_LOG_ERROR, "job %s: the %s are not where the summary says", j->id, PART[part]);
+    js_source src = value_source(&j->result);
+    if (j->spans[k][1] > src.size) {
+        gpd_log(GPD_LOG_ERROR, "job %s: the %s are not where the summary says", j->id,
+                SVG_PART_NAME[part]);
         *failed = 1;
         return NULL;
     }
-    gp_svg_items *it = gp_svg_items_scan(&j->rsrc, j->spans[k][0], part);
+    gp_svg_items *it = gp_svg_items_scan(&src, j->spans[k][0], part);
     if (!it) *failed = 1;
     return it;
 }
 
 svg_job_rc svg_job_open(const char *id, const char *kind, const char *view,
-                        const gp_svg_options *opt, svg_job **out, char status[16], int *http,
-                        char *err, size_t errlen)
+                        const gp_svg_options *opt, svg_job **out, char status[16], gpd_err *err)
 {
     *out = NULL;
-    *http = 500;
-    if (errlen) err[0] = 0;
+    gpd_err_set(err, 500, "%s", "");
     char *text = NULL;
     size_t len = 0;
     uint64_t spans[STORE_SUMMARY_NSKIP][2];
@@ -128,7 +124,7 @@ svg_job_rc svg_job_open(const char *id, const char *kind, const char *view,
     svg_job *j = calloc(1, sizeof *j);
     if (!j) {
         free(text);
-        snprintf(err, errlen, "out of memory");
+        gpd_err_set(err, 500, "out of memory");
         return SVG_JOB_VIEW_ERROR;
     }
     snprintf(j->id, sizeof j->id, "%s", id);
@@ -138,11 +134,11 @@ svg_job_rc svg_job_open(const char *id, const char *kind, const char *view,
     free(text);
     if (!j->summary) {
         svg_job_close(j);
-        snprintf(err, errlen, "the stored result summary is not valid JSON");
+        gpd_err_set(err, 500, "the stored result summary is not valid JSON");
         return SVG_JOB_VIEW_ERROR;
     }
     gp_svg_input in = {kind, j->summary, job_items, j};
-    j->svg = gp_svg_open(&in, view, opt, http, err, errlen);
+    j->svg = gp_svg_open(&in, view, opt, err);
     if (!j->svg) {
         svg_job_close(j);
         return SVG_JOB_VIEW_ERROR;
@@ -158,15 +154,19 @@ int svg_job_read(svg_job *j, char *buf, size_t cap, size_t *n)
     return -1;
 }
 
+static void value_close(job_value *v)
+{
+    store_stream_close(v->stream);
+    free(v->mem);
+}
+
 void svg_job_close(svg_job *j)
 {
     if (!j) return;
     gp_svg_close(j->svg);
     json_decref(j->summary);
-    store_stream_close(j->pack_stream);
-    free(j->pack_mem);
-    store_stream_close(j->result_stream);
-    free(j->result_mem);
+    value_close(&j->pack);
+    value_close(&j->result);
     free(j);
 #ifdef __GLIBC__
     /* what this picture freed (the summary's tree, the items, the private connections' page

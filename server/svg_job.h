@@ -25,14 +25,13 @@ typedef enum {
     SVG_JOB_NOT_FOUND,   /* unknown job */
     SVG_JOB_NOT_READY,   /* the job has not succeeded (its status in status) */
     SVG_JOB_STORE_ERROR, /* the database failed */
-    SVG_JOB_VIEW_ERROR   /* the view cannot be drawn: *http (400, 409, 500) and the message */
+    SVG_JOB_VIEW_ERROR   /* the view cannot be drawn: err (400, 409, 500 and the message) */
 } svg_job_rc;
 
 /* Opens view of job id, whose kind is known (store_get_text(id, "kind")); opt may be NULL.
- * On SVG_JOB_OK *out is the stream. status gets the job's status; err a one-line message. */
+ * On SVG_JOB_OK *out is the stream. status gets the job's status. */
 svg_job_rc svg_job_open(const char *id, const char *kind, const char *view,
-                        const gp_svg_options *opt, svg_job **out, char status[16], int *http,
-                        char *err, size_t errlen);
+                        const gp_svg_options *opt, svg_job **out, char status[16], gpd_err *err);
 
 /* Copies up to cap bytes of the document into buf; *n = 0 at the end. -1 when reading the job
  * failed mid-way (logged; drop the document). */

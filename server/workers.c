@@ -11,13 +11,8 @@
 
 #include <jansson.h>
 
-#include "gp_export.h"
+#include "kind.h"
 #include "result_json.h"
-#ifdef GPD_HAVE_SCHEMA
-#include "gp_spec.h"
-#endif
-#include "gp_specimen2d.h"
-#include "gp_specimen3d.h"
 
 #define PROGRESS_MIN_INTERVAL_S 0.25 /* <= 4 Hz per job */
 #define STORE_RETRY_PAUSE_S 0.5      /* before the one retry of a failed final write */
@@ -38,7 +33,6 @@ typedef struct slot {
 
 static slot *slots = NULL;
 static int nslots = 0;
-static int started = 0;
 static pthread_mutex_t reg_mu = PTHREAD_MUTEX_INITIALIZER; /* claims, cancels, slot ids */
 static pthread_mutex_t wake_mu = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t wake_cv;
@@ -161,6 +155,7 @@ static void *reaper_main(void *arg)
 typedef struct run_ctx {
     slot *s;
     const char *id;
+    const gpd_kind *kind;
     double t0;
     double last_write;
     char phase[32]; /* the last phase the core reported ("starting" before the first) */
@@ -177,74 +172,47 @@ static char *progress_text(const char *phase, double fraction, double eta, json_
     return t;
 }
 
-/* Throttled progress write; returns non-zero when the job must stop. */
-/* 2D detail: {steps, error}; 3D detail: {steps, porosity, stability}. */
-__attribute__((unused)) static int report(run_ctx *c, const char *phase, double f, long steps,
-                                          double error, int is3d, double porosity,
-                                          double stability)
+/* Writes a progress text (taken); a job that is no longer running was cancelled meanwhile:
+ * its flag goes up. */
+static void write_progress(run_ctx *c, char *text)
 {
-    if (phase && strncmp(c->phase, phase, sizeof c->phase - 1))
-        snprintf(c->phase, sizeof c->phase, "%s", phase);
+    if (text && store_progress(c->id, text) == STORE_CONFLICT)
+        __atomic_store_n(&c->s->cancel, 1, __ATOMIC_RELAXED);
+    free(text);
+}
+
+/* The core's progress callback: a throttled write, with the kind's detail; returns non-zero
+ * when the job must stop. */
+static int on_progress(void *user, const gp_progress *p)
+{
+    run_ctx *c = user;
+    if (p->phase && strncmp(c->phase, p->phase, sizeof c->phase - 1))
+        snprintf(c->phase, sizeof c->phase, "%s", p->phase);
     if (__atomic_load_n(&c->s->cancel, __ATOMIC_RELAXED)) return 1;
     double now = gpd_monotonic_s();
     if (now - c->last_write < PROGRESS_MIN_INTERVAL_S) return 0;
     c->last_write = now;
+    double f = p->fraction;
     if (!(f >= 0)) f = 0;
     if (f > 1) f = 1;
     double elapsed = now - c->t0;
     double eta = (f >= 0.01 && f < 1) ? elapsed * (1 - f) / f : (f >= 1 ? 0 : NAN);
-    json_t *detail = is3d ? json_pack("{s:I, s:o, s:o}", "steps", (json_int_t)steps, "porosity",
-                                      gpd_jreal(porosity), "stability", gpd_jreal(stability))
-                          : json_pack("{s:I, s:o}", "steps", (json_int_t)steps, "error",
-                                      gpd_jreal(error));
-    char *t = progress_text(phase, f, eta, detail);
-    if (t) {
-        if (store_progress(c->id, t) == STORE_CONFLICT) /* no longer running: cancelled */
-            __atomic_store_n(&c->s->cancel, 1, __ATOMIC_RELAXED);
-        free(t);
-    }
+    write_progress(c, progress_text(p->phase, f, eta, c->kind->progress_detail(p)));
     return __atomic_load_n(&c->s->cancel, __ATOMIC_RELAXED);
 }
-
-#ifdef GPD_HAVE_SPECIMEN2D
-static int on_progress2d(void *user, const gp_progress *p)
-{
-    return report(user, p->phase, p->fraction, p->steps, p->error, 0, 0, 0);
-}
-#endif
-#ifdef GPD_HAVE_SPECIMEN3D
-static int on_progress3d(void *user, const gp_progress *p)
-{
-    return report(user, p->phase, p->fraction, p->steps, 0, 1, p->porosity, p->stability);
-}
-#endif
 
 /* Says "result" in the job's progress while a large result is built and written (seconds for
  * 10^5 spheres or 10^4 grains), keeping the 4 Hz bound: waits out what is left of the interval
  * since the last write (at most 0.25 s, next to seconds of work). */
-__attribute__((unused)) static void report_result_phase(run_ctx *c, double fraction)
+static void report_result_phase(run_ctx *c, double fraction)
 {
-    double wait = c->last_write + PROGRESS_MIN_INTERVAL_S - gpd_monotonic_s();
-    if (wait > 0) {
-        struct timespec ts = {0, (long)(wait * 1e9)};
-        nanosleep(&ts, NULL);
-    }
+    gpd_sleep_s(c->last_write + PROGRESS_MIN_INTERVAL_S - gpd_monotonic_s());
     snprintf(c->phase, sizeof c->phase, "result");
     c->last_write = gpd_monotonic_s();
-    char *t = progress_text("result", fraction, NAN, NULL);
-    if (t && store_progress(c->id, t) == STORE_CONFLICT)
-        __atomic_store_n(&c->s->cancel, 1, __ATOMIC_RELAXED);
-    free(t);
+    write_progress(c, progress_text("result", fraction, NAN, NULL));
 }
 
 /* ------------------------------------------------------------------ one job */
-
-static void pause_s(double s)
-{
-    struct timespec ts = {.tv_sec = (time_t)s, .tv_nsec = (long)((s - (double)(time_t)s) * 1e9)};
-    while (nanosleep(&ts, &ts) != 0) {
-    }
-}
 
 /* Final states that could not be written (the database refused every try): kept here and
  * written by the next worker that comes by (each idle second at least, and at shutdown), so
@@ -315,7 +283,7 @@ static void finish_failed(const char *id, const char *code, const char *msg)
 {
     store_rc rc = store_fail(id, code, msg);
     if (rc == STORE_ERROR) {
-        pause_s(STORE_RETRY_PAUSE_S);
+        gpd_sleep_s(STORE_RETRY_PAUSE_S);
         rc = store_fail(id, code, msg);
     }
     if (rc == STORE_OK) {
@@ -340,15 +308,63 @@ static void finish_timeout(run_ctx *ctx, const char *phase)
     finish_failed(ctx->id, "timeout", msg);
 }
 
-static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err, const char *extra);
+/* A build that did not succeed: cancelled (by DELETE or shutdown) or failed; err may be NULL
+ * only with GP_ERR_CANCELLED; extra (may be NULL) is appended to the message. */
+static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err, const char *extra)
+{
+    if (__atomic_load_n(&ctx->s->reason, __ATOMIC_RELAXED) == REASON_TIMEOUT) {
+        finish_timeout(ctx, ctx->phase);
+        return;
+    }
+    if (st == GP_ERR_CANCELLED || __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED)) {
+        if (__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
+            if (store_requeue(ctx->id) == STORE_OK)
+                gpd_log(GPD_LOG_INFO, "job %s requeued (shutdown)", ctx->id);
+        }
+        /* else: a DELETE already marked it cancelled */
+        return;
+    }
+    char msg[GP_ERROR_MESSAGE_MAX + 128];
+    snprintf(msg, sizeof msg, "%s%s",
+             err && err->message[0] ? err->message : gp_status_name(st),
+             extra ? extra : "");
+    finish_failed(ctx->id, gp_status_name(st), msg);
+}
+
+/* The result text, the "done" progress and the pack committed with status succeeded; a write
+ * the database refuses is tried once more, and a result it can never take fails the job. */
+static void store_result(run_ctx *ctx, const char *text, const char *prog, const void *pack,
+                         size_t pack_len)
+{
+    gpd_err why;
+    store_rc rc = store_succeed(ctx->id, text, prog, pack, pack_len, &why);
+    if (rc == STORE_ERROR) { /* maybe passing (busy, I/O): once more after a pause */
+        gpd_log(GPD_LOG_WARN, "job %s: storing the result failed (%s); retrying once", ctx->id,
+                why.msg);
+        gpd_sleep_s(STORE_RETRY_PAUSE_S);
+        rc = store_succeed(ctx->id, text, prog, pack, pack_len, &why);
+    }
+    char msg[600];
+    if (rc == STORE_OK) {
+        gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%zu bytes)", ctx->id,
+                gpd_monotonic_s() - ctx->t0, strlen(text));
+    } else if (rc == STORE_TOOBIG) {
+        snprintf(msg, sizeof msg, "the result cannot be stored: %s", why.msg);
+        finish_failed(ctx->id, "too_large", msg);
+    } else if (rc == STORE_ERROR) {
+        snprintf(msg, sizeof msg, "the result could not be stored (tried twice): %s", why.msg);
+        finish_failed(ctx->id, "store_error", msg);
+    }
+    /* STORE_CONFLICT: cancelled by a DELETE meanwhile */
+}
 
 /* Stores a result (takes r) and the export pack (takes pack, may be NULL) together with status
  * succeeded and the "done" progress (takes detail, NULL = {}). Reals get 17 significant digits:
  * the geometry reads back bit for bit, as in the exports. The writing stops at the cancel flag
  * (a 133 MB result takes ~5 s to write); a result written in full is stored even when a
  * shutdown came meanwhile (a second or so), not after a DELETE (the job is cancelled). */
-__attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r, json_t *detail,
-                                                     void *pack, size_t pack_len)
+static void finish_succeeded(run_ctx *ctx, json_t *r, json_t *detail, void *pack,
+                             size_t pack_len)
 {
     char *text = r ? gpd_dumps_c(r, JSON_COMPACT | JSON_REAL_PRECISION(17), &ctx->s->cancel)
                    : NULL;
@@ -371,26 +387,7 @@ __attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r, js
     } else if (!text || !prog) {
         finish_failed(ctx->id, "internal", "out of memory while serialising the result");
     } else {
-        char why[400];
-        store_rc rc = store_succeed(ctx->id, text, prog, pack, pack_len, why, sizeof why);
-        if (rc == STORE_ERROR) { /* maybe passing (busy, I/O): once more after a pause */
-            gpd_log(GPD_LOG_WARN, "job %s: storing the result failed (%s); retrying once",
-                    ctx->id, why);
-            pause_s(STORE_RETRY_PAUSE_S);
-            rc = store_succeed(ctx->id, text, prog, pack, pack_len, why, sizeof why);
-        }
-        char msg[600];
-        if (rc == STORE_OK) {
-            gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%zu bytes)", ctx->id,
-                    gpd_monotonic_s() - ctx->t0, strlen(text));
-        } else if (rc == STORE_TOOBIG) {
-            snprintf(msg, sizeof msg, "the result cannot be stored: %s", why);
-            finish_failed(ctx->id, "too_large", msg);
-        } else if (rc == STORE_ERROR) {
-            snprintf(msg, sizeof msg, "the result could not be stored (tried twice): %s", why);
-            finish_failed(ctx->id, "store_error", msg);
-        }
-        /* STORE_CONFLICT: cancelled by a DELETE meanwhile */
+        store_result(ctx, text, prog, pack, pack_len);
     }
     json_decref(detail);
     free(text);
@@ -398,53 +395,14 @@ __attribute__((unused)) static void finish_succeeded(run_ctx *ctx, json_t *r, js
     free(pack);
 }
 
-/* A build that did not succeed: cancelled (by DELETE or shutdown) or failed; err may be NULL
- * only with GP_ERR_CANCELLED. */
-__attribute__((unused)) static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err,
-                                                  const char *extra)
-{
-    if (__atomic_load_n(&ctx->s->reason, __ATOMIC_RELAXED) == REASON_TIMEOUT) {
-        finish_timeout(ctx, ctx->phase);
-        return;
-    }
-    if (st == GP_ERR_CANCELLED || __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED)) {
-        if (__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
-            if (store_requeue(ctx->id) == STORE_OK)
-                gpd_log(GPD_LOG_INFO, "job %s requeued (shutdown)", ctx->id);
-        }
-        /* else: a DELETE already marked it cancelled */
-        return;
-    }
-    char msg[GP_ERROR_MESSAGE_MAX + 128];
-    snprintf(msg, sizeof msg, "%s%s",
-             err && err->message[0] ? err->message : gp_status_name(st),
-             extra ? extra : "");
-    finish_failed(ctx->id, gp_status_name(st), msg);
-}
-
 /* The result tree could not be built: cancelled meanwhile, or out of memory. */
-__attribute__((unused)) static void result_not_built(run_ctx *ctx)
+static void result_not_built(run_ctx *ctx)
 {
     if (__atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED))
         finish_not_ok(ctx, GP_ERR_CANCELLED, NULL, NULL);
     else
         finish_failed(ctx->id, "internal", "out of memory while building the result");
 }
-
-#ifdef GPD_HAVE_SPECIMEN2D
-/* The "done" detail of a 2D job: how the IMC ended, the warnings and the fit summary (stats.fit
- * without its CDF curves), so that a poller of GET /v1/jobs/{id} sees them without the result. */
-__attribute__((unused)) static json_t *done_detail_2d(const char *id, const gp_specimen2d *s)
-{
-    json_t *w = gpd_warnings_2d(s);
-    for (size_t i = 0; i < json_array_size(w); i++)
-        gpd_log(GPD_LOG_WARN, "job %s: %s", id, json_string_value(json_array_get(w, i)));
-    return json_pack("{s:I, s:o, s:s, s:o, s:o}", "steps", (json_int_t)s->imc_steps, "error",
-                     gpd_jreal(s->imc_error), "stop_reason",
-                     s->imc_stop_reason ? s->imc_stop_reason : "", "warnings", w ? w : json_array(),
-                     "fit", gpd_fit_2d(&s->fit, 0));
-}
-#endif
 
 static void unavailable(const char *id, const char *kind)
 {
@@ -453,112 +411,62 @@ static void unavailable(const char *id, const char *kind)
     finish_failed(id, "not_implemented", msg);
 }
 
-static void run_2d(slot *s, const char *id, json_t *spec_json)
+/* A built specimen (taken) becomes the result, the export pack and the final "done" detail of
+ * the job, stored together; a result that could not be built is dropped (cancelled, or out of
+ * memory). */
+static void finish_built(run_ctx *ctx, const void *spec, const json_t *spec_json, void *out)
 {
-#if defined(GPD_HAVE_SCHEMA) && defined(GPD_HAVE_SPECIMEN2D)
-    gp_spec2d spec;
-    gp_spec_problem prob;
-    memset(&prob, 0, sizeof prob);
-    if (gp_spec2d_read(spec_json, &spec, &prob) != 0) {
-        gp_spec2d_free(&spec);
-        finish_failed(id, "invalid_spec", prob.message);
+    const gpd_kind *k = ctx->kind;
+    if (k->large_result(out)) report_result_phase(ctx, 1.0);
+    json_t *r = k->result(out, spec, spec_json, &ctx->s->cancel);
+    if (!r || __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED)) { /* (r: partial) */
+        reap_later(r);
+        k->destroy(out);
+        result_not_built(ctx);
         return;
     }
-    spec.threads = 1;
-    run_ctx ctx = {.s = s, .id = id, .t0 = gpd_monotonic_s(), .last_write = 0,
-                   .phase = "starting"};
-    gp_specimen2d *out = NULL;
-    gp_error err;
-    gp_error_clear(&err);
-    gp_status st = gp_specimen2d_build(&spec, on_progress2d, &ctx, &s->cancel, &out, &err);
-    if (st == GP_OK && out) {
-        size_t np = out->ncells * 12; /* the result's size in points, roughly: ~0.5 s a million */
-        for (size_t i = 0; i < out->ngrains; i++)
-            np += out->grains[i].ncontour + out->grains[i].ndiscs;
-        if (np > 1000000) report_result_phase(&ctx, 1.0);
-        json_t *r = gpd_result_2d_c(out, &spec, spec_json, &s->cancel);
-        if (!r || __atomic_load_n(&s->cancel, __ATOMIC_RELAXED)) { /* (r: partial) */
-            reap_later(r);
-            gp_specimen2d_destroy(out);
-            gp_spec2d_free(&spec);
-            result_not_built(&ctx);
-            return;
-        }
-        /* exports need the ODEC discs; without them there is no pack and GET .../export
-         * answers 409 naming the output to ask for */
-        void *pack = NULL;
-        size_t pack_len = 0;
-        if (spec.outputs & GP_OUT2_ODEC) {
-            gp_error perr;
-            if (gp_export_pack_2d(out, &spec, GP_EXPORT_DEFAULT_DENSITY, &pack, &pack_len, &perr))
-                gpd_log(GPD_LOG_WARN, "job %s: no export pack: %s", id, perr.message);
-        }
-        json_t *detail = done_detail_2d(id, out);
-        gp_specimen2d_destroy(out);
-        finish_succeeded(&ctx, r, detail, pack, pack_len);
-    } else {
-        if (out) gp_specimen2d_destroy(out);
-        finish_not_ok(&ctx, st, &err, NULL);
-    }
-    gp_spec2d_free(&spec);
-#else
-    (void)s;
-    (void)spec_json;
-    unavailable(id, "fourier-voronoi-2d");
-#endif
+    void *pack = NULL;
+    size_t pack_len = 0;
+    gp_error perr;
+    if (k->pack(out, spec, &pack, &pack_len, &perr) < 0)
+        gpd_log(GPD_LOG_WARN, "job %s: no export pack: %s", ctx->id, perr.message);
+    json_t *detail = k->done_detail ? k->done_detail(ctx->id, out) : NULL;
+    k->destroy(out);
+    finish_succeeded(ctx, r, detail, pack, pack_len);
 }
 
-static void run_3d(slot *s, const char *id, json_t *spec_json)
+/* Runs a job of kind k: its spec parsed for the core, the specimen built on this thread. */
+static void run_kind(slot *s, const char *id, const gpd_kind *k, const json_t *spec_json)
 {
-#if defined(GPD_HAVE_SCHEMA) && defined(GPD_HAVE_SPECIMEN3D)
-    gp_spec3d spec;
     gp_spec_problem prob;
     memset(&prob, 0, sizeof prob);
-    if (gp_spec3d_read(spec_json, &spec, &prob) != 0) {
-        gp_spec3d_free(&spec);
+    void *spec = calloc(1, k->spec_size);
+    if (!spec) {
+        finish_failed(id, "internal", "out of memory while reading the spec");
+        return;
+    }
+    if (k->read_spec(spec_json, spec, &prob)) {
+        k->free_spec(spec);
+        free(spec);
         finish_failed(id, "invalid_spec", prob.message);
         return;
     }
-    spec.threads = 1;
-    run_ctx ctx = {.s = s, .id = id, .t0 = gpd_monotonic_s(), .last_write = 0,
+    run_ctx ctx = {.s = s, .id = id, .kind = k, .t0 = gpd_monotonic_s(), .last_write = 0,
                    .phase = "starting"};
-    gp_specimen3d *out = NULL;
     gp_error err;
     gp_error_clear(&err);
-    gp_status st = gp_specimen3d_build(&spec, on_progress3d, &ctx, &s->cancel, &out, &err);
+    gp_status st = GP_ERR_INTERNAL;
+    void *out = k->build(spec, on_progress, &ctx, &s->cancel, &st, &err);
     if (st == GP_OK && out) {
-        if ((out->spheres && out->count > 50000) || out->ncontacts > 100000)
-            report_result_phase(&ctx, 1.0); /* ~0.5 s and more */
-        json_t *r = gpd_result_3d_c(out, &spec, spec_json, &s->cancel);
-        if (!r || __atomic_load_n(&s->cancel, __ATOMIC_RELAXED)) { /* (r: partial) */
-            reap_later(r);
-            gp_specimen3d_destroy(out);
-            gp_spec3d_free(&spec);
-            result_not_built(&ctx);
-            return;
-        }
-        void *pack = NULL;
-        size_t pack_len = 0;
-        if (out->spheres) {
-            gp_error perr;
-            if (gp_export_pack_3d(out, spec.material.density, &pack, &pack_len, &perr))
-                gpd_log(GPD_LOG_WARN, "job %s: no export pack: %s", id, perr.message);
-        }
-        gp_specimen3d_destroy(out);
-        finish_succeeded(&ctx, r, NULL, pack, pack_len);
+        finish_built(&ctx, spec, spec_json, out);
     } else {
-        char extra[96] = "";
-        if (out && out->stats.stop_reason)
-            snprintf(extra, sizeof extra, " (stop reason: %s)", out->stats.stop_reason);
-        if (out) gp_specimen3d_destroy(out);
-        finish_not_ok(&ctx, st, &err, extra);
+        char note[96] = "";
+        if (out && k->failure_note) k->failure_note(out, note, sizeof note);
+        if (out) k->destroy(out);
+        finish_not_ok(&ctx, st, &err, note);
     }
-    gp_spec3d_free(&spec);
-#else
-    (void)s;
-    (void)spec_json;
-    unavailable(id, "spheres-3d");
-#endif
+    k->free_spec(spec);
+    free(spec);
 }
 
 static void run_job(slot *s, const char *id, const char *kind, const char *spec_text)
@@ -569,10 +477,9 @@ static void run_job(slot *s, const char *id, const char *kind, const char *spec_
         finish_failed(id, "internal", "stored spec is not valid JSON");
         return;
     }
-    if (!strcmp(kind, "fourier-voronoi-2d"))
-        run_2d(s, id, spec);
-    else if (!strcmp(kind, "spheres-3d"))
-        run_3d(s, id, spec);
+    const gpd_kind *k = gpd_kind_find(kind);
+    if (k)
+        run_kind(s, id, k, spec);
     else
         unavailable(id, kind);
     json_decref(spec);
@@ -723,7 +630,6 @@ int workers_start(int n)
             return -1;
         }
     }
-    started = 1;
     return 0;
 }
 
@@ -756,5 +662,4 @@ void workers_stop(void)
     nslots = 0;
     pthread_cond_destroy(&wake_cv);
     pthread_cond_destroy(&wd_cv);
-    started = 0;
 }

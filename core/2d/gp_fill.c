@@ -245,6 +245,22 @@ static int cast_rays(gp_fill_workspace *ws, gp_vec2 c)
 
 /* ------------------------------------------------------------------ the grain's shape */
 
+/* Adds mode n of amplitude d and phase delta to rho_i = r(theta_i) / r0 on the Np rays:
+ * d cos(n theta_i - delta) = d cos(delta) cos(n theta_i) + d sin(delta) sin(n theta_i). This and
+ * the tables it reads are the filling's own evaluation of the Fourier radius r(theta) of
+ * gp_fourier.h, on purpose: the search evaluates the shape thousands of times per cell with
+ * only modes 2-7 changing, so the fixed modes are summed once per cell (fixed_part) and each
+ * evaluation costs six table sweeps. (gp_shape_curve_points evaluates the same r(theta) at any
+ * np, gp_fourier_radii by inverse FFT on a plan's samples.) */
+static void add_mode(const gp_fill_workspace *ws, double *rho, size_t n, double d, double delta)
+{
+    size_t np = ws->np;
+    double ca = d * cos(delta), sa = d * sin(delta);
+    const double *cn = ws->cosn + n * np, *sn = ws->sinn + n * np;
+    for (size_t i = 0; i < np; i++)
+        rho[i] += ca * cn[i] + sa * sn[i];
+}
+
 /* rho_i for the optimised phases ph[0..5] = delta_2..delta_7 (grain frame); returns min rho
  * and keeps min and max. Mode by mode over all the rays (these loops vectorise), and min /
  * max over four independent lanes rather than one serial chain. */
@@ -255,11 +271,7 @@ static double shape_factor(gp_fill_workspace *ws, const double *ph)
     memcpy(rho, ws->base, np * sizeof *rho);
     for (int j = 0; j < NOPT; j++) {
         size_t n = FIRST_OPT + (size_t)j;
-        double d = n < ws->nm ? ws->p.D[n] : 0.0;
-        double ca = d * cos(ph[j]), sa = d * sin(ph[j]);
-        const double *cn = ws->cosn + n * np, *sn = ws->sinn + n * np;
-        for (size_t i = 0; i < np; i++)
-            rho[i] += ca * cn[i] + sa * sn[i];
+        add_mode(ws, rho, n, n < ws->nm ? ws->p.D[n] : 0.0, ph[j]);
     }
     double mn[4], mx[4];
     for (int l = 0; l < 4; l++)
@@ -781,9 +793,7 @@ static uint64_t fixed_part(gp_fill_workspace *ws, const double *phases)
         rs = splitmix64(&s);
         if ((n >= FIRST_OPT && n <= LAST_OPT) || ws->p.D[n] == 0.0)
             continue;
-        double ca = ws->p.D[n] * cos(phases[n]), sa = ws->p.D[n] * sin(phases[n]);
-        for (size_t i = 0; i < np; i++)
-            ws->base[i] += ca * ws->cosn[n * np + i] + sa * ws->sinn[n * np + i];
+        add_mode(ws, ws->base, n, ws->p.D[n], phases[n]);
     }
     return rs;
 }

@@ -213,6 +213,20 @@ static void fill_half_spectrum(fftw_complex *c, size_t nc, double r0, const doub
     }
 }
 
+/* The smallest of a[0 .. n) (n >= 1) and, in *at, the first index where it is. */
+static double min_at(const double *a, size_t n, size_t *at)
+{
+    double m = a[0];
+    *at = 0;
+    for (size_t i = 1; i < n; i++) {
+        if (a[i] < m) {
+            m = a[i];
+            *at = i;
+        }
+    }
+    return m;
+}
+
 /* Star check (see header). Runs c2r into f->r; returns GP_OK if r > 0 on the continuous curve. */
 static gp_status synthesise(gp_fourier *f, double r0, const double *D, const double *delta,
                             size_t nmodes, gp_error *err)
@@ -221,14 +235,8 @@ static gp_status synthesise(gp_fourier *f, double r0, const double *D, const dou
     fill_half_spectrum(f->c, nc, r0, D, delta, nmodes);
     fftw_execute(f->c2r);
 
-    double rmin = f->r[0];
-    size_t imin = 0;
-    for (size_t i = 1; i < f->np; i++) {
-        if (f->r[i] < rmin) {
-            rmin = f->r[i];
-            imin = i;
-        }
-    }
+    size_t imin;
+    double rmin = min_at(f->r, f->np, &imin);
     if (!(rmin > 0))
         return gp_error_set(err, GP_ERR_NOT_STAR,
                             "fourier: spectrum is not star-shaped with these phases: r = %.3g r0 "
@@ -245,14 +253,8 @@ static gp_status synthesise(gp_fourier *f, double r0, const double *D, const dou
     size_t ncf = f->npf / 2 + 1;
     fill_half_spectrum(f->cf, ncf, r0, D, delta, nmodes);
     fftw_execute(f->c2r_fine);
-    double fmin = f->rf[0];
-    size_t jmin = 0;
-    for (size_t j = 1; j < f->npf; j++) {
-        if (f->rf[j] < fmin) {
-            fmin = f->rf[j];
-            jmin = j;
-        }
-    }
+    size_t jmin;
+    double fmin = min_at(f->rf, f->npf, &jmin);
     double h = 2.0 * GP_PI / (double)f->npf;
     /* the true minimum is within h/2 of a fine sample, where r' = 0: Taylor bound */
     double bound = fmin - 0.5 * r0 * sum2 * (0.5 * h) * (0.5 * h) - 1e-12 * r0 * (1.0 + sum);

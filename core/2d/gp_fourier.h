@@ -24,6 +24,11 @@
  * bound is not positive the call fails with GP_ERR_NOT_STAR (conservative: a contour that
  * comes within about 1e-3 r0 of its centre is refused too).
  *
+ * Where r(theta) is evaluated: here, by inverse FFT on a plan's Np samples; gp_shape_curve_points
+ * (gp_shape.h), by direct summation at any number of angles (the regularity's perimeters);
+ * gp_fill, from its own cos / sin tables, because its search re-evaluates the shape thousands
+ * of times per cell with only modes 2-7 changing.
+ *
  * Threads: a gp_fourier plan object holds FFTW plans and buffers for one Np; use one object
  * per thread (the calls that take a non-const gp_fourier* write its buffers). Creating and
  * destroying objects is safe from several threads at once (the FFTW planner is made thread

@@ -269,12 +269,20 @@ double gp_poly_boundary_distance(const gp_vec2 *p, size_t n, gp_vec2 q)
 /* ------------------------------------------------------------------------------------------ */
 /* point in polygon                                                                            */
 
-/* Exact even-odd classification: 1 inside, 0 on the boundary, -1 outside. */
-static int point_class(const gp_vec2 *p, size_t n, gp_vec2 q)
+/* The one point-in-polygon test of core/2d (even-odd rule): 1 inside, 0 on the boundary, -1
+ * outside. Crossings are decided by the exact orientation predicate. With tol >= 0 a point
+ * within tol of an edge is on the boundary too (gp_poly_contains); with tol < 0 only a point
+ * exactly on it (the exact predicates of gp_poly_inside_poly and gp_poly_overlap). */
+static int point_class(const gp_vec2 *p, size_t n, gp_vec2 q, double tol)
 {
+    const double tol2 = tol * tol;
     int c = 0;
     for (size_t i = 0, j = n - 1; i < n; j = i++) {
         gp_vec2 a = p[j], b = p[i];
+        if (tol >= 0.0 && q.x >= dmin(a.x, b.x) - tol && q.x <= dmax(a.x, b.x) + tol &&
+            q.y >= dmin(a.y, b.y) - tol && q.y <= dmax(a.y, b.y) + tol &&
+            seg_dist2(q.x, q.y, a.x, a.y, b.x, b.y) <= tol2)
+            return 0;
         if ((a.y > q.y) != (b.y > q.y)) {
             int o = orient(a, b, q);
             if (o == 0) return 0;
@@ -297,22 +305,9 @@ int gp_poly_contains(const gp_vec2 *p, size_t n, gp_vec2 q)
     if (!isfinite(size)) return 0;
     double tol = 1e-12 * size;
     if (q.x < x0 - tol || q.x > x1 + tol || q.y < y0 - tol || q.y > y1 + tol) return 0;
-    double tol2 = tol * tol;
-    int c = 0;
-    for (size_t i = 0, j = n - 1; i < n; j = i++) {
-        gp_vec2 a = p[j], b = p[i];
-        /* on (or within tol of) this edge: inside */
-        if (q.x >= dmin(a.x, b.x) - tol && q.x <= dmax(a.x, b.x) + tol &&
-            q.y >= dmin(a.y, b.y) - tol && q.y <= dmax(a.y, b.y) + tol &&
-            seg_dist2(q.x, q.y, a.x, a.y, b.x, b.y) <= tol2)
-            return 1;
-        if ((a.y > q.y) != (b.y > q.y)) {
-            int o = orient(a, b, q);
-            if (o == 0) return 1;
-            if ((o > 0) == (b.y > a.y)) c ^= 1;
-        }
-    }
-    return c;
+    /* a point exactly on a horizontal edge or on a vertex is within tol of that edge, so
+     * point_class's exact boundary cases add nothing here */
+    return point_class(p, n, q, tol) >= 0;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -956,6 +951,50 @@ gp_status gp_max_inscribed_circle(const gp_vec2 *p, size_t n, double tol, gp_vec
 /* ------------------------------------------------------------------------------------------ */
 /* minimum caliper width                                                                       */
 
+double gp_axis_angle(double ex, double ey)
+{
+    double ang = atan2(ey, ex);
+    if (ang <= -GP_PI / 2) ang += GP_PI;
+    else if (ang > GP_PI / 2) ang -= GP_PI;
+    if (ang <= -GP_PI / 2) ang = GP_PI / 2; /* guard rounding at the boundary */
+    return ang;
+}
+
+/* Rotating calipers: for edge k, the antipodal vertex j maximises h = cross(e_k, h[j] - h[k]);
+ * as k turns counter-clockwise so does j, so one walk serves every edge (O(m)). */
+size_t gp_min_caliper_edge(const gp_vec2 *h, size_t m, double eps2, int squared)
+{
+    if (!h || m < 2) return m;
+    size_t s = 0;
+    for (size_t k = 1; k < m; k++)
+        if (h[k].y < h[s].y || (h[k].y == h[s].y && h[k].x < h[s].x)) s = k;
+    size_t best_k = m, j = m; /* j == m: not placed yet (the first edge kept places it) */
+    double best = INFINITY;
+    for (size_t c = 0; c < m; c++) {
+        size_t k = s + c;
+        if (k >= m) k -= m;
+        size_t k1 = k + 1 == m ? 0 : k + 1;
+        double ex = h[k1].x - h[k].x, ey = h[k1].y - h[k].y;
+        double l2 = ex * ex + ey * ey;
+        if (l2 <= eps2) continue;
+        if (j == m) j = k1;
+        double cur = ex * (h[j].y - h[k].y) - ey * (h[j].x - h[k].x);
+        for (size_t step = 0; step < m; step++) {
+            size_t j1 = j + 1 == m ? 0 : j + 1;
+            double nxt = ex * (h[j1].y - h[k].y) - ey * (h[j1].x - h[k].x);
+            if (nxt < cur) break;
+            cur = nxt;
+            j = j1;
+        }
+        double w = squared ? cur * cur / l2 : cur / hypot(ex, ey);
+        if (w < best) {
+            best = w;
+            best_k = k;
+        }
+    }
+    return best_k;
+}
+
 gp_status gp_min_caliper(const gp_vec2 *p, size_t n, double *width, double *angle_rad,
                          double *length, gp_error *err)
 {
@@ -973,27 +1012,8 @@ gp_status gp_min_caliper(const gp_vec2 *p, size_t n, double *width, double *angl
         h[i].x -= o.x;
         h[i].y -= o.y;
     }
-    /* rotating calipers: for edge i, the antipodal vertex j maximises cross(e_i, h[j] - h[i]) */
-    size_t j = 1, best_i = 0;
-    double best_w = INFINITY;
-    for (size_t i = 0; i < m; i++) {
-        size_t i1 = i + 1 == m ? 0 : i + 1;
-        double ex = h[i1].x - h[i].x, ey = h[i1].y - h[i].y;
-        double len = hypot(ex, ey);
-        double cur = ex * (h[j].y - h[i].y) - ey * (h[j].x - h[i].x);
-        for (size_t step = 0; step < m; step++) {
-            size_t j1 = j + 1 == m ? 0 : j + 1;
-            double nxt = ex * (h[j1].y - h[i].y) - ey * (h[j1].x - h[i].x);
-            if (nxt < cur) break;
-            cur = nxt;
-            j = j1;
-        }
-        double wd = cur / len;
-        if (wd < best_w) {
-            best_w = wd;
-            best_i = i;
-        }
-    }
+    size_t best_i = gp_min_caliper_edge(h, m, -1.0, 0);
+    if (best_i == m) best_i = 0; /* only for NaN widths: keep the first edge */
     /* re-measure the chosen edge in full, independently of the caliper bookkeeping */
     size_t i1 = best_i + 1 == m ? 0 : best_i + 1;
     double ex = h[i1].x - h[best_i].x, ey = h[i1].y - h[best_i].y;
@@ -1007,10 +1027,7 @@ gp_status gp_min_caliper(const gp_vec2 *p, size_t n, double *width, double *angl
         if (dt > lmax) lmax = dt;
     }
     free(h);
-    double ang = atan2(ey, ex);
-    if (ang <= -GP_PI / 2) ang += GP_PI;
-    else if (ang > GP_PI / 2) ang -= GP_PI;
-    if (ang <= -GP_PI / 2) ang = GP_PI / 2; /* guard rounding at the boundary */
+    double ang = gp_axis_angle(ex, ey);
     if (width) *width = wmax;
     if (angle_rad) *angle_rad = ang;
     if (length) *length = lmax - lmin;
@@ -1120,7 +1137,7 @@ static int boundary_flags(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t 
 {
     int f = 0;
     for (size_t i = 0; i < na; i++) {
-        int c = point_class(b, nb, a[i]);
+        int c = point_class(b, nb, a[i], -1.0);
         f |= c > 0 ? BF_IN : (c < 0 ? BF_OUT : 0);
         if (f & stop) return f;
     }
@@ -1140,7 +1157,7 @@ static int boundary_flags(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t 
             seg_events(u, v, b, nb, t0, tm, &tch, &dummy, &cov);
             if (!cov) {
                 gp_vec2 q = {u.x + tm * (v.x - u.x), u.y + tm * (v.y - u.y)};
-                int c = point_class(b, nb, q);
+                int c = point_class(b, nb, q, -1.0);
                 f |= c > 0 ? BF_IN : (c < 0 ? BF_OUT : 0);
                 if (f & stop) return f;
             }

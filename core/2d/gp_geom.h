@@ -1,4 +1,5 @@
-/* gp_geom.h -- planar polygon geometry on double coordinates.
+/* gp_geom.h -- planar polygon geometry on double coordinates: the one point-in-polygon test,
+ * bounding box and minimum caliper (Mollon & Zhao 2012 Fig. 1a) that the rest of core/2d uses.
  *
  * Polygons are arrays of vertices, implicitly closed (the last vertex joins the first), in
  * either orientation unless a function says otherwise. Functions tolerate duplicate
@@ -26,7 +27,8 @@ double gp_poly_perimeter(const gp_vec2 *p, size_t n);
 gp_status gp_poly_centroid(const gp_vec2 *p, size_t n, gp_vec2 *c, gp_error *err);
 
 /* Point in polygon (even-odd rule): 1 strictly inside, 0 outside; a point on an edge (within
- * a relative tolerance of ~1e-12 of the polygon's size) counts as inside (returns 1). */
+ * a relative tolerance of ~1e-12 of the polygon's size) counts as inside (returns 1). The one
+ * point-in-polygon test of core/2d (gp_voronoi's cell parts and holes use it too). */
 int gp_poly_contains(const gp_vec2 *p, size_t n, gp_vec2 q);
 
 /* Convex hull by Andrew's monotone chain: writes h (capacity >= n) counter-clockwise, starting
@@ -91,5 +93,19 @@ int gp_orient2d(gp_vec2 a, gp_vec2 b, gp_vec2 c);
 /* 1 if the closed segments [a, b] and [c, d] share at least one point (exact); 0 otherwise or
  * for non-finite input. */
 int gp_segments_intersect(gp_vec2 a, gp_vec2 b, gp_vec2 c, gp_vec2 d);
+
+/* The rotating-calipers pass of gp_min_caliper, for a polygon that is already convex and
+ * counter-clockwise (a hull; the convex Voronoi cells): the index k of the edge h[k] -> h[k+1]
+ * across which the polygon is thinnest, the edges visited from the lowest-then-leftmost vertex
+ * on, the first thinnest winning; edges with squared length <= eps2 are skipped (the collinear
+ * runs of a polygon clipped in floating point; eps2 < 0 skips none). m when every edge was
+ * skipped (or m < 2). The width across edge k is h_k / |e_k| (squared = 0, gp_min_caliper) or
+ * compared as h_k^2 / |e_k|^2 (squared = 1, gp_voronoi's cell orientation): the two rank edges
+ * alike up to rounding, and each caller's results are pinned to its own. O(m), no allocation. */
+size_t gp_min_caliper_edge(const gp_vec2 *h, size_t m, double eps2, int squared);
+
+/* The axis angle of the direction (ex, ey): atan2 folded into (-pi/2, pi/2] (Fig. 1a's theta;
+ * the angle_rad of gp_min_caliper). */
+double gp_axis_angle(double ex, double ey);
 
 #endif /* GP_GEOM_H */

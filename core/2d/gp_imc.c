@@ -11,9 +11,10 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "gp_adstat.h"
+#include "gp_alloc.h"
+#include "gp_clock.h"
 #include "gp_rng.h"
 
 #define GP_IMC_PI 3.14159265358979323846
@@ -406,13 +407,9 @@ static gp_status state_init(imc_state *S, const gp_imc_params *p, const gp_law *
     if (ok && S->kind == GP_IMC_ERROR_AD) {
         S->ads = gp_adstat_create(n, err);
         S->adt = gp_adstat_create(n, err);
-        S->sk = malloc(n * sizeof(double));
-        S->sg = malloc(n * sizeof(double));
-        S->sh = malloc(n * sizeof(double));
-        S->tk = malloc(n * sizeof(double));
-        S->tg = malloc(n * sizeof(double));
-        S->th = malloc(n * sizeof(double));
-        ok = S->ads && S->adt && S->sk && S->sg && S->sh && S->tk && S->tg && S->th;
+        double **const scratch[] = {&S->sk, &S->sg, &S->sh, &S->tk, &S->tg, &S->th};
+        int scratch_ok = gp_alloc_doubles(n, scratch, 6, NULL) == GP_OK;
+        ok = S->ads && S->adt && scratch_ok;
         S->ad_floor = gp_adstat_floor(n);
         S->mu = gp_law_mean(law);
         S->cov_q = quantile_cov(law, n, S->mu);
@@ -441,21 +438,30 @@ static gp_status state_init(imc_state *S, const gp_imc_params *p, const gp_law *
 /* ------------------------------------------------------------------------------------------ */
 /* seeds                                                                                       */
 
+/* The outer ring's bounding box {x0, y0, x1, y1}, passing over NaN coordinates (fmin / fmax:
+ * place_seeds' area checks then refuse such a container; gp_poly_bbox would stop at them). */
+static void outer_box(const gp_vec2 *outer, size_t nouter, double box[4])
+{
+    box[0] = box[1] = INFINITY;
+    box[2] = box[3] = -INFINITY;
+    for (size_t k = 0; k < nouter; k++) {
+        box[0] = fmin(box[0], outer[k].x);
+        box[1] = fmin(box[1], outer[k].y);
+        box[2] = fmax(box[2], outer[k].x);
+        box[3] = fmax(box[3], outer[k].y);
+    }
+}
+
 static gp_status place_seeds(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *holes,
                              const size_t *nhole, size_t nholes, size_t n, const gp_imc_params *p,
-                             gp_rng *rng, const volatile int *cancel, gp_vec2 *seeds, gp_error *err)
+                             const double *box, gp_rng *rng, const volatile int *cancel,
+                             gp_vec2 *seeds, gp_error *err)
 {
     if (p->seeds) {
         memcpy(seeds, p->seeds, n * sizeof *seeds);
         return GP_OK;
     }
-    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-    for (size_t k = 0; k < nouter; k++) {
-        x0 = fmin(x0, outer[k].x);
-        x1 = fmax(x1, outer[k].x);
-        y0 = fmin(y0, outer[k].y);
-        y1 = fmax(y1, outer[k].y);
-    }
+    const double x0 = box[0], y0 = box[1], x1 = box[2], y1 = box[3];
     if (!(x1 > x0 && y1 > y0) || !isfinite(x1 - x0) || !isfinite(y1 - y0))
         return gp_error_set(err, GP_ERR_INVALID, "imc: container has no area");
     double aout = gp_poly_area(outer, nouter), ahole = 0.0;
@@ -681,7 +687,23 @@ static int cancel_raised(const volatile int *cancel)
 typedef struct run_out {
     long steps, accepted;
     gp_imc_stop why;
+    double error0;             /* the error at the first progress report; < 0 before */
 } run_out;
+
+/* One progress report (gp_progress.h): phase "imc", the steps and error, and as the fraction
+ * how far log(error) has come from its value at the first report towards log(threshold). */
+static int report(gp_progress_fn progress, void *user, const gp_imc_params *p, run_out *ro,
+                  double error)
+{
+    if (ro->error0 < 0.0) ro->error0 = error;
+    double frac = 0.0;
+    if (error <= p->threshold)
+        frac = 1.0;
+    else if (ro->error0 > p->threshold && error > 0.0)
+        frac = fmin(1.0, fmax(0.0, log(ro->error0 / error) / log(ro->error0 / p->threshold)));
+    gp_progress r = {.phase = "imc", .fraction = frac, .steps = ro->steps, .error = error};
+    return progress(user, &r);
+}
 
 long gp_imc_stall_window(size_t n) { return 20000 + 50 * (long)(n < 100000000 ? n : 100000000); }
 
@@ -703,7 +725,7 @@ static gp_imc_stop stop_check(const imc_state *S, const gp_imc_params *p, const 
 }
 
 static gp_status run_loop(imc_state *S, gp_voronoi *v, gp_rng *rng, const gp_imc_params *p,
-                          gp_imc_progress_fn progress, void *user, const volatile int *cancel,
+                          gp_progress_fn progress, void *user, const volatile int *cancel,
                           objective *cur, run_out *ro, gp_error *err)
 {
     step_buf b;
@@ -723,7 +745,7 @@ static gp_status run_loop(imc_state *S, gp_voronoi *v, gp_rng *rng, const gp_imc
             break;
         }
         if (ro->steps > 0 && (ro->steps % GP_IMC_PROGRESS_EVERY) == 0 && progress &&
-            progress(user, ro->steps, cur->error)) {
+            report(progress, user, p, ro, cur->error)) {
             ro->why = GP_IMC_STOP_CANCELLED;
             break;
         }
@@ -778,16 +800,9 @@ static void end_message(gp_status *st, const run_out *ro, const gp_imc_params *p
         gp_error_clear(err);
 }
 
-static double seconds_since(const struct timespec *t0)
-{
-    struct timespec t1;
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    return (double)(t1.tv_sec - t0->tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0->tv_nsec);
-}
-
 gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *holes,
                      const size_t *nhole, size_t nholes, size_t n, const gp_imc_params *p,
-                     gp_imc_progress_fn progress, void *user, const volatile int *cancel,
+                     gp_progress_fn progress, void *user, const volatile int *cancel,
                      gp_voronoi **out, gp_imc_report *rep, gp_error *err)
 {
     if (out) *out = NULL;
@@ -803,17 +818,17 @@ gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *
     memset(&S, 0, sizeof S);
     gp_voronoi *v = NULL;
     gp_law *own_law = NULL;
-    run_out ro = {0, 0, GP_IMC_STOP_MAX_STEPS};
+    run_out ro = {0, 0, GP_IMC_STOP_MAX_STEPS, -1.0};
     if (!seeds) {
         st = gp_error_set(err, GP_ERR_NOMEM, "imc: out of memory");
         goto done;
     }
-    st = place_seeds(outer, nouter, holes, nhole, nholes, n, p, rng, cancel, seeds, err);
+    outer_box(outer, nouter, S.box);
+    st = place_seeds(outer, nouter, holes, nhole, nholes, n, p, S.box, rng, cancel, seeds, err);
     if (st != GP_OK) goto done;
-    struct timespec t0;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = gp_clock_seconds();
     v = gp_voronoi_create_ex(outer, nouter, holes, nhole, nholes, seeds, n, cancel, err);
-    if (rep) rep->t_init = seconds_since(&t0);
+    if (rep) rep->t_init = gp_clock_seconds() - t0;
     if (!v) {
         st = err ? err->code : GP_ERR_INVALID;
         goto done;
@@ -829,14 +844,6 @@ gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *
     double floor_e = 0.0;
     st = state_init(&S, p, law, v, n, cancel, &floor_e, err);
     if (st != GP_OK) goto done;
-    S.box[0] = S.box[1] = INFINITY;
-    S.box[2] = S.box[3] = -INFINITY;
-    for (size_t k = 0; k < nouter; k++) {
-        S.box[0] = fmin(S.box[0], outer[k].x);
-        S.box[1] = fmin(S.box[1], outer[k].y);
-        S.box[2] = fmax(S.box[2], outer[k].x);
-        S.box[3] = fmax(S.box[3], outer[k].y);
-    }
     objective cur = evaluate(&S);
     if (rep) {
         rep->error_initial = cur.error;
@@ -850,7 +857,7 @@ gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *
                           p->threshold, floor_e, S.ks, S.kt, n);
     } else {
         st = run_loop(&S, v, rng, p, progress, user, cancel, &cur, &ro, err);
-        if (progress && st == GP_OK) progress(user, ro.steps, cur.error);
+        if (progress && st == GP_OK) report(progress, user, p, &ro, cur.error);
         end_message(&st, &ro, p, cur.error, err);
     }
     if (st == GP_ERR_NOMEM) goto done;

@@ -64,6 +64,7 @@
 #include "gp_error.h"
 #include "gp_geom.h"
 #include "gp_law.h"
+#include "gp_progress.h"
 #include "gp_voronoi.h"
 
 /* error_kind values: 1, 2, 3 for E1, E2, E3, 4 for AD (the same numbers as gp_imc_error_kind
@@ -138,11 +139,11 @@ typedef struct gp_imc_report {
 
 void gp_imc_report_free(gp_imc_report *r);
 
-/* Called every 4096 steps (and at the end) with the step count and current error; a non-zero
- * return cancels the run. */
-typedef int (*gp_imc_progress_fn)(void *user, long steps, double error);
-
 /* Runs IMC in the container (as gp_voronoi_create) with n cells.
+ * progress (gp_progress.h, the one callback type of core) is called every 4096 steps and at the
+ * end with phase "imc", the steps done, the current error, and as the fraction how far
+ * log(error) has come from its value at the first report towards log(threshold), in [0, 1]; a
+ * non-zero return cancels the run.
  * Returns GP_OK when the threshold was reached; GP_ERR_NOT_CONVERGED at max_steps, when
  * stalled, or for a single cell;
  * GP_ERR_INFEASIBLE when the threshold is below the floor (stop reason "floor", no step done);
@@ -154,7 +155,7 @@ typedef int (*gp_imc_progress_fn)(void *user, long steps, double error);
  * cancel and progress may be NULL. */
 gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *holes,
                      const size_t *nhole, size_t nholes, size_t n, const gp_imc_params *p,
-                     gp_imc_progress_fn progress, void *user, const volatile int *cancel,
+                     gp_progress_fn progress, void *user, const volatile int *cancel,
                      gp_voronoi **out, gp_imc_report *rep, gp_error *err);
 
 /* The exact integer-count floor of one normalised histogram: min over integer counts c with

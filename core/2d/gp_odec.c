@@ -112,73 +112,96 @@ static int add_disc(gp_odec_result *out, size_t *cap, double cx, double cy, doub
     return 1;
 }
 
-gp_status gp_odec_build(const gp_vec2 *poly, size_t n, const gp_odec_params *params,
-                        gp_odec_result *out, gp_error *err)
+/* One ODEC build: the polygon without duplicate vertices, the scales of the algorithm, and the
+ * nodes with their tangent radii. The steps of gp_odec.h run in order over this state. */
+typedef struct odec_run {
+    gp_odec_params P;
+    gp_vec2 *q;            /* the polygon, consecutive duplicates dropped: nv vertices */
+    size_t nv;
+    double orient;         /* inward normal = orient * left normal of an edge */
+    double req, rmin, s, gap;
+    double tol;            /* duplicate tolerance, 1e-12 of the polygon's size */
+    double rcap;           /* no tangent radius exceeds this */
+    size_t m;              /* nodes */
+    node *nd;
+    double *rt, *forb, *X, *Y;
+    cand *cd;              /* the nodes by decreasing tangent radius */
+    unsigned char *covered;
+    size_t cap;            /* discs allocated in out */
+    gp_odec_result *out;
+} odec_run;
+
+static void odec_free(odec_run *R)
 {
-    if (!out)
-        return gp_error_set(err, GP_ERR_INVALID, "odec: out is NULL");
-    memset(out, 0, sizeof *out);
+    free(R->q);
+    free(R->nd);
+    free(R->rt);
+    free(R->cd);
+    free(R->covered);
+    free(R->forb);
+    free(R->X);
+    free(R->Y);
+}
+
+/* Arguments, parameters, and the polygon's scales: size, duplicates, area, R_eq. */
+static gp_status odec_setup(odec_run *R, const gp_vec2 *poly, size_t n, const gp_odec_params *params,
+                            gp_error *err)
+{
     gp_status st = check_poly(poly, n, "odec", err);
     if (st != GP_OK)
         return st;
-    gp_odec_params P;
     if (params)
-        P = *params;
+        R->P = *params;
     else
-        gp_odec_params_default(&P);
-    if (!(P.r_min > 0 && P.r_min < 10) || !(P.spacing > 0 && P.spacing < 10))
+        gp_odec_params_default(&R->P);
+    if (!(R->P.r_min > 0 && R->P.r_min < 10) || !(R->P.spacing > 0 && R->P.spacing < 10))
         return gp_error_set(err, GP_ERR_INVALID,
                             "odec: r_min = %g and spacing = %g must be in (0, 10) (relative to "
-                            "the equivalent radius)", P.r_min, P.spacing);
-
-    /* scale and duplicate tolerance */
-    double xmin = poly[0].x, xmax = xmin, ymin = poly[0].y, ymax = ymin;
-    for (size_t i = 1; i < n; i++) {
-        xmin = fmin(xmin, poly[i].x);
-        xmax = fmax(xmax, poly[i].x);
-        ymin = fmin(ymin, poly[i].y);
-        ymax = fmax(ymax, poly[i].y);
-    }
-    double size = fmax(xmax - xmin, ymax - ymin);
-    double tol = 1e-12 * size;
-    gp_vec2 *q = malloc(n * sizeof *q);
-    if (!q)
+                            "the equivalent radius)", R->P.r_min, R->P.spacing);
+    gp_vec2 lo, hi;
+    gp_poly_bbox(poly, n, &lo, &hi, NULL);
+    double size = fmax(hi.x - lo.x, hi.y - lo.y);
+    R->tol = 1e-12 * size;
+    R->rcap = 2.0 * hypot(hi.x - lo.x, hi.y - lo.y);
+    R->q = malloc(n * sizeof *R->q);
+    if (!R->q)
         return gp_error_set(err, GP_ERR_NOMEM, "odec: out of memory");
-    size_t nv = dedupe(poly, n, q, tol * tol);
-    double A = nv >= 3 ? gp_poly_signed_area(q, nv) : 0.0;
-    if (!(fabs(A) > 1e-12 * size * size)) {
-        free(q);
+    R->nv = dedupe(poly, n, R->q, R->tol * R->tol);
+    double A = R->nv >= 3 ? gp_poly_signed_area(R->q, R->nv) : 0.0;
+    if (!(fabs(A) > 1e-12 * size * size))
         return gp_error_set(err, GP_ERR_DEGENERATE, "odec: the polygon has no area");
-    }
-    double orient = A > 0 ? 1.0 : -1.0; /* inward normal = orient * left normal of the edge */
-    double req = sqrt(fabs(A) / GP_PI);
-    double rmin = P.r_min * req, s = P.spacing * req;
-    double gap = sqrt(2.0 * P.spacing * P.r_min) * req;
+    R->orient = A > 0 ? 1.0 : -1.0;
+    R->req = sqrt(fabs(A) / GP_PI);
+    R->rmin = R->P.r_min * R->req;
+    R->s = R->P.spacing * R->req;
+    R->gap = sqrt(2.0 * R->P.spacing * R->P.r_min) * R->req;
+    return GP_OK;
+}
 
-    /* 1. nodes */
+/* Step 1: the vertices plus nodes inserted evenly on every edge longer than the gap; a
+ * vertex's normal bisects its two edges' inward normals. */
+static gp_status odec_nodes(odec_run *R, gp_error *err)
+{
+    const gp_vec2 *q = R->q;
+    const size_t nv = R->nv;
+    const double gap = R->gap, orient = R->orient;
     size_t m = 0;
     for (size_t i = 0; i < nv; i++) {
         gp_vec2 a = q[i], b = q[(i + 1) % nv];
         double len = hypot(b.x - a.x, b.y - a.y);
         m += 1 + (len > gap ? (size_t)ceil(len / gap) - 1 : 0);
     }
-    node *nd = malloc(m * sizeof *nd);
-    double *rt = malloc(m * sizeof *rt);
-    cand *cd = malloc(m * sizeof *cd);
-    unsigned char *covered = calloc(m, 1);
-    double *forb = malloc(2 * m * sizeof *forb);
-    double *X = malloc(m * sizeof *X), *Y = malloc(m * sizeof *Y);
-    if (!nd || !rt || !cd || !covered || !forb || !X || !Y) {
-        free(X);
-        free(Y);
-        free(forb);
-        free(q);
-        free(nd);
-        free(rt);
-        free(cd);
-        free(covered);
+    R->m = m;
+    R->nd = malloc(m * sizeof *R->nd);
+    R->rt = malloc(m * sizeof *R->rt);
+    R->cd = malloc(m * sizeof *R->cd);
+    R->covered = calloc(m, 1);
+    R->forb = malloc(2 * m * sizeof *R->forb);
+    R->X = malloc(m * sizeof *R->X);
+    R->Y = malloc(m * sizeof *R->Y);
+    if (!R->nd || !R->rt || !R->cd || !R->covered || !R->forb || !R->X || !R->Y)
         return gp_error_set(err, GP_ERR_NOMEM, "odec: out of memory for %zu nodes", m);
-    }
+    node *nd = R->nd;
     size_t k = 0;
     for (size_t i = 0; i < nv; i++) {
         gp_vec2 p = q[(i + nv - 1) % nv], a = q[i], b = q[(i + 1) % nv];
@@ -201,194 +224,242 @@ gp_status gp_odec_build(const gp_vec2 *poly, size_t n, const gp_odec_params *par
             }
         }
     }
-    out->nnodes = m;
-    out->r_eq = req;
     for (size_t i = 0; i < m; i++) {
-        X[i] = nd[i].x;
-        Y[i] = nd[i].y;
+        R->X[i] = nd[i].x;
+        R->Y[i] = nd[i].y;
     }
+    return GP_OK;
+}
 
-    /* 2. tangent radii. A vertex is a sample of the grain's (smooth) curve, so its disc is
-     * first computed without the nodes inserted on its two own edges (which would shrink it to
-     * nothing at any convex vertex); that larger disc is kept if it cuts into those two edges
-     * by no more than the tolerance between nodes, delta = r_min - sqrt(r_min^2 - g^2/4),
-     * which is what it would do with no inserted nodes; otherwise (a real corner) the disc
-     * respects every node. */
-    double rcap = 2.0 * hypot(xmax - xmin, ymax - ymin);
-    double dup2 = tol * tol;
-    double delta = rmin - sqrt(fmax(0.0, rmin * rmin - 0.25 * gap * gap));
-    for (size_t i = 0; i < m; i++) {
-        double px = nd[i].x, py = nd[i].y, nx = nd[i].nx, ny = nd[i].ny;
-        double best = rcap, bex = rcap;
-        size_t kn = 0, kp = 0; /* inserted nodes right after / before vertex i */
-        if (nd[i].vtx) {
-            while (kn + 1 < m && !nd[(i + kn + 1) % m].vtx)
-                kn++;
-            while (kp + 1 < m && !nd[(i + m - kp - 1) % m].vtx)
-                kp++;
-        }
-        if (nx == 0 && ny == 0) {
-            best = bex = 0;
-        } else if (kn + kp == 0) {
-            for (size_t j = 0; j < m; j++) {
-                double ux = X[j] - px, uy = Y[j] - py;
-                double un = ux * nx + uy * ny;
-                if (un <= 0)
-                    continue;
-                double u2 = ux * ux + uy * uy;
-                if (u2 <= dup2)
-                    continue;
-                /* r(Q) = |u|^2 / (2 u.n) < best  <=>  u2 < 2 best un */
-                if (u2 < 2.0 * best * un)
-                    best = u2 / (2.0 * un);
-            }
-            bex = best;
-        } else {
-            for (size_t j = 0; j < m; j++) {
-                double ux = nd[j].x - px, uy = nd[j].y - py;
-                double un = ux * nx + uy * ny;
-                if (un <= 0)
-                    continue;
-                double u2 = ux * ux + uy * uy;
-                if (u2 <= dup2)
-                    continue;
-                if (u2 < 2.0 * best * un) {
-                    double rq = u2 / (2.0 * un);
-                    best = rq;
-                    size_t off = j >= i ? j - i : j + m - i;
-                    if ((off > kn && off < m - kp) && rq < bex)
-                        bex = rq;
-                } else if (u2 < 2.0 * bex * un) {
-                    size_t off = j >= i ? j - i : j + m - i;
-                    if (off > kn && off < m - kp)
-                        bex = u2 / (2.0 * un);
-                }
-            }
-            if (bex > best) {
-                /* how far the disc of radius bex cuts into the vertex's own two edges */
-                size_t in = (i + kn + 1) % m, ip = (i + m - kp - 1) % m;
-                double cx = px + bex * nx, cy = py + bex * ny;
-                double d1 = sqrt(seg_dist2(cx, cy, px, py, nd[in].x, nd[in].y));
-                double d0 = sqrt(seg_dist2(cx, cy, nd[ip].x, nd[ip].y, px, py));
-                if (bex - fmin(d0, d1) <= delta)
-                    best = bex;
-            }
-        }
-        rt[i] = best;
-        cd[i] = (cand){best, i};
+/* Node Q = P + (ux, uy) against the tangent at P (inward normal (nx, ny)): 1 when Q lies ahead
+ * of it and is not P itself, with un = u.n and u2 = |u|^2 (the disc tangent at P through Q has
+ * radius u2 / (2 un)). */
+static inline int ahead(double ux, double uy, double nx, double ny, double dup2, double *un,
+                        double *u2)
+{
+    *un = ux * nx + uy * ny;
+    if (*un <= 0)
+        return 0;
+    *u2 = ux * ux + uy * uy;
+    return !(*u2 <= dup2);
+}
+
+/* Step 2 for node i: the largest disc tangent at it that holds no node. A vertex is a sample of
+ * the grain's (smooth) curve, so its disc is first computed without the nodes inserted on its
+ * two own edges (which would shrink it to nothing at any convex vertex); that larger disc is
+ * kept if it cuts into those two edges by no more than the tolerance between nodes,
+ * delta = r_min - sqrt(r_min^2 - g^2/4), which is what it would do with no inserted nodes;
+ * otherwise (a real corner) the disc respects every node. */
+static double tangent_radius(const odec_run *R, size_t i, double delta)
+{
+    const node *nd = R->nd;
+    const size_t m = R->m;
+    const double dup2 = R->tol * R->tol;
+    double px = nd[i].x, py = nd[i].y, nx = nd[i].nx, ny = nd[i].ny;
+    double best = R->rcap, bex = R->rcap;
+    size_t kn = 0, kp = 0; /* inserted nodes right after / before vertex i */
+    if (nd[i].vtx) {
+        while (kn + 1 < m && !nd[(i + kn + 1) % m].vtx)
+            kn++;
+        while (kp + 1 < m && !nd[(i + m - kp - 1) % m].vtx)
+            kp++;
     }
-    qsort(cd, m, sizeof *cd, cand_cmp);
-
-    /* 3. discs, largest tangent radius first */
-    size_t cap = 0;
-    int nomem = 0;
-    for (size_t c = 0; c < m && !nomem; c++) {
-        size_t i = cd[c].i;
-        double r = cd[c].r;
-        if (r < rmin)
-            break;
-        if (covered[i])
+    if (nx == 0 && ny == 0)
+        return 0;
+    double un, u2;
+    if (kn + kp == 0) { /* the common case, on the nodes' coordinate arrays */
+        for (size_t j = 0; j < m; j++) {
+            if (!ahead(R->X[j] - px, R->Y[j] - py, nx, ny, dup2, &un, &u2))
+                continue;
+            /* r(Q) = |u|^2 / (2 u.n) < best  <=>  u2 < 2 best un */
+            if (u2 < 2.0 * best * un)
+                best = u2 / (2.0 * un);
+        }
+        return best;
+    }
+    for (size_t j = 0; j < m; j++) {
+        if (!ahead(nd[j].x - px, nd[j].y - py, nx, ny, dup2, &un, &u2))
             continue;
-        if (P.max_discs && out->ndiscs >= P.max_discs) {
-            out->capped = 1;
+        if (u2 < 2.0 * best * un) {
+            double rq = u2 / (2.0 * un);
+            best = rq;
+            size_t off = j >= i ? j - i : j + m - i;
+            if ((off > kn && off < m - kp) && rq < bex)
+                bex = rq;
+        } else if (u2 < 2.0 * bex * un) {
+            size_t off = j >= i ? j - i : j + m - i;
+            if (off > kn && off < m - kp)
+                bex = u2 / (2.0 * un);
+        }
+    }
+    if (bex > best) {
+        /* how far the disc of radius bex cuts into the vertex's own two edges */
+        size_t in = (i + kn + 1) % m, ip = (i + m - kp - 1) % m;
+        double cx = px + bex * nx, cy = py + bex * ny;
+        double d1 = sqrt(seg_dist2(cx, cy, px, py, nd[in].x, nd[in].y));
+        double d0 = sqrt(seg_dist2(cx, cy, nd[ip].x, nd[ip].y, px, py));
+        if (bex - fmin(d0, d1) <= delta)
+            best = bex;
+    }
+    return best;
+}
+
+/* Step 2: every node's tangent radius, and the nodes in the order of step 3. */
+static void odec_radii(odec_run *R)
+{
+    double delta = R->rmin - sqrt(fmax(0.0, R->rmin * R->rmin - 0.25 * R->gap * R->gap));
+    for (size_t i = 0; i < R->m; i++) {
+        double best = tangent_radius(R, i, delta);
+        R->rt[i] = best;
+        R->cd[i] = (cand){best, i};
+    }
+    qsort(R->cd, R->m, sizeof *R->cd, cand_cmp);
+}
+
+/* Step 3: discs, largest tangent radius first, at nodes not yet covered. 0, or -1 when out of
+ * memory. */
+static int odec_discs(odec_run *R)
+{
+    for (size_t c = 0; c < R->m; c++) {
+        size_t i = R->cd[c].i;
+        double r = R->cd[c].r;
+        if (r < R->rmin)
+            break;
+        if (R->covered[i])
+            continue;
+        if (R->P.max_discs && R->out->ndiscs >= R->P.max_discs) {
+            R->out->capped = 1;
             break;
         }
-        double cx = nd[i].x + r * nd[i].nx, cy = nd[i].y + r * nd[i].ny;
-        if (!gp_poly_contains(q, nv, (gp_vec2){cx, cy}))
+        const node *n = &R->nd[i];
+        double cx = n->x + r * n->nx, cy = n->y + r * n->ny;
+        if (!gp_poly_contains(R->q, R->nv, (gp_vec2){cx, cy}))
             continue; /* cannot happen for a simple polygon sampled densely enough */
-        if (!add_disc(out, &cap, cx, cy, r, nd, m, covered, s))
-            nomem = 1;
+        if (!add_disc(R->out, &R->cap, cx, cy, r, R->nd, R->m, R->covered, R->s))
+            return -1;
     }
+    return 0;
+}
 
-    /* 4. uncovered nodes: the nearest admissible disc of radius r_min among the discs tangent
-     * to the node segments within an arc length 2 (r_min + spacing) + gap on either side. On a
-     * segment A -> B (inward unit normal nn) the tangent disc's centre is c(t) = A + r_min nn +
-     * t (B - A); it is admissible where no node is closer than r_min to c(t), i.e. outside
-     * one interval of t per node; |node - c(t)| is convex in t, so the best admissible t is the
-     * unconstrained optimum or an end of a forbidden interval or of the segment. */
-    for (size_t i = 0; i < m && !nomem && !out->capped; i++) {
-        if (covered[i])
+/* The admissible disc of radius r_min tangent to segment a -> b nearest to node i: on the
+ * segment (inward unit normal nn) the centre is c(t) = a + r_min nn + t (b - a); it is
+ * admissible where no node is closer than r_min to c(t), i.e. outside one interval of t per
+ * node; |node - c(t)| is convex in t, so the best admissible t is the unconstrained optimum or
+ * an end of a forbidden interval or of the segment. Updates *bestd and (*bx, *by). */
+static void segment_disc(odec_run *R, size_t i, size_t a, size_t b, double *bestd, double *bx,
+                         double *by)
+{
+    const node *nd = R->nd;
+    const double rmin = R->rmin;
+    double *forb = R->forb;
+    double ex = nd[b].x - nd[a].x, ey = nd[b].y - nd[a].y;
+    double ee = ex * ex + ey * ey, el = sqrt(ee);
+    double nnx = -R->orient * ey / el, nny = R->orient * ex / el;
+    double ox = nd[a].x + rmin * nnx, oy = nd[a].y + rmin * nny;
+    size_t nf = 0;
+    double eps2 = 1e-18 * rmin * rmin * ee;
+    for (size_t o = 0; o < R->m; o++) {
+        double wx = nd[o].x - ox, wy = nd[o].y - oy;
+        double we = wx * ex + wy * ey;
+        double D = we * we - ee * (wx * wx + wy * wy - rmin * rmin);
+        if (D <= eps2)
+            continue;
+        double sq = sqrt(D);
+        double t1 = (we - sq) / ee, t2 = (we + sq) / ee;
+        if (t2 <= 0 || t1 >= 1)
+            continue;
+        forb[2 * nf] = t1;
+        forb[2 * nf + 1] = t2;
+        nf++;
+    }
+    double tc[3];
+    double tstar = ((nd[i].x - ox) * ex + (nd[i].y - oy) * ey) / ee;
+    tc[0] = tstar < 0 ? 0 : (tstar > 1 ? 1 : tstar);
+    tc[1] = 0;
+    tc[2] = 1;
+    for (size_t c = 0; c < 3 + 2 * nf; c++) {
+        double t = c < 3 ? tc[c] : forb[c - 3];
+        if (t < 0 || t > 1)
+            continue;
+        int ok = 1;
+        for (size_t f = 0; f < nf && ok; f++)
+            ok = !(t > forb[2 * f] + 1e-12 && t < forb[2 * f + 1] - 1e-12);
+        if (!ok)
+            continue;
+        double cx = ox + t * ex, cy = oy + t * ey;
+        double d = hypot(nd[i].x - cx, nd[i].y - cy) - rmin;
+        if (d < *bestd) {
+            *bestd = d;
+            *bx = cx;
+            *by = cy;
+        }
+    }
+}
+
+/* Step 4: each node still uncovered, by index, gets the nearest admissible disc of radius
+ * r_min among those tangent to the node segments within an arc length 2 (r_min + spacing) +
+ * gap on either side, if it comes within spacing of the node. 0, or -1 when out of memory. */
+static int odec_corners(odec_run *R)
+{
+    const size_t m = R->m;
+    const double reach = 2.0 * (R->rmin + R->s) + R->gap;
+    for (size_t i = 0; i < m && !R->out->capped; i++) {
+        if (R->covered[i])
             continue;
         double bestd = INFINITY, bx = 0, by = 0;
-        double reach = 2.0 * (rmin + s) + gap;
         for (int dir = -1; dir <= 1; dir += 2) {
             double arc = 0;
             size_t j = i;
             for (size_t steps = 0; steps < m && arc <= reach; steps++) {
                 size_t jn = dir > 0 ? (j + 1) % m : (j + m - 1) % m;
                 size_t a = dir > 0 ? j : jn, b = dir > 0 ? jn : j; /* contour order a -> b */
-                double ex = nd[b].x - nd[a].x, ey = nd[b].y - nd[a].y;
-                double ee = ex * ex + ey * ey, el = sqrt(ee);
+                double ex = R->nd[b].x - R->nd[a].x, ey = R->nd[b].y - R->nd[a].y;
+                double el = sqrt(ex * ex + ey * ey);
                 arc += el;
                 j = jn;
-                if (!(el > 0))
-                    continue;
-                double nnx = -orient * ey / el, nny = orient * ex / el;
-                double ox = nd[a].x + rmin * nnx, oy = nd[a].y + rmin * nny;
-                size_t nf = 0;
-                double eps2 = 1e-18 * rmin * rmin * ee;
-                for (size_t o = 0; o < m; o++) {
-                    double wx = nd[o].x - ox, wy = nd[o].y - oy;
-                    double we = wx * ex + wy * ey;
-                    double D = we * we - ee * (wx * wx + wy * wy - rmin * rmin);
-                    if (D <= eps2)
-                        continue;
-                    double sq = sqrt(D);
-                    double t1 = (we - sq) / ee, t2 = (we + sq) / ee;
-                    if (t2 <= 0 || t1 >= 1)
-                        continue;
-                    forb[2 * nf] = t1;
-                    forb[2 * nf + 1] = t2;
-                    nf++;
-                }
-                double tc[3];
-                double tstar = ((nd[i].x - ox) * ex + (nd[i].y - oy) * ey) / ee;
-                tc[0] = tstar < 0 ? 0 : (tstar > 1 ? 1 : tstar);
-                tc[1] = 0;
-                tc[2] = 1;
-                for (size_t c = 0; c < 3 + 2 * nf; c++) {
-                    double t = c < 3 ? tc[c] : forb[c - 3];
-                    if (t < 0 || t > 1)
-                        continue;
-                    int ok = 1;
-                    for (size_t f = 0; f < nf && ok; f++)
-                        ok = !(t > forb[2 * f] + 1e-12 && t < forb[2 * f + 1] - 1e-12);
-                    if (!ok)
-                        continue;
-                    double cx = ox + t * ex, cy = oy + t * ey;
-                    double d = hypot(nd[i].x - cx, nd[i].y - cy) - rmin;
-                    if (d < bestd) {
-                        bestd = d;
-                        bx = cx;
-                        by = cy;
-                    }
-                }
+                if (el > 0)
+                    segment_disc(R, i, a, b, &bestd, &bx, &by);
             }
         }
-        if (bestd <= s) {
-            if (P.max_discs && out->ndiscs >= P.max_discs) {
-                out->capped = 1;
+        if (bestd <= R->s) {
+            if (R->P.max_discs && R->out->ndiscs >= R->P.max_discs) {
+                R->out->capped = 1;
                 break;
             }
-            if (!gp_poly_contains(q, nv, (gp_vec2){bx, by}))
+            if (!gp_poly_contains(R->q, R->nv, (gp_vec2){bx, by}))
                 continue;
-            if (!add_disc(out, &cap, bx, by, rmin, nd, m, covered, s))
-                nomem = 1;
+            if (!add_disc(R->out, &R->cap, bx, by, R->rmin, R->nd, m, R->covered, R->s))
+                return -1;
         }
     }
-    size_t unc = 0;
-    for (size_t i = 0; i < m; i++)
-        unc += !covered[i];
-    out->uncovered = unc;
+    return 0;
+}
 
-    free(q);
-    free(nd);
-    free(rt);
-    free(cd);
-    free(covered);
-    free(forb);
-    free(X);
-    free(Y);
+gp_status gp_odec_build(const gp_vec2 *poly, size_t n, const gp_odec_params *params,
+                        gp_odec_result *out, gp_error *err)
+{
+    if (!out)
+        return gp_error_set(err, GP_ERR_INVALID, "odec: out is NULL");
+    memset(out, 0, sizeof *out);
+    odec_run R;
+    memset(&R, 0, sizeof R);
+    R.out = out;
+    gp_status st = odec_setup(&R, poly, n, params, err);
+    if (st == GP_OK)
+        st = odec_nodes(&R, err);
+    if (st != GP_OK) {
+        odec_free(&R);
+        return st;
+    }
+    out->nnodes = R.m;
+    out->r_eq = R.req;
+    odec_radii(&R);
+    int nomem = odec_discs(&R) != 0 || odec_corners(&R) != 0;
+    size_t unc = 0;
+    for (size_t i = 0; i < R.m; i++)
+        unc += !R.covered[i];
+    out->uncovered = unc;
+    odec_free(&R);
     if (nomem) {
         gp_odec_result_free(out);
         return gp_error_set(err, GP_ERR_NOMEM, "odec: out of memory for discs");
@@ -486,37 +557,18 @@ static double inter_len(const ival *u, size_t nu, const ival *v, size_t nv)
     return L;
 }
 
-gp_status gp_odec_measure(const gp_vec2 *poly, size_t n, const gp_odec_disc *discs,
-                          size_t ndiscs, gp_odec_quality *q, gp_error *err)
+/* area_ratio and area_excess by 512 scanlines: on each, the union of the disc chords and the
+ * polygon's inside intervals, exactly in x. */
+static gp_status scan_areas(const gp_vec2 *poly, size_t n, const gp_odec_disc *discs,
+                            size_t ndiscs, double area, gp_odec_quality *q, gp_error *err)
 {
-    if (!q)
-        return gp_error_set(err, GP_ERR_INVALID, "odec quality: q is NULL");
-    memset(q, 0, sizeof *q);
-    gp_status st = check_poly(poly, n, "odec quality", err);
-    if (st != GP_OK)
-        return st;
-    if (ndiscs > 0 && !discs)
-        return gp_error_set(err, GP_ERR_INVALID, "odec quality: discs is NULL");
-    for (size_t k = 0; k < ndiscs; k++) {
-        if (!isfinite(discs[k].x) || !isfinite(discs[k].y) || !(discs[k].r > 0) ||
-            !isfinite(discs[k].r))
-            return gp_error_set(err, GP_ERR_INVALID, "odec quality: disc %zu is invalid", k);
-    }
-    double area = gp_poly_area(poly, n);
-    if (!(area > 0))
-        return gp_error_set(err, GP_ERR_DEGENERATE, "odec quality: the polygon has no area");
-    double req = sqrt(area / GP_PI);
-
-    double ymin = poly[0].y, ymax = ymin;
-    for (size_t i = 1; i < n; i++) {
-        ymin = fmin(ymin, poly[i].y);
-        ymax = fmax(ymax, poly[i].y);
-    }
+    gp_vec2 lo, hi;
+    gp_poly_bbox(poly, n, &lo, &hi, NULL);
+    double ymin = lo.y, ymax = hi.y;
     for (size_t k = 0; k < ndiscs; k++) {
         ymin = fmin(ymin, discs[k].y - discs[k].r);
         ymax = fmax(ymax, discs[k].y + discs[k].r);
     }
-
     ival *du = malloc((ndiscs + 1) * sizeof *du);
     ival *pu = malloc((n / 2 + 2) * sizeof *pu);
     double *xs = malloc((n + 2) * sizeof *xs);
@@ -526,8 +578,6 @@ gp_status gp_odec_measure(const gp_vec2 *poly, size_t n, const gp_odec_disc *dis
         free(xs);
         return gp_error_set(err, GP_ERR_NOMEM, "odec quality: out of memory");
     }
-
-    /* areas by scanlines */
     const size_t nlines = 512;
     double h = (ymax - ymin) / (double)nlines;
     double a_union = 0, a_inter = 0;
@@ -563,8 +613,17 @@ gp_status gp_odec_measure(const gp_vec2 *poly, size_t n, const gp_odec_disc *dis
     }
     q->area_ratio = a_inter / area;
     q->area_excess = fmax(0.0, (a_union - a_inter) / area);
+    free(du);
+    free(pu);
+    free(xs);
+    return GP_OK;
+}
 
-    /* protrusion */
+/* max over discs of how far each reaches beyond the contour (r - distance, or r + distance for
+ * a centre outside), 0 if none does */
+static double max_protrusion(const gp_vec2 *poly, size_t n, const gp_odec_disc *discs,
+                             size_t ndiscs)
+{
     double prot = 0;
     for (size_t k = 0; k < ndiscs; k++) {
         double d = contour_dist(poly, n, discs[k].x, discs[k].y);
@@ -573,43 +632,49 @@ gp_status gp_odec_measure(const gp_vec2 *poly, size_t n, const gp_odec_disc *dis
         if (p > prot)
             prot = p;
     }
-    q->max_protrusion = prot / req;
+    return prot;
+}
 
-    /* h1: contour points (vertices, and every <= 0.01 R_eq along edges) to the union */
+/* h1: contour points (vertices, and every <= step along edges) to the union */
+static double contour_to_union(const gp_vec2 *poly, size_t n, const gp_odec_disc *discs,
+                               size_t ndiscs, double step)
+{
+    if (ndiscs == 0)
+        return INFINITY;
     double h1 = 0;
-    double step = 0.01 * req;
-    if (ndiscs == 0) {
-        h1 = INFINITY;
-    } else {
-        gp_vec2 a = poly[n - 1];
-        for (size_t i = 0; i < n; i++) {
-            gp_vec2 b = poly[i];
-            double len = hypot(b.x - a.x, b.y - a.y);
-            size_t ns = (size_t)ceil(len / step);
-            if (ns < 1)
-                ns = 1;
-            for (size_t t = 0; t < ns; t++) {
-                double f = (double)t / (double)ns;
-                double x = a.x + f * (b.x - a.x), y = a.y + f * (b.y - a.y);
-                double best = INFINITY;
-                for (size_t k = 0; k < ndiscs; k++) {
-                    double d = hypot(x - discs[k].x, y - discs[k].y) - discs[k].r;
-                    if (d < best)
-                        best = d;
-                }
-                if (best > h1)
-                    h1 = best;
+    gp_vec2 a = poly[n - 1];
+    for (size_t i = 0; i < n; i++) {
+        gp_vec2 b = poly[i];
+        double len = hypot(b.x - a.x, b.y - a.y);
+        size_t ns = (size_t)ceil(len / step);
+        if (ns < 1)
+            ns = 1;
+        for (size_t t = 0; t < ns; t++) {
+            double f = (double)t / (double)ns;
+            double x = a.x + f * (b.x - a.x), y = a.y + f * (b.y - a.y);
+            double best = INFINITY;
+            for (size_t k = 0; k < ndiscs; k++) {
+                double d = hypot(x - discs[k].x, y - discs[k].y) - discs[k].r;
+                if (d < best)
+                    best = d;
             }
-            a = b;
+            if (best > h1)
+                h1 = best;
         }
+        a = b;
     }
+    return h1;
+}
 
-    /* h2: boundary of the union to the contour */
+/* h2: the boundary of the union to the contour, sampled at the pairwise circle intersections
+ * on it (the cusps) and at most 0.02 R_eq apart along each circle (at least 16 points) */
+static double union_to_contour(const gp_vec2 *poly, size_t n, const gp_odec_disc *discs,
+                               size_t ndiscs, double req)
+{
     double h2 = 0;
     size_t hint = 0;
     for (size_t k = 0; k < ndiscs; k++) {
         double cx = discs[k].x, cy = discs[k].y, r = discs[k].r;
-        /* samples at most 0.02 R_eq apart along the circle (at least 16) */
         int nsamp = (int)ceil(2.0 * GP_PI * r / (0.02 * req));
         nsamp = nsamp < 16 ? 16 : (nsamp > 4096 ? 4096 : nsamp);
         for (size_t j = 0; j <= ndiscs; j++) {
@@ -657,9 +722,35 @@ gp_status gp_odec_measure(const gp_vec2 *poly, size_t n, const gp_odec_disc *dis
             }
         }
     }
+    return h2;
+}
+
+gp_status gp_odec_measure(const gp_vec2 *poly, size_t n, const gp_odec_disc *discs,
+                          size_t ndiscs, gp_odec_quality *q, gp_error *err)
+{
+    if (!q)
+        return gp_error_set(err, GP_ERR_INVALID, "odec quality: q is NULL");
+    memset(q, 0, sizeof *q);
+    gp_status st = check_poly(poly, n, "odec quality", err);
+    if (st != GP_OK)
+        return st;
+    if (ndiscs > 0 && !discs)
+        return gp_error_set(err, GP_ERR_INVALID, "odec quality: discs is NULL");
+    for (size_t k = 0; k < ndiscs; k++) {
+        if (!isfinite(discs[k].x) || !isfinite(discs[k].y) || !(discs[k].r > 0) ||
+            !isfinite(discs[k].r))
+            return gp_error_set(err, GP_ERR_INVALID, "odec quality: disc %zu is invalid", k);
+    }
+    double area = gp_poly_area(poly, n);
+    if (!(area > 0))
+        return gp_error_set(err, GP_ERR_DEGENERATE, "odec quality: the polygon has no area");
+    double req = sqrt(area / GP_PI);
+    st = scan_areas(poly, n, discs, ndiscs, area, q, err);
+    if (st != GP_OK)
+        return st;
+    q->max_protrusion = max_protrusion(poly, n, discs, ndiscs) / req;
+    double h1 = contour_to_union(poly, n, discs, ndiscs, 0.01 * req);
+    double h2 = union_to_contour(poly, n, discs, ndiscs, req);
     q->hausdorff = fmax(h1, h2) / req;
-    free(du);
-    free(pu);
-    free(xs);
     return GP_OK;
 }

@@ -16,8 +16,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "gp_clock.h"
 #include "gp_fill.h"
 #include "gp_fit.h"
 #include "gp_fourier.h"
@@ -60,13 +60,6 @@ void gp_spec2d_defaults(gp_spec2d *s)
     s->contour_points = 128;
     s->outputs = GP_OUT2_GRAINS;
     s->threads = 1;
-}
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 static double rng_u01(void *state) { return gp_rng_uniform((gp_rng *)state); }
@@ -291,7 +284,7 @@ static void fill_one(fill_job *j, gp_fill_workspace *ws, double *phases, gp_vec2
         }
         g->area = -1.0;
     }
-    double t0 = now_s();
+    double t0 = gp_clock_seconds();
     gp_fill_result fr;
     gp_status st = cell_phases(j, i, phases, &e);
     if (st == GP_OK)
@@ -317,7 +310,7 @@ static void fill_one(fill_job *j, gp_fill_workspace *ws, double *phases, gp_vec2
         for (size_t k = 2; k < 8; k++)
             c->phases27[k - 2] = fr.phases[k];
     }
-    *tf += now_s() - t0;
+    *tf += gp_clock_seconds() - t0;
 }
 
 /* scales grain i about its centre so that its area is multiplied by f (<= 1: it stays in
@@ -385,18 +378,18 @@ static void finish_one(fill_job *j, double *phases, size_t i, double *to, double
     gp_grain2d *g = &j->out->grains[i];
     if (j->area_scale && j->area_scale[i] != 1.0)
         grain_scale(g, &j->curve[i], j->area_scale[i]);
-    double t1 = now_s();
+    double t1 = gp_clock_seconds();
     gp_odec_result od;
     memset(&od, 0, sizeof od);
     gp_status st = GP_OK;
     if (j->outputs & GP_OUT2_ODEC)
         st = odec_one(g, &od, &e);
-    double t2 = now_s();
+    double t2 = gp_clock_seconds();
     *to += t2 - t1;
     if (st == GP_OK && (j->outputs & GP_OUT2_DESCRIPTORS))
         st = describe_one(j, i, phases, &od, &e);
     gp_odec_result_free(&od);
-    *td += now_s() - t2;
+    *td += gp_clock_seconds() - t2;
     if (st != GP_OK)
         job_fail(j, i, &e);
 }
@@ -519,29 +512,20 @@ typedef struct imc_relay {
     gp_progress_fn fn;
     void *user;
     const volatile int *cancel;
-    double threshold;
-    double error0; /* first error seen, < 0 before */
 } imc_relay;
 
-/* IMC progress -> job progress: the fraction is how far log(error) has come from the start
- * towards log(threshold), mapped to [0.05, 0.65] of the job. */
-static int imc_progress(void *user, long steps, double error)
+/* IMC progress -> job progress: the IMC's own fraction (log(error) from its start towards
+ * log(threshold)) mapped to [0.05, 0.65] of the job. */
+static int imc_progress(void *user, const gp_progress *p)
 {
     imc_relay *r = user;
-    double threshold = r->threshold;
-    if (r->error0 < 0.0)
-        r->error0 = error;
     if (cancelled(r->cancel))
         return 1;
     if (!r->fn)
         return 0;
-    double frac = 0.0;
-    if (error <= threshold)
-        frac = 1.0;
-    else if (r->error0 > threshold && error > 0.0)
-        frac = fmin(1.0, fmax(0.0, log(r->error0 / error) / log(r->error0 / threshold)));
-    gp_progress p = {.phase = "imc", .fraction = 0.05 + 0.6 * frac, .steps = steps, .error = error};
-    return r->fn(r->user, &p);
+    gp_progress q = *p;
+    q.fraction = 0.05 + 0.6 * p->fraction;
+    return r->fn(r->user, &q);
 }
 
 static gp_status spectrum_make(const gp_spec2d *s, size_t nmodes, double *D, gp_error *err)
@@ -742,15 +726,15 @@ static gp_status run_imc(build_ctx *b, gp_error *err)
     ip.init = spec->imc_init == GP_INIT_HALTON ? 1 : 0;
     ip.classes_size = spec->imc_classes;
     ip.classes_orient = spec->imc_classes;
-    imc_relay relay = {b->progress, b->user, b->cancel, spec->imc_threshold, -1.0};
+    imc_relay relay = {b->progress, b->user, b->cancel};
     gp_imc_report rep;
     memset(&rep, 0, sizeof rep);
-    double t0 = now_s();
+    double t0 = gp_clock_seconds();
     gp_status st = gp_imc_run(b->cont.outer, b->cont.nouter, b->cont.holes, b->cont.nhole,
                               b->cont.nholes, b->n, &ip, imc_progress, &relay, b->cancel, &b->vor,
                               &rep, err);
     out->t_tessellation = rep.t_init;
-    out->t_imc = now_s() - t0 - rep.t_init;
+    out->t_imc = gp_clock_seconds() - t0 - rep.t_init;
     /* Reaching max_steps is not a failure: the specimen is built and its warnings say how far
      * the IMC got. A threshold below the integer-count floor (refused at submit by the
      * service), a cancel or bad input end the job with the IMC's message. */
@@ -1164,7 +1148,7 @@ gp_status gp_specimen2d_build(const gp_spec2d *spec, gp_progress_fn progress, vo
     gp_status st = check_spec(spec, err);
     if (st != GP_OK)
         return st;
-    double t_start = now_s();
+    double t_start = gp_clock_seconds();
     build_ctx b;
     memset(&b, 0, sizeof b);
     b.spec = spec;
@@ -1183,7 +1167,7 @@ gp_status gp_specimen2d_build(const gp_spec2d *spec, gp_progress_fn progress, vo
         gp_specimen2d_destroy(b.out);
         return st;
     }
-    b.out->t_total = now_s() - t_start;
+    b.out->t_total = gp_clock_seconds() - t_start;
     if (progress) {
         gp_progress p = {.phase = "done", .fraction = 1.0, .steps = b.out->imc_steps,
                          .error = b.out->imc_error};

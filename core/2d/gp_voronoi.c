@@ -19,8 +19,9 @@
  *
  * - Holes and non-convex outer rings ("general" rings) are binned too. A cell whose convex
  *   polygon C reaches a bin holding general edges is intersected with the container by a
- *   hand-written convex-polygon-with-region clip (general_clip): ring chains inside C, joined
- *   along C's boundary, one loop per part. Vertex classification and crossings are computed
+ *   hand-written convex-polygon-with-region clip (general_clip, in phases: the ring edges'
+ *   entry and exit events on C, paired and sorted along C, walked into loops, holes keyholed,
+ *   loops stored): ring chains inside C, joined along C's boundary, one loop per part. Vertex classification and crossings are computed
  *   from one snapped set of signed distances, so they are consistent by construction; touching
  *   contacts (a zero-length chain) are dropped; anything still inconsistent is reported as
  *   GP_ERR_INTERNAL, never guessed. GEOS was not needed: C is convex, which makes this simple.
@@ -169,18 +170,6 @@ static double ring_area_about(const gp_vec2 *p, int32_t n, gp_vec2 r)
         s += (a.x - r.x) * (b.y - r.y) - (a.y - r.y) * (b.x - r.x);
     }
     return 0.5 * s;
-}
-
-static int pip(const gp_vec2 *p, int32_t n, gp_vec2 q)
-{
-    int c = 0;
-    for (int32_t i = 0, j = n - 1; i < n; j = i++) {
-        if ((p[i].y > q.y) != (p[j].y > q.y)) {
-            double x = p[j].x + (q.y - p[j].y) * (p[i].x - p[j].x) / (p[i].y - p[j].y);
-            if (q.x < x) c ^= 1;
-        }
-    }
-    return c;
 }
 
 static double seg_dist2(gp_vec2 q, gp_vec2 a, gp_vec2 b)
@@ -360,45 +349,16 @@ clip_hp(const gp_vec2 *sv, const int32_t *st, int32_t m, gp_vec2 o, gp_vec2 nrm,
     return w;
 }
 
-/* Minimum caliper of a convex counter-clockwise polygon: angle (radians, (-pi/2, pi/2]) of the
- * side across which the width is smallest. Same definition and tie rule as gp_min_caliper
- * (hull order from the lowest-then-leftmost vertex, first strictly smaller width wins);
- * degenerate (shorter than eps) sides are skipped, they are collinear runs of the hull. */
+/* Orientation of a convex counter-clockwise polygon: the axis angle (radians, (-pi/2, pi/2])
+ * of the side across which the width is smallest, by gp_min_caliper's rotating calipers (same
+ * start and tie rule) on squared widths; sides shorter than sqrt(eps2) are skipped, they are
+ * collinear runs of the clipped polygon. */
 static double convex_orientation(const gp_vec2 *p, int32_t m, double eps2)
 {
-    int32_t s = 0;
-    for (int32_t k = 1; k < m; k++)
-        if (p[k].y < p[s].y || (p[k].y == p[s].y && p[k].x < p[s].x)) s = k;
-    double best = INFINITY, bx = 1.0, by = 0.0;
-    int32_t j = -1; /* antipodal vertex, advanced monotonically (rotating calipers) */
-    for (int32_t c = 0; c < m; c++) {
-        int32_t k = s + c;
-        if (k >= m) k -= m;
-        int32_t k1 = k + 1 == m ? 0 : k + 1;
-        double ex = p[k1].x - p[k].x, ey = p[k1].y - p[k].y;
-        double l2 = ex * ex + ey * ey;
-        if (l2 <= eps2) continue;
-        if (j < 0) j = k1;
-        double h = ex * (p[j].y - p[k].y) - ey * (p[j].x - p[k].x);
-        for (int32_t t = 0; t < m; t++) {
-            int32_t j1 = j + 1 == m ? 0 : j + 1;
-            double nx = ex * (p[j1].y - p[k].y) - ey * (p[j1].x - p[k].x);
-            if (nx < h) break;
-            h = nx;
-            j = j1;
-        }
-        double w = h * h / l2;
-        if (w < best) {
-            best = w;
-            bx = ex;
-            by = ey;
-        }
-    }
-    double a = atan2(by, bx);
-    if (a <= -GP_VOR_PI / 2) a += GP_VOR_PI;
-    else if (a > GP_VOR_PI / 2) a -= GP_VOR_PI;
-    if (a <= -GP_VOR_PI / 2) a = GP_VOR_PI / 2;
-    return a;
+    size_t k = gp_min_caliper_edge(p, (size_t)m, eps2, 1);
+    if (k == (size_t)m) return gp_axis_angle(1.0, 0.0);
+    size_t k1 = k + 1 == (size_t)m ? 0 : k + 1;
+    return gp_axis_angle(p[k1].x - p[k].x, p[k1].y - p[k].y);
 }
 
 static int vlt(const void *a, const void *b)
@@ -530,10 +490,26 @@ static int keyhole(gp_voronoi *v, int32_t *nlv, int32_t li, int32_t nloops, int3
     return 0;
 }
 
-/* C = (P, T, m), CCW convex. gathered general edges in v->gedges[0..ng). Builds the parts of
- * C intersected with the container into out. Returns GP_OK or an error code. */
-static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const int32_t *T,
-                              int32_t m, int32_t ng, vcell *out)
+/* The general clip of one cell: C = (P, T, m), convex and counter-clockwise, intersected with
+ * the general rings near it (their edges gathered in v->gedges[0 .. ng), sorted). The phases
+ * below run in order over this state; the loops being built live in v->lv / v->lt, their
+ * offsets in v->lpo. */
+typedef struct clip_run {
+    gp_voronoi *v;
+    gp_vec2 s;            /* the seed */
+    const gp_vec2 *P;
+    const int32_t *T;
+    int32_t m, ng;
+    uint32_t es;          /* this clip's stamp in v->eslot_st */
+    double dup;           /* points closer than this (per coordinate) are one */
+    int32_t ne;           /* events in v->ev */
+    int32_t nk;           /* events kept, in boundary order in ord[0 .. nk) */
+    int32_t *ord, *used;
+    int32_t nlv, nloops;  /* vertices and loops built */
+} clip_run;
+
+/* The lines of C's edges: direction (lex, ley) and snapping tolerance leps. */
+static gp_status clip_lines(gp_voronoi *v, const gp_vec2 *P, int32_t m)
 {
     if (m > v->lcap) {
         int32_t c = v->lcap ? v->lcap : 16;
@@ -546,7 +522,6 @@ static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const 
         }
         v->lcap = c;
     }
-    double *da = v->da, *db = v->db;
     const double epsr = 1e-13 * v->L;
     for (int32_t k = 0; k < m; k++) {
         int32_t k1 = k + 1 == m ? 0 : k + 1;
@@ -554,87 +529,107 @@ static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const 
         v->ley[k] = P[k1].y - P[k].y;
         v->leps[k] = epsr * (fabs(v->lex[k]) + fabs(v->ley[k]));
     }
+    return GP_OK;
+}
+
+/* The entry and exit of ring edge e through C, as events keyed by their position along C's
+ * boundary (line k + parameter on it). Both come from one snapped set of signed distances
+ * (line_d), so classification and crossings agree by construction. */
+static gp_status edge_events(clip_run *R, int32_t e)
+{
+    gp_voronoi *v = R->v;
+    const gp_vec2 *P = R->P;
+    const int32_t m = R->m;
+    double *da = v->da, *db = v->db;
+    gp_vec2 a = v->rv[e], b = v->rv[v->enext[e]];
+    int ain = 1, bin = 1;
+    for (int32_t k = 0; k < m; k++) {
+        da[k] = line_d(v, P, k, a);
+        db[k] = line_d(v, P, k, b);
+        if (da[k] < 0) ain = 0;
+        if (db[k] < 0) bin = 0;
+    }
+    v->rst[v->ering[e]] = 1;
+    v->eslot_st[e] = R->es;
+    v->eslot_in[e] = -1;
+    v->eslot_out[e] = -1;
+    if (ain && bin) return GP_OK;
+    double t0 = 0.0, t1 = 1.0;
+    int32_t k0 = -1, k1 = -1;
+    for (int32_t k = 0; k < m; k++) {
+        if (da[k] < 0 && db[k] < 0) return GP_OK; /* wholly outside one line */
+        if (da[k] < 0) {
+            double t = da[k] / (da[k] - db[k]);
+            if (t > t0 || k0 < 0) {
+                t0 = t;
+                k0 = k;
+            }
+        } else if (db[k] < 0) {
+            double t = da[k] / (da[k] - db[k]);
+            if (t < t1 || k1 < 0) {
+                t1 = t;
+                k1 = k;
+            }
+        }
+    }
+    int want_in = !ain, want_out = !bin;
+    if (!ain && !bin && !(t0 < t1)) return GP_OK;
+    if (R->ne + 2 > v->evcap && grow((void **)&v->ev, &v->evcap, R->ne + 2, sizeof(vevent)))
+        return GP_ERR_NOMEM;
+    for (int w = 0; w < 2; w++) {
+        if (w == 0 && !want_in) continue;
+        if (w == 1 && !want_out) continue;
+        double t = w == 0 ? t0 : t1;
+        int32_t k = w == 0 ? k0 : k1;
+        if (k < 0) return GP_ERR_INTERNAL;
+        vevent *E = &v->ev[R->ne];
+        E->p.x = a.x + t * (b.x - a.x);
+        E->p.y = a.y + t * (b.y - a.y);
+        if (t == 0.0) E->p = a;
+        if (t == 1.0) E->p = b;
+        double l2 = v->lex[k] * v->lex[k] + v->ley[k] * v->ley[k];
+        double sp = ((E->p.x - P[k].x) * v->lex[k] + (E->p.y - P[k].y) * v->ley[k]) / l2;
+        if (!(sp >= 0)) sp = 0;
+        if (sp > 1) sp = 1;
+        E->key = k + sp;
+        E->edge = e;
+        E->line = k;
+        E->type = w;
+        E->mate = -1;
+        E->dropped = 0;
+        if (w == 0) v->eslot_in[e] = R->ne;
+        else v->eslot_out[e] = R->ne;
+        v->rev[v->ering[e]] = 1;
+        R->ne++;
+    }
+    return GP_OK;
+}
+
+/* Events of every gathered edge; per ring, whether it was seen (rst) and crossed (rev). */
+static gp_status clip_events(clip_run *R)
+{
+    gp_voronoi *v = R->v;
     stamp_next(&v->gstamp, v->eslot_st, v->nedges);
-    uint32_t es = v->gstamp;
-    int32_t ne = 0;
-    /* per ring: seen / raw events */
+    R->es = v->gstamp;
+    R->ne = 0;
     for (uint32_t r = 0; r < v->nrings; r++) {
         v->rst[r] = 0;
         v->rev[r] = 0;
     }
-    for (int32_t g = 0; g < ng; g++) {
-        int32_t e = v->gedges[g];
-        gp_vec2 a = v->rv[e], b = v->rv[v->enext[e]];
-        int ain = 1, bin = 1;
-        for (int32_t k = 0; k < m; k++) {
-            da[k] = line_d(v, P, k, a);
-            db[k] = line_d(v, P, k, b);
-            if (da[k] < 0) ain = 0;
-            if (db[k] < 0) bin = 0;
-        }
-        v->rst[v->ering[e]] = 1;
-        v->eslot_st[e] = es;
-        v->eslot_in[e] = -1;
-        v->eslot_out[e] = -1;
-        if (ain && bin) continue;
-        double t0 = 0.0, t1 = 1.0;
-        int32_t k0 = -1, k1 = -1, none = 0;
-        for (int32_t k = 0; k < m; k++) {
-            if (da[k] < 0 && db[k] < 0) {
-                none = 1;
-                break;
-            }
-            if (da[k] < 0) {
-                double t = da[k] / (da[k] - db[k]);
-                if (t > t0 || k0 < 0) {
-                    t0 = t;
-                    k0 = k;
-                }
-            } else if (db[k] < 0) {
-                double t = da[k] / (da[k] - db[k]);
-                if (t < t1 || k1 < 0) {
-                    t1 = t;
-                    k1 = k;
-                }
-            }
-        }
-        if (none) continue;
-        int want_in = !ain, want_out = !bin;
-        if (!ain && !bin && !(t0 < t1)) continue;
-        if (ne + 2 > v->evcap && grow((void **)&v->ev, &v->evcap, ne + 2, sizeof(vevent)))
-            return GP_ERR_NOMEM;
-        for (int w = 0; w < 2; w++) {
-            if (w == 0 && !want_in) continue;
-            if (w == 1 && !want_out) continue;
-            double t = w == 0 ? t0 : t1;
-            int32_t k = w == 0 ? k0 : k1;
-            if (k < 0) return GP_ERR_INTERNAL;
-            vevent *E = &v->ev[ne];
-            E->p.x = a.x + t * (b.x - a.x);
-            E->p.y = a.y + t * (b.y - a.y);
-            if (t == 0.0) E->p = a;
-            if (t == 1.0) E->p = b;
-            int32_t kk = k + 1 == m ? 0 : k + 1;
-            double l2 = v->lex[k] * v->lex[k] + v->ley[k] * v->ley[k];
-            double sp = ((E->p.x - P[k].x) * v->lex[k] + (E->p.y - P[k].y) * v->ley[k]) / l2;
-            (void)kk;
-            if (!(sp >= 0)) sp = 0;
-            if (sp > 1) sp = 1;
-            E->key = k + sp;
-            E->edge = e;
-            E->line = k;
-            E->type = w;
-            E->mate = -1;
-            E->dropped = 0;
-            if (w == 0) v->eslot_in[e] = ne;
-            else v->eslot_out[e] = ne;
-            v->rev[v->ering[e]] = 1;
-            ne++;
-        }
+    for (int32_t g = 0; g < R->ng; g++) {
+        gp_status st = edge_events(R, v->gedges[g]);
+        if (st != GP_OK) return st;
     }
-    /* pair each entry with the exit that ends its chain; drop touching (zero-length) chains */
-    const double dup = 1e-12 * v->L;
-    for (int32_t q = 0; q < ne; q++) {
+    return GP_OK;
+}
+
+/* Pairs each entry with the exit that ends its ring chain inside C; a touching contact (a
+ * chain of at most one ring vertex within dup) is dropped. Every event must find its mate. */
+static gp_status clip_pair(clip_run *R)
+{
+    gp_voronoi *v = R->v;
+    const double dup = R->dup;
+    for (int32_t q = 0; q < R->ne; q++) {
         vevent *E = &v->ev[q];
         if (E->type != 0) continue;
         int32_t e = E->edge, nint = 0, steps = 0, r = v->ering[e];
@@ -649,7 +644,7 @@ static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const 
             if (p.y > y1) y1 = p.y;
             nint++;
             e = vx;
-            if (v->eslot_st[e] != es || ++steps > ringlen) return GP_ERR_INTERNAL;
+            if (v->eslot_st[e] != R->es || ++steps > ringlen) return GP_ERR_INTERNAL;
         }
         int32_t xq = v->eslot_out[e];
         vevent *X = &v->ev[xq];
@@ -661,11 +656,18 @@ static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const 
         X->mate = q;
         if (nint <= 1 && x1 - x0 <= dup && y1 - y0 <= dup) E->dropped = X->dropped = 1;
     }
-    for (int32_t q = 0; q < ne; q++)
+    for (int32_t q = 0; q < R->ne; q++)
         if (v->ev[q].mate < 0) return GP_ERR_INTERNAL;
-    /* sort the kept events along the boundary of C */
+    return GP_OK;
+}
+
+/* The kept events in order along C's boundary (key, then exits before entries, then edge). */
+static gp_status clip_sort(clip_run *R)
+{
+    gp_voronoi *v = R->v;
+    const int32_t ne = R->ne;
     if (grow((void **)&v->evs, &v->evscap, 2 * ne + 2, sizeof(int32_t))) return GP_ERR_NOMEM;
-    int32_t *ord = v->evs, *used = v->evs + ne + 1;
+    int32_t *ord = v->evs;
     int32_t nk = 0;
     for (int32_t q = 0; q < ne; q++) {
         if (v->ev[q].dropped) continue;
@@ -681,96 +683,126 @@ static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const 
         ord[k] = q;
     }
     for (int32_t k = 0; k < nk; k++) v->ev[ord[k]].pos = k;
-    gp_status st = GP_OK;
-    int32_t nlv = 0, nloops = 0;
-    if (grow((void **)&v->lpo, &v->lpcap, 2, sizeof(int32_t))) return GP_ERR_NOMEM;
-    v->lpo[0] = 0;
-    if (nk > 0) {
-        /* along C the kept events must alternate exit, entry, exit, ... */
-        if (nk % 2) st = GP_ERR_INTERNAL;
-        int32_t f = v->ev[ord[0]].type;
-        for (int32_t k = 0; st == GP_OK && k < nk; k++)
-            if (v->ev[ord[k]].type != ((f + k) & 1)) st = GP_ERR_INTERNAL;
-        for (int32_t k = 0; k < nk; k++) used[k] = 0;
-        for (int32_t k0 = 0; st == GP_OK && k0 < nk; k0++) {
-            if (used[k0] || v->ev[ord[k0]].type != 1) continue;
-            int32_t b = nlv, k = k0, guard = 0;
+    R->ord = ord;
+    R->used = v->evs + ne + 1;
+    R->nk = nk;
+    return GP_OK;
+}
+
+/* One loop from exit k0: along C to the next entry, then along the ring to its exit, and so
+ * on until back at k0. */
+static gp_status clip_walk(clip_run *R, int32_t k0)
+{
+    gp_voronoi *v = R->v;
+    const int32_t m = R->m, nk = R->nk, *ord = R->ord;
+    int32_t k = k0, guard = 0;
+    do {
+        const vevent *X = &v->ev[ord[k]];
+        R->used[k] = 1;
+        const vevent *E = &v->ev[ord[(k + 1) % nk]];
+        if (push_lv(v, &R->nlv, X->p, R->T[X->line])) return GP_ERR_NOMEM;
+        if (!(E->line == X->line && E->key >= X->key)) {
+            int32_t c = X->line;
             do {
-                const vevent *X = &v->ev[ord[k]];
-                used[k] = 1;
-                const vevent *E = &v->ev[ord[(k + 1) % nk]];
-                if (push_lv(v, &nlv, X->p, T[X->line])) { st = GP_ERR_NOMEM; break; }
-                if (!(E->line == X->line && E->key >= X->key)) {
-                    int32_t c = X->line;
-                    do {
-                        c = c + 1 == m ? 0 : c + 1;
-                        if (push_lv(v, &nlv, P[c], T[c])) { st = GP_ERR_NOMEM; break; }
-                    } while (c != E->line);
-                }
-                if (push_lv(v, &nlv, E->p, -(E->edge + 2))) { st = GP_ERR_NOMEM; break; }
-                int32_t e = E->edge;
-                while (v->eslot_out[e] < 0) {
-                    int32_t vx = v->enext[e];
-                    if (push_lv(v, &nlv, v->rv[vx], -(vx + 2))) { st = GP_ERR_NOMEM; break; }
-                    e = vx;
-                }
-                k = v->ev[v->eslot_out[e]].pos;
-                if (++guard > nk) st = GP_ERR_INTERNAL;
-            } while (st == GP_OK && k != k0);
-            if (st != GP_OK) break;
-            nlv = dedup_loop(v, b, nlv, dup);
-            if (nlv - b < 3) {
-                nlv = b;
-                continue;
-            }
-            if (grow((void **)&v->lpo, &v->lpcap, nloops + 2, sizeof(int32_t))) { st = GP_ERR_NOMEM; break; }
-            v->lpo[++nloops] = nlv;
+                c = c + 1 == m ? 0 : c + 1;
+                if (push_lv(v, &R->nlv, R->P[c], R->T[c])) return GP_ERR_NOMEM;
+            } while (c != E->line);
         }
-    } else {
-        /* no crossing: C lies inside the region, or a general outer ring lies inside C */
-        int outer_in = 0;
-        if (!v->outer_convex && v->rst[0] && !v->rev[0]) {
-            int in = 1;
-            for (int32_t k = 0; k < m; k++)
-                if (line_d(v, P, k, v->rv[0]) < 0) in = 0;
-            outer_in = in;
+        if (push_lv(v, &R->nlv, E->p, -(E->edge + 2))) return GP_ERR_NOMEM;
+        int32_t e = E->edge;
+        while (v->eslot_out[e] < 0) {
+            int32_t vx = v->enext[e];
+            if (push_lv(v, &R->nlv, v->rv[vx], -(vx + 2))) return GP_ERR_NOMEM;
+            e = vx;
         }
-        if (outer_in) {
-            for (uint32_t k = v->roff[0]; k < v->roff[1] && st == GP_OK; k++)
-                if (push_lv(v, &nlv, v->rv[k], -((int32_t)k + 2))) st = GP_ERR_NOMEM;
-        } else {
-            for (int32_t k = 0; k < m && st == GP_OK; k++)
-                if (push_lv(v, &nlv, P[k], T[k])) st = GP_ERR_NOMEM;
+        k = v->ev[v->eslot_out[e]].pos;
+        if (++guard > nk) return GP_ERR_INTERNAL;
+    } while (k != k0);
+    return GP_OK;
+}
+
+/* The loops when rings cross C: along C the kept events must alternate exit, entry, exit,
+ * ...; each unused exit starts a loop; loops of fewer than 3 distinct points are dropped. */
+static gp_status clip_loops_crossing(clip_run *R)
+{
+    gp_voronoi *v = R->v;
+    const int32_t nk = R->nk;
+    if (nk % 2) return GP_ERR_INTERNAL;
+    int32_t f = v->ev[R->ord[0]].type;
+    for (int32_t k = 0; k < nk; k++)
+        if (v->ev[R->ord[k]].type != ((f + k) & 1)) return GP_ERR_INTERNAL;
+    for (int32_t k = 0; k < nk; k++) R->used[k] = 0;
+    for (int32_t k0 = 0; k0 < nk; k0++) {
+        if (R->used[k0] || v->ev[R->ord[k0]].type != 1) continue;
+        int32_t b = R->nlv;
+        gp_status st = clip_walk(R, k0);
+        if (st != GP_OK) return st;
+        R->nlv = dedup_loop(v, b, R->nlv, R->dup);
+        if (R->nlv - b < 3) {
+            R->nlv = b;
+            continue;
         }
-        if (st == GP_OK) {
-            if (grow((void **)&v->lpo, &v->lpcap, 2, sizeof(int32_t))) st = GP_ERR_NOMEM;
-            else v->lpo[++nloops] = nlv;
-        }
+        if (grow((void **)&v->lpo, &v->lpcap, R->nloops + 2, sizeof(int32_t))) return GP_ERR_NOMEM;
+        v->lpo[++R->nloops] = R->nlv;
     }
-    if (st != GP_OK) return st;
-    /* holes entirely inside C: keyhole them into the loop that holds them */
+    return GP_OK;
+}
+
+/* No crossing: C lies inside the region (the loop is C), or a general outer ring lies inside C
+ * (the loop is that ring). */
+static gp_status clip_loops_inside(clip_run *R)
+{
+    gp_voronoi *v = R->v;
+    int outer_in = 0;
+    if (!v->outer_convex && v->rst[0] && !v->rev[0]) {
+        int in = 1;
+        for (int32_t k = 0; k < R->m; k++)
+            if (line_d(v, R->P, k, v->rv[0]) < 0) in = 0;
+        outer_in = in;
+    }
+    if (outer_in) {
+        for (uint32_t k = v->roff[0]; k < v->roff[1]; k++)
+            if (push_lv(v, &R->nlv, v->rv[k], -((int32_t)k + 2))) return GP_ERR_NOMEM;
+    } else {
+        for (int32_t k = 0; k < R->m; k++)
+            if (push_lv(v, &R->nlv, R->P[k], R->T[k])) return GP_ERR_NOMEM;
+    }
+    if (grow((void **)&v->lpo, &v->lpcap, 2, sizeof(int32_t))) return GP_ERR_NOMEM;
+    v->lpo[++R->nloops] = R->nlv;
+    return GP_OK;
+}
+
+/* Holes lying entirely inside C: each is keyholed into the loop that holds it. */
+static gp_status clip_keyholes(clip_run *R)
+{
+    gp_voronoi *v = R->v;
     for (uint32_t r = 1; r < v->nrings; r++) {
         if (!v->rst[r] || v->rev[r]) continue;
         gp_vec2 h0 = v->rv[v->roff[r]];
         int in = 1;
-        for (int32_t k = 0; k < m; k++)
-            if (line_d(v, P, k, h0) < 0) in = 0;
+        for (int32_t k = 0; k < R->m; k++)
+            if (line_d(v, R->P, k, h0) < 0) in = 0;
         if (!in) continue;
-        for (int32_t li = 0; li < nloops; li++) {
-            if (pip(v->lv + v->lpo[li], v->lpo[li + 1] - v->lpo[li], h0)) {
-                if (keyhole(v, &nlv, li, nloops, (int32_t)r)) return GP_ERR_NOMEM;
+        for (int32_t li = 0; li < R->nloops; li++) {
+            if (gp_poly_contains(v->lv + v->lpo[li], (size_t)(v->lpo[li + 1] - v->lpo[li]), h0)) {
+                if (keyhole(v, &R->nlv, li, R->nloops, (int32_t)r)) return GP_ERR_NOMEM;
                 break;
             }
         }
     }
-    /* areas; drop zero-area artefacts; all loops must be counter-clockwise */
+    return GP_OK;
+}
+
+/* The loops into out: zero-area artefacts dropped, every other loop counter-clockwise. */
+static gp_status clip_store(clip_run *R, vcell *out)
+{
+    gp_voronoi *v = R->v;
     const double amin = 1e-24 * v->L * v->L;
     int32_t w = 0, wv = 0;
     double total = 0.0;
-    int32_t nbk = 0;
-    for (int32_t li = 0; li < nloops; li++) {
+    for (int32_t li = 0; li < R->nloops; li++) {
         int32_t b = v->lpo[li], e = v->lpo[li + 1];
-        double a = ring_area_about(v->lv + b, e - b, s);
+        double a = ring_area_about(v->lv + b, e - b, R->s);
         if (a < -amin) return GP_ERR_INTERNAL;
         if (a <= amin) continue;
         total += a;
@@ -781,26 +813,32 @@ static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const 
         v->lpo[w] = wv;
         wv += e - b;
         w++;
-        (void)nbk;
     }
     v->lpo[w] = wv;
-    nloops = w;
-    if (nloops == 0) return GP_ERR_INTERNAL;
-    if (cell_reserve(out, wv, nloops, out->nnb)) return GP_ERR_NOMEM;
+    R->nloops = w;
+    if (w == 0) return GP_ERR_INTERNAL;
+    if (cell_reserve(out, wv, w, out->nnb)) return GP_ERR_NOMEM;
     memcpy(out->v, v->lv, (size_t)wv * sizeof(gp_vec2));
     memcpy(out->tag, v->lt, (size_t)wv * sizeof(int32_t));
-    memcpy(out->poff, v->lpo, (size_t)(nloops + 1) * sizeof(int32_t));
+    memcpy(out->poff, v->lpo, (size_t)(w + 1) * sizeof(int32_t));
     out->nv = wv;
-    out->nparts = nloops;
+    out->nparts = w;
     out->area = total;
     out->convex = 0;
-    /* the seed's part */
+    return GP_OK;
+}
+
+/* The part that holds the seed (for a seed on a part boundary, the part nearest to it), and
+ * the cell's orientation: the minimum caliper of the hull of that part. */
+static gp_status seed_part_orientation(gp_voronoi *v, vcell *out, gp_vec2 s)
+{
     int32_t sp = -1;
-    for (int32_t li = 0; li < nloops && sp < 0; li++)
-        if (pip(out->v + out->poff[li], out->poff[li + 1] - out->poff[li], s)) sp = li;
+    for (int32_t li = 0; li < out->nparts && sp < 0; li++)
+        if (gp_poly_contains(out->v + out->poff[li], (size_t)(out->poff[li + 1] - out->poff[li]), s))
+            sp = li;
     if (sp < 0) {
         double bd = INFINITY;
-        for (int32_t li = 0; li < nloops; li++) {
+        for (int32_t li = 0; li < out->nparts; li++) {
             int32_t b = out->poff[li], e = out->poff[li + 1];
             for (int32_t k = b; k < e; k++) {
                 double d = seg_dist2(s, out->v[k], out->v[k + 1 < e ? k + 1 : b]);
@@ -812,7 +850,6 @@ static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const 
         }
     }
     out->seed_part = sp;
-    /* orientation: min caliper of the hull of the seed's part */
     int32_t b = out->poff[sp], e = out->poff[sp + 1], np = e - b;
     if (grow((void **)&v->hv, &v->hcap, 3 * np + 2, sizeof(gp_vec2))) return GP_ERR_NOMEM;
     memcpy(v->hv, out->v + b, (size_t)np * sizeof(gp_vec2));
@@ -820,6 +857,27 @@ static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const 
     if (hn < 3) return GP_ERR_INTERNAL;
     out->orient = convex_orientation(v->hv + np, hn, (1e-13 * v->L) * (1e-13 * v->L));
     return GP_OK;
+}
+
+/* C = (P, T, m), CCW convex, against the general edges gathered in v->gedges[0..ng): the parts
+ * of C intersected with the container, into out. GP_OK or an error code. */
+static gp_status general_clip(gp_voronoi *v, gp_vec2 s, const gp_vec2 *P, const int32_t *T,
+                              int32_t m, int32_t ng, vcell *out)
+{
+    clip_run R = {.v = v, .s = s, .P = P, .T = T, .m = m, .ng = ng, .dup = 1e-12 * v->L};
+    gp_status st = clip_lines(v, P, m);
+    if (st == GP_OK) st = clip_events(&R);
+    if (st == GP_OK) st = clip_pair(&R);
+    if (st == GP_OK) st = clip_sort(&R);
+    if (st == GP_OK && grow((void **)&v->lpo, &v->lpcap, 2, sizeof(int32_t))) st = GP_ERR_NOMEM;
+    if (st == GP_OK) {
+        v->lpo[0] = 0;
+        st = R.nk > 0 ? clip_loops_crossing(&R) : clip_loops_inside(&R);
+    }
+    if (st == GP_OK) st = clip_keyholes(&R);
+    if (st == GP_OK) st = clip_store(&R, out);
+    if (st == GP_OK) st = seed_part_orientation(v, out, s);
+    return st;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -907,128 +965,162 @@ static gp_status compute_cell(gp_voronoi *v, uint32_t i, vcell *out)
     return st;
 }
 
-static gp_status compute_cell_box(gp_voronoi *v, uint32_t i, vcell *out, int full)
+/* One cell being clipped: the polygon is in sa/ta (ina) or sb/tb, m vertices; rmax2 is the
+ * squared distance from the seed to its farthest vertex (no seed 2 Rmax away can cut it). */
+typedef struct cell_run {
+    gp_voronoi *v;
+    uint32_t i;
+    gp_vec2 s;           /* the seed */
+    int32_t m;
+    int ina;
+    double rmax2;
+    uint32_t es;         /* this cell's stamp in v->estamp */
+    int32_t bx, by;      /* the seed's bin */
+    double epsr;
+} cell_run;
+
+/* The starting polygon: the box B, or (full == 0) its part within 2 bins of the seed, whose
+ * sides are tagged TAG_SMALL. */
+static gp_status cell_start(cell_run *R, gp_voronoi *v, uint32_t i, int full)
 {
     const gp_vec2 s = v->seed[i];
     if (scratch_reserve(v, 64)) return GP_ERR_NOMEM;
-    int ina = 1;
     gp_vec2 *cv = v->sa;
     int32_t *ct = v->ta;
-    int32_t m = 4;
-    {
-        double r0 = 2.0 * fmax(v->hx, v->hy);
-        double x0 = v->bmin.x, y0 = v->bmin.y, x1 = v->bmax.x, y1 = v->bmax.y;
-        ct[0] = TAG_B;
-        ct[1] = TAG_B + 1;
-        ct[2] = TAG_B + 2;
-        ct[3] = TAG_B + 3;
-        if (!full) {
-            if (s.y - r0 > y0) { y0 = s.y - r0; ct[0] = TAG_SMALL; }
-            if (s.x + r0 < x1) { x1 = s.x + r0; ct[1] = TAG_SMALL; }
-            if (s.y + r0 < y1) { y1 = s.y + r0; ct[2] = TAG_SMALL; }
-            if (s.x - r0 > x0) { x0 = s.x - r0; ct[3] = TAG_SMALL; }
-        }
-        cv[0] = (gp_vec2){x0, y0};
-        cv[1] = (gp_vec2){x1, y0};
-        cv[2] = (gp_vec2){x1, y1};
-        cv[3] = (gp_vec2){x0, y1};
+    double r0 = 2.0 * fmax(v->hx, v->hy);
+    double x0 = v->bmin.x, y0 = v->bmin.y, x1 = v->bmax.x, y1 = v->bmax.y;
+    ct[0] = TAG_B;
+    ct[1] = TAG_B + 1;
+    ct[2] = TAG_B + 2;
+    ct[3] = TAG_B + 3;
+    if (!full) {
+        if (s.y - r0 > y0) { y0 = s.y - r0; ct[0] = TAG_SMALL; }
+        if (s.x + r0 < x1) { x1 = s.x + r0; ct[1] = TAG_SMALL; }
+        if (s.y + r0 < y1) { y1 = s.y + r0; ct[2] = TAG_SMALL; }
+        if (s.x - r0 > x0) { x0 = s.x - r0; ct[3] = TAG_SMALL; }
     }
+    cv[0] = (gp_vec2){x0, y0};
+    cv[1] = (gp_vec2){x1, y0};
+    cv[2] = (gp_vec2){x1, y1};
+    cv[3] = (gp_vec2){x0, y1};
     double rmax2 = 0.0;
     for (int32_t k = 0; k < 4; k++) {
         double dx = cv[k].x - s.x, dy = cv[k].y - s.y, d2 = dx * dx + dy * dy;
         if (d2 > rmax2) rmax2 = d2;
     }
     stamp_next(&v->stamp, v->estamp, v->nedges);
-    const uint32_t es = v->stamp;
-    const int32_t bx = bin_x(v, s.x), by = bin_y(v, s.y);
-    const double epsr = 1e-13 * v->L;
-    const int conv = v->outer_convex;
-    /* rings 0 and 1 form the first batch, then one ring per batch; inside a batch the seeds are
-     * clipped nearest first (the near ones shrink the polygon, the far ones then fail the cheap
-     * distance test). The result does not depend on this order (canonical vertices). */
-    for (int32_t r = 0;; r++) {
-        int32_t rlo = r == 1 ? 1 : r, nc = 0;
-        if (r == 0) r = 1;
-        for (int32_t rr = r == 1 ? 0 : rlo; rr <= r; rr++) {
-            int32_t y0 = by - rr, y1 = by + rr;
-            for (int32_t yy = y0 < 0 ? 0 : y0; yy <= y1 && yy < v->nby; yy++) {
-                int edge_row = (yy == y0 || yy == y1);
-                int32_t step = edge_row ? 1 : 2 * rr;
-                for (int32_t xx = bx - rr; xx <= bx + rr; xx += (step ? step : 1)) {
-                    if (xx < 0 || xx >= v->nbx) continue;
-                    double lx = xx * v->hx, ux = lx + v->hx, ly = yy * v->hy, uy = ly + v->hy;
-                    double dx = s.x < lx ? lx - s.x : (s.x > ux ? s.x - ux : 0.0);
-                    double dy = s.y < ly ? ly - s.y : (s.y > uy ? s.y - uy : 0.0);
-                    double md2 = dx * dx + dy * dy;
-                    if (md2 >= 4.0 * rmax2) continue;
-                    int32_t b = yy * v->nbx + xx;
-                    if (conv && md2 <= rmax2) {
-                        for (uint32_t q = v->ce_off[b]; q < v->ce_off[b + 1]; q++) {
-                            uint32_t e = v->ce[q];
-                            if (v->estamp[e] == es) continue;
-                            v->estamp[e] = es;
-                            gp_vec2 a = v->rv[e], c = v->rv[v->enext[e]];
-                            gp_vec2 nrm = {c.y - a.y, a.x - c.x};
-                            gp_status st = clip_step(v, &m, &ina, a, nrm, epsr * (fabs(nrm.x) + fabs(nrm.y)),
-                                                     -(int32_t)e - 2, s, &rmax2);
-                            if (st != GP_OK) return st;
-                        }
-                    }
-                    vbin *bn = &v->bins[b];
-                    const int32_t *it = bin_items(bn);
-                    if (nc + bn->cnt > v->candcap) {
-                        int32_t c0 = v->candcap;
-                        if (grow((void **)&v->cand_d, &c0, nc + bn->cnt, sizeof(double))) return GP_ERR_NOMEM;
-                        c0 = v->candcap;
-                        if (grow((void **)&v->cand_j, &c0, nc + bn->cnt, sizeof(int32_t))) return GP_ERR_NOMEM;
-                        v->candcap = c0;
-                    }
-                    for (int32_t q = 0; q < bn->cnt; q++) {
-                        int32_t j = it[q];
-                        if ((uint32_t)j == i) continue;
-                        double nx = v->seed[j].x - s.x, ny = v->seed[j].y - s.y, d2 = nx * nx + ny * ny;
-                        if (d2 >= 4.0 * rmax2) continue;
-                        v->cand_d[nc] = d2;
-                        v->cand_j[nc++] = j;
-                    }
-                }
-            }
-        }
-        for (int32_t q = 0; q < nc; q++) {
-            if (r == 1 && q < 8) { /* partial selection sort: the nearest few first */
-                int32_t b = q;
-                for (int32_t k = q + 1; k < nc; k++)
-                    if (v->cand_d[k] < v->cand_d[b]) b = k;
-                double td = v->cand_d[q];
-                int32_t tj = v->cand_j[q];
-                v->cand_d[q] = v->cand_d[b];
-                v->cand_j[q] = v->cand_j[b];
-                v->cand_d[b] = td;
-                v->cand_j[b] = tj;
-            }
-            if (v->cand_d[q] >= 4.0 * rmax2) continue;
-            int32_t j = v->cand_j[q];
-            double nx = v->seed[j].x - s.x, ny = v->seed[j].y - s.y;
-            gp_vec2 mid = {s.x + 0.5 * nx, s.y + 0.5 * ny};
-            gp_status st = clip_step(v, &m, &ina, mid, (gp_vec2){nx, ny}, epsr * (fabs(nx) + fabs(ny)), j,
-                                     s, &rmax2);
+    *R = (cell_run){.v = v, .i = i, .s = s, .m = 4, .ina = 1, .rmax2 = rmax2, .es = v->stamp,
+                    .bx = bin_x(v, s.x), .by = bin_y(v, s.y), .epsr = 1e-13 * v->L};
+    return GP_OK;
+}
+
+/* Bin b (nearest point md2 from the seed): clips by the convex outer ring's edges in it (their
+ * half-planes contain the container, so a convex container costs nothing extra), and appends
+ * its seeds closer than 2 Rmax to the candidates v->cand_d / cand_j [*nc ..). */
+static gp_status cell_bin(cell_run *R, int32_t b, double md2, int32_t *nc)
+{
+    gp_voronoi *v = R->v;
+    const gp_vec2 s = R->s;
+    if (v->outer_convex && md2 <= R->rmax2) {
+        for (uint32_t q = v->ce_off[b]; q < v->ce_off[b + 1]; q++) {
+            uint32_t e = v->ce[q];
+            if (v->estamp[e] == R->es) continue;
+            v->estamp[e] = R->es;
+            gp_vec2 a = v->rv[e], c = v->rv[v->enext[e]];
+            gp_vec2 nrm = {c.y - a.y, a.x - c.x};
+            gp_status st = clip_step(v, &R->m, &R->ina, a, nrm, R->epsr * (fabs(nrm.x) + fabs(nrm.y)),
+                                     -(int32_t)e - 2, s, &R->rmax2);
             if (st != GP_OK) return st;
         }
-        /* stop when every seed outside the block of rings 0..r is at least 2 Rmax away */
-        double dmin = INFINITY;
-        if (bx - r > 0) dmin = fmin(dmin, s.x - (bx - r) * v->hx);
-        if (bx + r < v->nbx - 1) dmin = fmin(dmin, (bx + r + 1) * v->hx - s.x);
-        if (by - r > 0) dmin = fmin(dmin, s.y - (by - r) * v->hy);
-        if (by + r < v->nby - 1) dmin = fmin(dmin, (by + r + 1) * v->hy - s.y);
-        if (dmin == INFINITY) break;
-        if (dmin > 0 && dmin * dmin >= 4.0 * rmax2) break;
     }
-    for (int32_t k = 0; k < m; k++)
-        if ((ina ? v->ta : v->tb)[k] == TAG_SMALL) return GP_ERR_NOT_CONVERGED; /* box too small */
-    cv = ina ? v->sb : v->sa; /* canonical copy into the other buffer */
-    ct = ina ? v->tb : v->ta;
-    canonicalise(v, s, ina ? v->sa : v->sb, ina ? v->ta : v->tb, m, cv, ct);
-    /* neighbours of C (sorted, unique: each line appears once in a convex polygon) */
+    vbin *bn = &v->bins[b];
+    const int32_t *it = bin_items(bn);
+    if (*nc + bn->cnt > v->candcap) {
+        int32_t c0 = v->candcap;
+        if (grow((void **)&v->cand_d, &c0, *nc + bn->cnt, sizeof(double))) return GP_ERR_NOMEM;
+        c0 = v->candcap;
+        if (grow((void **)&v->cand_j, &c0, *nc + bn->cnt, sizeof(int32_t))) return GP_ERR_NOMEM;
+        v->candcap = c0;
+    }
+    for (int32_t q = 0; q < bn->cnt; q++) {
+        int32_t j = it[q];
+        if ((uint32_t)j == R->i) continue;
+        double nx = v->seed[j].x - s.x, ny = v->seed[j].y - s.y, d2 = nx * nx + ny * ny;
+        if (d2 >= 4.0 * R->rmax2) continue;
+        v->cand_d[*nc] = d2;
+        v->cand_j[(*nc)++] = j;
+    }
+    return GP_OK;
+}
+
+/* Batch r: the bins of rings (r == 1 ? 0 : r) .. r around the seed's bin, skipping those at
+ * least 2 Rmax away; then their candidate seeds' bisectors, nearest first in the first batch
+ * (the near ones shrink the polygon, the far ones then fail the cheap distance test). The
+ * result does not depend on this order (canonical vertices). */
+static gp_status cell_batch(cell_run *R, int32_t r)
+{
+    gp_voronoi *v = R->v;
+    const gp_vec2 s = R->s;
+    const int32_t bx = R->bx, by = R->by;
+    int32_t nc = 0;
+    for (int32_t rr = r == 1 ? 0 : r; rr <= r; rr++) {
+        int32_t y0 = by - rr, y1 = by + rr;
+        for (int32_t yy = y0 < 0 ? 0 : y0; yy <= y1 && yy < v->nby; yy++) {
+            int edge_row = (yy == y0 || yy == y1);
+            int32_t step = edge_row ? 1 : 2 * rr;
+            for (int32_t xx = bx - rr; xx <= bx + rr; xx += (step ? step : 1)) {
+                if (xx < 0 || xx >= v->nbx) continue;
+                double lx = xx * v->hx, ux = lx + v->hx, ly = yy * v->hy, uy = ly + v->hy;
+                double dx = s.x < lx ? lx - s.x : (s.x > ux ? s.x - ux : 0.0);
+                double dy = s.y < ly ? ly - s.y : (s.y > uy ? s.y - uy : 0.0);
+                double md2 = dx * dx + dy * dy;
+                if (md2 >= 4.0 * R->rmax2) continue;
+                gp_status st = cell_bin(R, yy * v->nbx + xx, md2, &nc);
+                if (st != GP_OK) return st;
+            }
+        }
+    }
+    for (int32_t q = 0; q < nc; q++) {
+        if (r == 1 && q < 8) { /* partial selection sort: the nearest few first */
+            int32_t b = q;
+            for (int32_t k = q + 1; k < nc; k++)
+                if (v->cand_d[k] < v->cand_d[b]) b = k;
+            double td = v->cand_d[q];
+            int32_t tj = v->cand_j[q];
+            v->cand_d[q] = v->cand_d[b];
+            v->cand_j[q] = v->cand_j[b];
+            v->cand_d[b] = td;
+            v->cand_j[b] = tj;
+        }
+        if (v->cand_d[q] >= 4.0 * R->rmax2) continue;
+        int32_t j = v->cand_j[q];
+        double nx = v->seed[j].x - s.x, ny = v->seed[j].y - s.y;
+        gp_vec2 mid = {s.x + 0.5 * nx, s.y + 0.5 * ny};
+        gp_status st = clip_step(v, &R->m, &R->ina, mid, (gp_vec2){nx, ny},
+                                 R->epsr * (fabs(nx) + fabs(ny)), j, s, &R->rmax2);
+        if (st != GP_OK) return st;
+    }
+    return GP_OK;
+}
+
+/* 1 when every seed outside the block of rings 0..r is at least 2 Rmax away (or there is none). */
+static int cell_done(const cell_run *R, int32_t r)
+{
+    const gp_voronoi *v = R->v;
+    const gp_vec2 s = R->s;
+    const int32_t bx = R->bx, by = R->by;
+    double dmin = INFINITY;
+    if (bx - r > 0) dmin = fmin(dmin, s.x - (bx - r) * v->hx);
+    if (bx + r < v->nbx - 1) dmin = fmin(dmin, (bx + r + 1) * v->hx - s.x);
+    if (by - r > 0) dmin = fmin(dmin, s.y - (by - r) * v->hy);
+    if (by + r < v->nby - 1) dmin = fmin(dmin, (by + r + 1) * v->hy - s.y);
+    if (dmin == INFINITY) return 1;
+    return dmin > 0 && dmin * dmin >= 4.0 * R->rmax2;
+}
+
+/* The neighbours of C (sorted, unique: each line appears once in a convex polygon). */
+static gp_status cell_neighbours(vcell *out, const int32_t *ct, int32_t m)
+{
     int32_t nn = 0;
     for (int32_t k = 0; k < m; k++)
         if (ct[k] >= 0) nn++;
@@ -1043,44 +1135,68 @@ static gp_status compute_cell_box(gp_voronoi *v, uint32_t i, vcell *out, int ful
         }
         out->nb[q] = t;
     }
-    /* does C reach a general (hole / non-convex) edge? */
-    if (v->has_general) {
-        double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
-        for (int32_t k = 0; k < m; k++) {
-            x0 = fmin(x0, cv[k].x);
-            x1 = fmax(x1, cv[k].x);
-            y0 = fmin(y0, cv[k].y);
-            y1 = fmax(y1, cv[k].y);
+    return GP_OK;
+}
+
+/* The general (hole, non-convex) edges in the bins C's bounding box reaches, into v->gedges
+ * sorted by id (so that the clip does not depend on the bins' visiting order). */
+static gp_status cell_general_edges(cell_run *R, const gp_vec2 *cv, int32_t m, int32_t *ngp)
+{
+    gp_voronoi *v = R->v;
+    gp_vec2 lo, hi;
+    gp_poly_bbox(cv, (size_t)m, &lo, &hi, NULL);
+    double pad = 1e-9 * v->L;
+    int32_t ix0 = bin_x(v, lo.x - pad), ix1 = bin_x(v, hi.x + pad);
+    int32_t iy0 = bin_y(v, lo.y - pad), iy1 = bin_y(v, hi.y + pad);
+    int32_t ng = 0;
+    for (int32_t yy = iy0; yy <= iy1; yy++)
+        for (int32_t xx = ix0; xx <= ix1; xx++) {
+            int32_t b = yy * v->nbx + xx;
+            for (uint32_t q = v->ge_off[b]; q < v->ge_off[b + 1]; q++) {
+                uint32_t e = v->ge[q];
+                if (v->estamp[e] == R->es) continue;
+                v->estamp[e] = R->es;
+                if (grow((void **)&v->gedges, &v->gecap, ng + 1, sizeof(int32_t)))
+                    return GP_ERR_NOMEM;
+                v->gedges[ng++] = (int32_t)e;
+            }
         }
-        double pad = 1e-9 * v->L;
-        int32_t ix0 = bin_x(v, x0 - pad), ix1 = bin_x(v, x1 + pad);
-        int32_t iy0 = bin_y(v, y0 - pad), iy1 = bin_y(v, y1 + pad);
+    for (int32_t a = 1; a < ng; a++) {
+        int32_t t = v->gedges[a], q = a;
+        while (q > 0 && v->gedges[q - 1] > t) {
+            v->gedges[q] = v->gedges[q - 1];
+            q--;
+        }
+        v->gedges[q] = t;
+    }
+    *ngp = ng;
+    return GP_OK;
+}
+
+static gp_status compute_cell_box(gp_voronoi *v, uint32_t i, vcell *out, int full)
+{
+    cell_run R;
+    gp_status st = cell_start(&R, v, i, full);
+    /* rings 0 and 1 form the first batch, then one ring per batch */
+    for (int32_t r = 1; st == GP_OK; r++) {
+        st = cell_batch(&R, r);
+        if (st == GP_OK && cell_done(&R, r)) break;
+    }
+    if (st != GP_OK) return st;
+    const int32_t m = R.m;
+    for (int32_t k = 0; k < m; k++)
+        if ((R.ina ? v->ta : v->tb)[k] == TAG_SMALL) return GP_ERR_NOT_CONVERGED; /* box too small */
+    gp_vec2 *cv = R.ina ? v->sb : v->sa; /* canonical copy into the other buffer */
+    int32_t *ct = R.ina ? v->tb : v->ta;
+    canonicalise(v, R.s, R.ina ? v->sa : v->sb, R.ina ? v->ta : v->tb, m, cv, ct);
+    st = cell_neighbours(out, ct, m);
+    if (st != GP_OK) return st;
+    if (v->has_general) { /* does C reach a general (hole / non-convex) edge? */
         int32_t ng = 0;
-        for (int32_t yy = iy0; yy <= iy1; yy++)
-            for (int32_t xx = ix0; xx <= ix1; xx++) {
-                int32_t b = yy * v->nbx + xx;
-                for (uint32_t q = v->ge_off[b]; q < v->ge_off[b + 1]; q++) {
-                    uint32_t e = v->ge[q];
-                    if (v->estamp[e] == es) continue;
-                    v->estamp[e] = es;
-                    if (grow((void **)&v->gedges, &v->gecap, ng + 1, sizeof(int32_t)))
-                        return GP_ERR_NOMEM;
-                    v->gedges[ng++] = (int32_t)e;
-                }
-            }
-        if (ng > 0) {
-            /* sort edge ids: the clip is then independent of bin visiting order */
-            for (int32_t a = 1; a < ng; a++) {
-                int32_t t = v->gedges[a], q = a;
-                while (q > 0 && v->gedges[q - 1] > t) {
-                    v->gedges[q] = v->gedges[q - 1];
-                    q--;
-                }
-                v->gedges[q] = t;
-            }
-            /* C lives in the scratch buffers that general_clip does not touch */
-            return general_clip(v, s, cv, ct, m, ng, out);
-        }
+        st = cell_general_edges(&R, cv, m, &ng);
+        if (st != GP_OK) return st;
+        /* C lives in the scratch buffers that general_clip does not touch */
+        if (ng > 0) return general_clip(v, R.s, cv, ct, m, ng, out);
     }
     memcpy(out->v, cv, (size_t)m * sizeof(gp_vec2));
     memcpy(out->tag, ct, (size_t)m * sizeof(int32_t));
@@ -1090,8 +1206,8 @@ static gp_status compute_cell_box(gp_voronoi *v, uint32_t i, vcell *out, int ful
     out->poff[0] = 0;
     out->poff[1] = m;
     out->convex = 1;
-    out->area = ring_area_about(cv, m, s);
-    out->orient = convex_orientation(cv, m, epsr * epsr);
+    out->area = ring_area_about(cv, m, R.s);
+    out->orient = convex_orientation(cv, m, R.epsr * R.epsr);
     if (!(out->area > 0.0)) return GP_ERR_INTERNAL;
     return GP_OK;
 }
@@ -1363,100 +1479,91 @@ static int cancel_raised(const volatile int *cancel)
     return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
 }
 
-gp_voronoi *gp_voronoi_create_ex(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *holes,
-                                 const size_t *nhole, size_t nholes, const gp_vec2 *seeds,
-                                 size_t n, const volatile int *cancel, gp_error *err)
+/* The arguments of gp_voronoi_create_ex, and the outer ring's bounding box. */
+static gp_status create_check(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *holes,
+                              const size_t *nhole, size_t nholes, const gp_vec2 *seeds, size_t n,
+                              gp_vec2 *lo, gp_vec2 *hi, size_t *total, gp_error *err)
 {
-    if (!outer || nouter < 3) {
-        gp_error_set(err, GP_ERR_INVALID, "voronoi: outer ring needs >= 3 points");
-        return NULL;
-    }
-    if (!seeds || n < 1 || n > (size_t)INT32_MAX / 4) {
-        gp_error_set(err, GP_ERR_INVALID, "voronoi: need 1 <= n seeds (got %zu)", n);
-        return NULL;
-    }
-    if (nholes && (!holes || !nhole)) {
-        gp_error_set(err, GP_ERR_INVALID, "voronoi: holes/nhole missing");
-        return NULL;
-    }
-    size_t total = nouter;
+    if (!outer || nouter < 3)
+        return gp_error_set(err, GP_ERR_INVALID, "voronoi: outer ring needs >= 3 points");
+    if (!seeds || n < 1 || n > (size_t)INT32_MAX / 4)
+        return gp_error_set(err, GP_ERR_INVALID, "voronoi: need 1 <= n seeds (got %zu)", n);
+    if (nholes && (!holes || !nhole))
+        return gp_error_set(err, GP_ERR_INVALID, "voronoi: holes/nhole missing");
+    *total = nouter;
     for (size_t h = 0; h < nholes; h++) {
-        if (!holes[h] || nhole[h] < 3) {
-            gp_error_set(err, GP_ERR_INVALID, "voronoi: hole %zu needs >= 3 points", h);
-            return NULL;
-        }
-        total += nhole[h];
+        if (!holes[h] || nhole[h] < 3)
+            return gp_error_set(err, GP_ERR_INVALID, "voronoi: hole %zu needs >= 3 points", h);
+        *total += nhole[h];
     }
-    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-    for (size_t k = 0; k < nouter; k++) {
-        if (!isfinite(outer[k].x) || !isfinite(outer[k].y)) {
-            gp_error_set(err, GP_ERR_INVALID, "voronoi: outer vertex %zu is not finite", k);
-            return NULL;
-        }
-        x0 = fmin(x0, outer[k].x);
-        x1 = fmax(x1, outer[k].x);
-        y0 = fmin(y0, outer[k].y);
-        y1 = fmax(y1, outer[k].y);
-    }
+    for (size_t k = 0; k < nouter; k++)
+        if (!isfinite(outer[k].x) || !isfinite(outer[k].y))
+            return gp_error_set(err, GP_ERR_INVALID, "voronoi: outer vertex %zu is not finite", k);
     for (size_t h = 0; h < nholes; h++)
         for (size_t k = 0; k < nhole[h]; k++)
-            if (!isfinite(holes[h][k].x) || !isfinite(holes[h][k].y)) {
-                gp_error_set(err, GP_ERR_INVALID, "voronoi: hole %zu vertex %zu is not finite", h, k);
-                return NULL;
-            }
-    gp_voronoi *v = calloc(1, sizeof *v);
-    if (!v) {
-        gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
-        return NULL;
-    }
-    gp_status st = GP_OK;
-    v->n = (uint32_t)n;
-    v->origin = (gp_vec2){x0, y0};
-    v->W = x1 - x0;
-    v->H = y1 - y0;
-    v->L = fmax(v->W, v->H);
-    v->tol = 1e-12 * v->L;
-    if (!(v->W > 0 && v->H > 0 && isfinite(v->L))) {
-        gp_error_set(err, GP_ERR_INVALID, "voronoi: container has no area");
-        gp_voronoi_destroy(v);
-        return NULL;
-    }
+            if (!isfinite(holes[h][k].x) || !isfinite(holes[h][k].y))
+                return gp_error_set(err, GP_ERR_INVALID, "voronoi: hole %zu vertex %zu is not finite",
+                                    h, k);
+    return gp_poly_bbox(outer, nouter, lo, hi, err);
+}
+
+/* The rings in local coordinates (outer counter-clockwise, holes clockwise), their offsets and
+ * the container's area. */
+static gp_status load_rings(gp_voronoi *v, const gp_vec2 *outer, size_t nouter,
+                            const gp_vec2 *const *holes, const size_t *nhole, size_t nholes,
+                            size_t total, gp_error *err)
+{
     v->nrings = (uint32_t)(1 + nholes);
     v->roff = calloc(v->nrings + 1, sizeof(uint32_t));
     v->rv = malloc(total * sizeof(gp_vec2));
     v->rst = calloc(v->nrings, sizeof(uint32_t));
     v->rev = calloc(v->nrings, sizeof(int32_t));
-    if (!v->roff || !v->rv || !v->rst || !v->rev) goto nomem;
-    {
-        int32_t w;
-        if (ring_copy(v->rv, outer, nouter, v->origin, v->tol, 1, &w)) {
-            gp_error_set(err, GP_ERR_INVALID, "voronoi: outer ring is degenerate (no area)");
-            gp_voronoi_destroy(v);
-            return NULL;
-        }
-        v->roff[1] = (uint32_t)w;
-        v->carea = ring_area_about(v->rv, w, v->rv[0]);
-        for (size_t h = 0; h < nholes; h++) {
-            uint32_t b = v->roff[h + 1];
-            if (ring_copy(v->rv + b, holes[h], nhole[h], v->origin, v->tol, 0, &w)) {
-                gp_error_set(err, GP_ERR_INVALID, "voronoi: hole %zu is degenerate (no area)", h);
-                gp_voronoi_destroy(v);
-                return NULL;
-            }
-            v->roff[h + 2] = b + (uint32_t)w;
-            v->carea += ring_area_about(v->rv + b, w, v->rv[b]); /* negative (clockwise) */
-            if (!pip(v->rv, (int32_t)v->roff[1], v->rv[b])) {
-                gp_error_set(err, GP_ERR_INVALID, "voronoi: hole %zu is not inside the outer ring", h);
-                gp_voronoi_destroy(v);
-                return NULL;
-            }
-        }
+    if (!v->roff || !v->rv || !v->rst || !v->rev)
+        return gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
+    int32_t w;
+    if (ring_copy(v->rv, outer, nouter, v->origin, v->tol, 1, &w))
+        return gp_error_set(err, GP_ERR_INVALID, "voronoi: outer ring is degenerate (no area)");
+    v->roff[1] = (uint32_t)w;
+    v->carea = ring_area_about(v->rv, w, v->rv[0]);
+    for (size_t h = 0; h < nholes; h++) {
+        uint32_t b = v->roff[h + 1];
+        if (ring_copy(v->rv + b, holes[h], nhole[h], v->origin, v->tol, 0, &w))
+            return gp_error_set(err, GP_ERR_INVALID, "voronoi: hole %zu is degenerate (no area)", h);
+        v->roff[h + 2] = b + (uint32_t)w;
+        v->carea += ring_area_about(v->rv + b, w, v->rv[b]); /* negative (clockwise) */
+        if (!gp_poly_contains(v->rv, v->roff[1], v->rv[b]))
+            return gp_error_set(err, GP_ERR_INVALID, "voronoi: hole %zu is not inside the outer ring", h);
     }
-    if (!(v->carea > 0)) {
-        gp_error_set(err, GP_ERR_INVALID, "voronoi: container area is not positive");
-        gp_voronoi_destroy(v);
-        return NULL;
+    if (!(v->carea > 0))
+        return gp_error_set(err, GP_ERR_INVALID, "voronoi: container area is not positive");
+    return GP_OK;
+}
+
+/* 1 if the outer ring is convex: no reflex turn (collinear runs allowed), and one turn in total
+ * (a self-overlapping star has no reflex turn either). */
+static int outer_is_convex(const gp_voronoi *v)
+{
+    uint32_t no = v->roff[1];
+    int convex = 1;
+    for (uint32_t k = 0; k < no && convex; k++) {
+        gp_vec2 a = v->rv[k ? k - 1 : no - 1], b = v->rv[k], c = v->rv[v->enext[k]];
+        double cr = cross3(a, b, c);
+        double sc = (fabs(b.x - a.x) + fabs(b.y - a.y)) * (fabs(c.x - b.x) + fabs(c.y - b.y));
+        if (cr < -1e-12 * sc) convex = 0;
     }
+    double turn = 0;
+    for (uint32_t k = 0; k < no && convex; k++) {
+        gp_vec2 a = v->rv[k ? k - 1 : no - 1], b = v->rv[k], c = v->rv[v->enext[k]];
+        turn += atan2(cross3(a, b, c), (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y));
+    }
+    if (convex && fabs(turn - 2 * GP_VOR_PI) > 1e-6) convex = 0;
+    return convex;
+}
+
+/* Per-edge tables (next edge, ring, scratch stamps), the convexity of the outer ring, and the
+ * box B. */
+static gp_status edge_tables(gp_voronoi *v, size_t nholes, gp_error *err)
+{
     v->nedges = v->roff[v->nrings];
     v->enext = malloc(v->nedges * sizeof(int32_t));
     v->ering = malloc(v->nedges * sizeof(int32_t));
@@ -1465,85 +1572,100 @@ gp_voronoi *gp_voronoi_create_ex(const gp_vec2 *outer, size_t nouter, const gp_v
     v->eslot_in = malloc(v->nedges * sizeof(int32_t));
     v->eslot_out = malloc(v->nedges * sizeof(int32_t));
     if (!v->enext || !v->ering || !v->estamp || !v->eslot_st || !v->eslot_in || !v->eslot_out)
-        goto nomem;
+        return gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
     for (uint32_t r = 0; r < v->nrings; r++)
         for (uint32_t k = v->roff[r]; k < v->roff[r + 1]; k++) {
             v->enext[k] = (int32_t)(k + 1 < v->roff[r + 1] ? k + 1 : v->roff[r]);
             v->ering[k] = (int32_t)r;
         }
-    {
-        /* convex outer ring: no reflex turn (collinear runs allowed) */
-        uint32_t no = v->roff[1];
-        int convex = 1;
-        for (uint32_t k = 0; k < no && convex; k++) {
-            gp_vec2 a = v->rv[k ? k - 1 : no - 1], b = v->rv[k], c = v->rv[v->enext[k]];
-            double cr = cross3(a, b, c);
-            double sc = (fabs(b.x - a.x) + fabs(b.y - a.y)) * (fabs(c.x - b.x) + fabs(c.y - b.y));
-            if (cr < -1e-12 * sc) convex = 0;
-        }
-        /* a convex ring must also turn once in total (reject self-overlapping stars) */
-        double turn = 0;
-        for (uint32_t k = 0; k < no && convex; k++) {
-            gp_vec2 a = v->rv[k ? k - 1 : no - 1], b = v->rv[k], c = v->rv[v->enext[k]];
-            turn += atan2(cross3(a, b, c), (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y));
-        }
-        if (convex && fabs(turn - 2 * GP_VOR_PI) > 1e-6) convex = 0;
-        v->outer_convex = convex;
-        v->has_general = !convex || nholes > 0;
-    }
-    {
-        double mg = 1e-3 * fmin(v->W, v->H) + 1e-6 * v->L;
-        v->bmin = (gp_vec2){-mg, -mg};
-        v->bmax = (gp_vec2){v->W + mg, v->H + mg};
-    }
-    st = build_grid(v, cancel);
-    if (st == GP_ERR_CANCELLED) goto cancelled;
-    if (st != GP_OK) goto nomem;
+    v->outer_convex = outer_is_convex(v);
+    v->has_general = !v->outer_convex || nholes > 0;
+    double mg = 1e-3 * fmin(v->W, v->H) + 1e-6 * v->L;
+    v->bmin = (gp_vec2){-mg, -mg};
+    v->bmax = (gp_vec2){v->W + mg, v->H + mg};
+    return GP_OK;
+}
+
+/* The seeds, in local coordinates and as given, into the bins; each inside the container and
+ * no duplicate. */
+static gp_status insert_seeds(gp_voronoi *v, const gp_vec2 *seeds, size_t n,
+                              const volatile int *cancel, gp_error *err)
+{
     v->seed = malloc(n * sizeof(gp_vec2));
     v->useed = malloc(n * sizeof(gp_vec2));
     v->cell = calloc(n, sizeof(vcell *));
     v->cst = calloc(n, sizeof(uint32_t));
-    if (!v->seed || !v->useed || !v->cell || !v->cst) goto nomem;
+    if (!v->seed || !v->useed || !v->cell || !v->cst)
+        return gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
     for (size_t i = 0; i < n; i++) {
-        if ((i + 1) % (16 * CANCEL_EVERY) == 0 && cancel_raised(cancel)) goto cancelled;
+        if ((i + 1) % (16 * CANCEL_EVERY) == 0 && cancel_raised(cancel))
+            return gp_error_set(err, GP_ERR_CANCELLED, "voronoi: cancelled");
         gp_vec2 p = {seeds[i].x - v->origin.x, seeds[i].y - v->origin.y};
-        if (!isfinite(p.x) || !isfinite(p.y) || !contains_local(v, p)) {
-            gp_error_set(err, GP_ERR_INVALID, "voronoi: seed %zu (%g, %g) is outside the container", i,
-                         seeds[i].x, seeds[i].y);
-            gp_voronoi_destroy(v);
-            return NULL;
-        }
+        if (!isfinite(p.x) || !isfinite(p.y) || !contains_local(v, p))
+            return gp_error_set(err, GP_ERR_INVALID, "voronoi: seed %zu (%g, %g) is outside the container",
+                                i, seeds[i].x, seeds[i].y);
         v->seed[i] = p;
         v->useed[i] = seeds[i];
         uint32_t other;
-        if (dup_check(v, p, (uint32_t)i, &other)) {
-            gp_error_set(err, GP_ERR_INVALID, "voronoi: seeds %u and %zu coincide (duplicate seeds)",
-                         other, i);
-            gp_voronoi_destroy(v);
-            return NULL;
-        }
-        if (bin_insert(&v->bins[bin_y(v, p.y) * v->nbx + bin_x(v, p.x)], (int32_t)i)) goto nomem;
+        if (dup_check(v, p, (uint32_t)i, &other))
+            return gp_error_set(err, GP_ERR_INVALID, "voronoi: seeds %u and %zu coincide (duplicate seeds)",
+                                other, i);
+        if (bin_insert(&v->bins[bin_y(v, p.y) * v->nbx + bin_x(v, p.x)], (int32_t)i))
+            return gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
     }
+    return GP_OK;
+}
+
+/* Every cell, from scratch. */
+static gp_status compute_cells(gp_voronoi *v, size_t n, const volatile int *cancel, gp_error *err)
+{
     for (size_t i = 0; i < n; i++) {
-        if ((i + 1) % CANCEL_EVERY == 0 && cancel_raised(cancel)) goto cancelled;
+        if ((i + 1) % CANCEL_EVERY == 0 && cancel_raised(cancel))
+            return gp_error_set(err, GP_ERR_CANCELLED, "voronoi: cancelled");
         v->cell[i] = calloc(1, sizeof(vcell));
-        if (!v->cell[i]) goto nomem;
-        st = compute_cell(v, (uint32_t)i, v->cell[i]);
-        if (st != GP_OK) {
-            gp_error_set(err, st, "voronoi: cell %zu: %s", i, status_msg(st));
-            gp_voronoi_destroy(v);
-            return NULL;
-        }
+        if (!v->cell[i]) return gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
+        gp_status st = compute_cell(v, (uint32_t)i, v->cell[i]);
+        if (st != GP_OK) return gp_error_set(err, st, "voronoi: cell %zu: %s", i, status_msg(st));
+    }
+    return GP_OK;
+}
+
+gp_voronoi *gp_voronoi_create_ex(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *holes,
+                                 const size_t *nhole, size_t nholes, const gp_vec2 *seeds,
+                                 size_t n, const volatile int *cancel, gp_error *err)
+{
+    gp_vec2 lo, hi;
+    size_t total = 0;
+    if (create_check(outer, nouter, holes, nhole, nholes, seeds, n, &lo, &hi, &total, err) != GP_OK)
+        return NULL;
+    gp_voronoi *v = calloc(1, sizeof *v);
+    if (!v) {
+        gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
+        return NULL;
+    }
+    v->n = (uint32_t)n;
+    v->origin = lo;
+    v->W = hi.x - lo.x;
+    v->H = hi.y - lo.y;
+    v->L = fmax(v->W, v->H);
+    v->tol = 1e-12 * v->L;
+    gp_status st = GP_OK;
+    if (!(v->W > 0 && v->H > 0 && isfinite(v->L)))
+        st = gp_error_set(err, GP_ERR_INVALID, "voronoi: container has no area");
+    if (st == GP_OK) st = load_rings(v, outer, nouter, holes, nhole, nholes, total, err);
+    if (st == GP_OK) st = edge_tables(v, nholes, err);
+    if (st == GP_OK) {
+        st = build_grid(v, cancel);
+        if (st == GP_ERR_CANCELLED) gp_error_set(err, st, "voronoi: cancelled");
+        else if (st != GP_OK) st = gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
+    }
+    if (st == GP_OK) st = insert_seeds(v, seeds, n, cancel, err);
+    if (st == GP_OK) st = compute_cells(v, n, cancel, err);
+    if (st != GP_OK) {
+        gp_voronoi_destroy(v);
+        return NULL;
     }
     return v;
-nomem:
-    gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
-    gp_voronoi_destroy(v);
-    return NULL;
-cancelled:
-    gp_error_set(err, GP_ERR_CANCELLED, "voronoi: cancelled");
-    gp_voronoi_destroy(v);
-    return NULL;
 }
 
 void gp_voronoi_destroy(gp_voronoi *v)
@@ -1855,16 +1977,11 @@ int gp_voronoi_sample_cell(const gp_voronoi *v, size_t i, double (*u01)(void *),
     }
     const gp_vec2 *q = c->v + c->poff[part];
     int32_t nq = c->poff[part + 1] - c->poff[part];
-    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
-    for (int32_t k = 0; k < nq; k++) {
-        x0 = fmin(x0, q[k].x);
-        x1 = fmax(x1, q[k].x);
-        y0 = fmin(y0, q[k].y);
-        y1 = fmax(y1, q[k].y);
-    }
+    gp_vec2 lo, hi;
+    gp_poly_bbox(q, (size_t)nq, &lo, &hi, NULL);
     for (int t = 0; t < 1000; t++) {
-        gp_vec2 r = {x0 + u01(state) * (x1 - x0), y0 + u01(state) * (y1 - y0)};
-        if (pip(q, nq, r)) {
+        gp_vec2 r = {lo.x + u01(state) * (hi.x - lo.x), lo.y + u01(state) * (hi.y - lo.y)};
+        if (gp_poly_contains(q, (size_t)nq, r)) {
             p->x = r.x + v->origin.x;
             p->y = r.y + v->origin.y;
             return 0;

@@ -22,7 +22,8 @@
  *
  * Orientation. Cell orientation is the grain orientation of Fig. 1a, gp_min_caliper()'s
  * angle_rad in (-pi/2, pi/2]: the direction of the side of the convex hull across which the
- * caliper width is smallest. A multi-part cell's orientation is that of the seed's part.
+ * caliper width is smallest (gp_min_caliper_edge on squared widths). A multi-part cell's
+ * orientation is that of the seed's part; parts and holes are located with gp_poly_contains.
  *
  * Neighbours. j is a neighbour of i when cells i and j share a boundary segment inside the
  * container (of length above ~1e-13 of the container size).

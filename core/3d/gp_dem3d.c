@@ -359,7 +359,6 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
     return GP_OK;
 }
 
-size_t gp_dem3d_count(const gp_dem3d *d) { return d->n; }
 double gp_dem3d_dt(const gp_dem3d *d) { return d->dt; }
 void gp_dem3d_set_friction(gp_dem3d *d, double deg) { d->tanphi = tan(deg * M_PI / 180); }
 void gp_dem3d_set_damping(gp_dem3d *d, double c) { d->damping = c; }
@@ -374,12 +373,6 @@ void gp_dem3d_set_radius_scale(gp_dem3d *d, double s)
         d->rscale_ref = s;
 }
 
-void gp_dem3d_set_wall(gp_dem3d *d, int w, double pos)
-{
-    d->wall[w] = pos;
-    d->servo_f[w] = 0;
-}
-
 void gp_dem3d_set_servo(gp_dem3d *d, int w, double force, double vmax)
 {
     d->servo_f[w] = force > 0 ? force : 0;
@@ -389,12 +382,6 @@ void gp_dem3d_set_servo(gp_dem3d *d, int w, double force, double vmax)
 void gp_dem3d_set_servo_limit(gp_dem3d *d, int w, double pos)
 {
     d->servo_lim[w] = pos;
-}
-
-void gp_dem3d_zero_velocities(gp_dem3d *d)
-{
-    memset(d->v, 0, 3 * d->n * sizeof *d->v);
-    memset(d->w, 0, 3 * d->n * sizeof *d->w);
 }
 
 /* ------------------------------------------------------------------ neighbour list */
@@ -422,9 +409,10 @@ static int grow_size_t(size_t **buf, size_t *cap, size_t need)
     return 0;
 }
 
-/* Rebuilds the candidate pair list, sorted by (i, j); shear springs are carried over by
- * (i, j). Buffers are kept from one rebuild to the next (no allocation in the steady state). */
-static gp_status rebuild(gp_dem3d *d, gp_error *err)
+/* The cell grids of the rebuild, one per size level, over the spheres' extent: each sphere's
+ * level (d->level) and cell (d->cell_of), and each grid's spheres by cell (start / list, in
+ * the buffers d keeps between rebuilds). reach: the gap below which a pair is listed. */
+static gp_status level_grids(gp_dem3d *d, level_grid lv[NLEVEL], double reach, gp_error *err)
 {
     size_t n = d->n;
     double rmax = d->r0max * d->rscale;
@@ -440,11 +428,7 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
         ext_lo[a] = mn;
         ext_hi[a] = mx;
     }
-    /* a pair is listed when its gap is below the skin plus free_gap: job_spheres then sees
-     * every surface within free_gap until a sphere has moved half the skin */
-    const double reach = d->skin + d->free_gap;
-    level_grid lv[NLEVEL];
-    memset(lv, 0, sizeof lv);
+    memset(lv, 0, NLEVEL * sizeof *lv);
     unsigned char *lev = d->level;
     for (size_t i = 0; i < n; i++) {
         int L = 0;
@@ -518,17 +502,22 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
             G->start[c] = G->start[c - 1];
         G->start[0] = 0;
     }
-    /* new pair list, into the spare buffers */
-    pair_set *P = &d->spare;
-    if (pair_set_reserve(P, d->np > 0 ? d->np + d->np / 4 + 64 : 8 * n + 64))
-        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
+    return GP_OK;
+}
+
+/* The candidate pairs (i < j, gap below reach) into P (grown as needed), sorted by (i, j);
+ * *np of them. */
+static gp_status find_candidates(const gp_dem3d *d, const level_grid lv[NLEVEL], double reach,
+                                 pair_set *P, size_t *np_out, gp_error *err)
+{
+    size_t n = d->n;
     size_t np = 0;
     for (size_t i = 0; i < n; i++) {
         size_t first = np;
         double xi[3] = {d->x[3 * i], d->x[3 * i + 1], d->x[3 * i + 2]};
         double ri = d->r[i] + reach;
         for (int L = 0; L < NLEVEL; L++) {
-            level_grid *G = lv + L;
+            const level_grid *G = lv + L;
             if (!G->n)
                 continue;
             double R = ri + G->rmax;
@@ -568,7 +557,14 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
             P->pj[m] = v;
         }
     }
-    /* carry the shear springs (and the contact state) over: both lists sorted by (i, j) */
+    *np_out = np;
+    return GP_OK;
+}
+
+/* The shear springs (and the contact state) of the list in use carried over to the np pairs
+ * of P by (i, j): both lists are sorted by (i, j). */
+static void carry_springs(const gp_dem3d *d, pair_set *P, size_t np)
+{
     memset(P->fs, 0, 3 * np * sizeof *P->fs);
     memset(P->fn, 0, np * sizeof *P->fn);
     size_t o = 0;
@@ -580,7 +576,12 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
             P->fn[k] = d->pfn[o]; /* job_pairs clears the spring of a contact that opens */
         }
     }
-    /* per-sphere lists in pair order */
+}
+
+/* Each sphere's list of the np pairs of P, in pair order: d->off (offsets), P->adj. */
+static void pair_adjacency(gp_dem3d *d, pair_set *P, size_t np)
+{
+    size_t n = d->n;
     memset(d->off, 0, (n + 1) * sizeof *d->off);
     for (size_t k = 0; k < np; k++) {
         d->off[P->pi[k] + 1]++;
@@ -593,6 +594,29 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
         P->adj[d->fill[P->pi[k]]++] = k << 1;
         P->adj[d->fill[P->pj[k]]++] = (k << 1) | 1;
     }
+}
+
+/* Rebuilds the candidate pair list, sorted by (i, j); shear springs are carried over by
+ * (i, j). Buffers are kept from one rebuild to the next (no allocation in the steady state):
+ * the new list is built in the spare buffers, which then become the list in use. */
+static gp_status rebuild(gp_dem3d *d, gp_error *err)
+{
+    size_t n = d->n;
+    /* a pair is listed when its gap is below the skin plus free_gap: job_spheres then sees
+     * every surface within free_gap until a sphere has moved half the skin */
+    const double reach = d->skin + d->free_gap;
+    level_grid lv[NLEVEL];
+    gp_status st = level_grids(d, lv, reach, err);
+    if (st)
+        return st;
+    pair_set *P = &d->spare;
+    if (pair_set_reserve(P, d->np > 0 ? d->np + d->np / 4 + 64 : 8 * n + 64))
+        return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (pairs)");
+    size_t np = 0;
+    if ((st = find_candidates(d, lv, reach, P, &np, err)))
+        return st;
+    carry_springs(d, P, np);
+    pair_adjacency(d, P, np);
     pair_set t = d->cur;
     d->cur = *P;
     *P = t;
@@ -855,7 +879,7 @@ void gp_dem3d_spheres(const gp_dem3d *d, double *xyzr)
     }
 }
 
-gp_status gp_dem3d_contacts(const gp_dem3d *d, gp_dem3d_contact **out, size_t *nout, gp_error *err)
+gp_status gp_dem3d_contacts(const gp_dem3d *d, gp_contact3d **out, size_t *nout, gp_error *err)
 {
     *out = NULL;
     *nout = 0;
@@ -867,7 +891,7 @@ gp_status gp_dem3d_contacts(const gp_dem3d *d, gp_dem3d_contact **out, size_t *n
             cnt += d->x[3 * i + a] - d->wall[2 * a] < d->r[i];
             cnt += d->wall[2 * a + 1] - d->x[3 * i + a] < d->r[i];
         }
-    gp_dem3d_contact *c = malloc((cnt ? cnt : 1) * sizeof *c);
+    gp_contact3d *c = malloc((cnt ? cnt : 1) * sizeof *c);
     if (!c)
         return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (contacts)");
     size_t m = 0;

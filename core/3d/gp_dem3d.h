@@ -26,6 +26,12 @@
  *   - threads: per-pair forces, then per-sphere sums in a fixed order; every reduction is done
  *     over fixed blocks of spheres, so results are bit for bit the same for any thread count.
  * Units SI. Walls 0..5: x-, x+, y-, y+, z-, z+.
+ *
+ * Ownership: gp_dem3d_create copies the spheres; the gp_dem3d owns its state and its worker
+ * threads until gp_dem3d_destroy. Lists handed out (gp_dem3d_contacts, gp_dem3d_find_pairs)
+ * are malloc'ed and the caller's to free. Thread safety: one caller thread per gp_dem3d (it
+ * runs its own workers inside gp_dem3d_run); the measures on a static list
+ * (gp_dem3d_measure.c) only read their arguments and may run concurrently.
  */
 #ifndef GP_DEM3D_H
 #define GP_DEM3D_H
@@ -57,14 +63,11 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
                           const double lo[3], const double hi[3], gp_dem3d **out, gp_error *err);
 void gp_dem3d_destroy(gp_dem3d *d);
 
-size_t gp_dem3d_count(const gp_dem3d *d);
 double gp_dem3d_dt(const gp_dem3d *d);
 void gp_dem3d_set_friction(gp_dem3d *d, double friction_deg);
 void gp_dem3d_set_damping(gp_dem3d *d, double damping);
 /* Current radii are the full radii times s (in (0, 1]); masses stay those of the full radii. */
 void gp_dem3d_set_radius_scale(gp_dem3d *d, double s);
-/* Moves wall w to a fixed position (stops any servo). */
-void gp_dem3d_set_wall(gp_dem3d *d, int w, double position);
 double gp_dem3d_wall(const gp_dem3d *d, int w);
 /* Servo wall (Eq. 10): each step the wall moves inward by gain * (F - F_c) / k_wall, F_c and
  * k_wall the sum of the forces and normal stiffnesses of its contacts, at most vmax * dt (and
@@ -72,8 +75,6 @@ double gp_dem3d_wall(const gp_dem3d *d, int w);
 void gp_dem3d_set_servo(gp_dem3d *d, int w, double force, double vmax);
 /* The servo never moves wall w inward past position (NAN = no limit). */
 void gp_dem3d_set_servo_limit(gp_dem3d *d, int w, double position);
-/* Zeroes all velocities (translation and rotation). */
-void gp_dem3d_zero_velocities(gp_dem3d *d);
 
 /* Advances nsteps. Fails (GP_ERR_DEGENERATE) if a sphere leaves the box or a value is not
  * finite, and with GP_ERR_CANCELLED before a step when the cancel flag is up. */
@@ -99,18 +100,23 @@ void gp_dem3d_get_state(const gp_dem3d *d, gp_dem3d_state *s);
 /* Current x, y, z, r (current radii) into xyzr[4n]. */
 void gp_dem3d_spheres(const gp_dem3d *d, double *xyzr);
 
-/* A contact: j >= 0 sphere (i < j), j < 0 wall -1 - j. normal from i to j (or the wall);
- * overlap: full sphere overlap, or R - d for a wall (Eq. 12); force on sphere i. */
-typedef struct gp_dem3d_contact {
+/* A contact, the one contact type of the 3D code: the DEM makes it (gp_dem3d_contacts), the
+ * flip maps it to a tiling (gp_flip.h), the measures below read it, and a specimen hands it
+ * out (gp_specimen3d.contacts). j >= 0: sphere j (i < j); j < 0: wall -1 - j, walls 0..5 =
+ * x-, x+, y-, y+, z-, z+ of the box (the tiled box in a tiled packing). normal: the unit
+ * vector from sphere i to j (or to the wall). overlap: the full overlap R_i + R_j - |O_i O_j|
+ * (for a wall: R_i - |O_i W|, Eq. 12; Eq. 11's penetration is half the sphere-sphere
+ * overlap). force: the force on sphere i (normal + shear), N. */
+typedef struct gp_contact3d {
     size_t i;
     long j;
     double normal[3];
     double overlap;
     double force[3];
-} gp_dem3d_contact;
+} gp_contact3d;
 
 /* The current contacts (sphere pairs in (i, j) order, then wall contacts by sphere), malloc'ed. */
-gp_status gp_dem3d_contacts(const gp_dem3d *d, gp_dem3d_contact **c, size_t *nc, gp_error *err);
+gp_status gp_dem3d_contacts(const gp_dem3d *d, gp_contact3d **c, size_t *nc, gp_error *err);
 
 /* --- measures on a static list (gp_dem3d_measure.c) --- */
 
@@ -123,21 +129,13 @@ gp_status gp_dem3d_find_pairs(const double *xyzr, size_t n, double gap, size_t *
  * both spheres (weight 2), a wall contact by one (weight 1; the flip turns it into half of a
  * pair with the sphere's image). With no wall contacts this is Eq. 14 exactly; with them it is
  * invariant under flip tiling. */
-void gp_dem3d_fabric(const gp_dem3d_contact *c, size_t nc, double F[3][3]);
+void gp_dem3d_fabric(const gp_contact3d *c, size_t nc, double F[3][3]);
 
 /* Eq. 15 with compression positive: sigma = -(1/V) sum_c l_c (x) f_c, summed over both spheres of
  * a pair (the branch vector O_i O_j times the force on i) and over the sphere of a wall contact
  * (centre to contact point). xyzr: the spheres the contacts refer to. */
-void gp_dem3d_stress(const gp_dem3d_contact *c, size_t nc, const double *xyzr, double volume,
+void gp_dem3d_stress(const gp_contact3d *c, size_t nc, const double *xyzr, double volume,
                      double S[3][3]);
-
-/* The same two, returning GP_ERR_CANCELLED (the matrix then half summed) as soon as *cancel
- * (read atomically every 65536 contacts; may be NULL) is non-zero; GP_OK otherwise, with the
- * same bits as above. */
-gp_status gp_dem3d_fabric_ex(const gp_dem3d_contact *c, size_t nc, double F[3][3],
-                             const volatile int *cancel);
-gp_status gp_dem3d_stress_ex(const gp_dem3d_contact *c, size_t nc, const double *xyzr,
-                             double volume, double S[3][3], const volatile int *cancel);
 
 /* The same measures as accumulators, for contacts that come in chunks (gp_flip_contacts_each
  * streams the contacts of a tiled packing without building their array): _init, _add for
@@ -156,11 +154,11 @@ typedef struct gp_dem3d_stress_acc {
 } gp_dem3d_stress_acc;
 
 void gp_dem3d_fabric_acc_init(gp_dem3d_fabric_acc *a);
-void gp_dem3d_fabric_acc_add(gp_dem3d_fabric_acc *a, const gp_dem3d_contact *c, size_t nc);
+void gp_dem3d_fabric_acc_add(gp_dem3d_fabric_acc *a, const gp_contact3d *c, size_t nc);
 /* F = sum / wsum (zero without contacts) */
 void gp_dem3d_fabric_acc_finish(const gp_dem3d_fabric_acc *a, double F[3][3]);
 void gp_dem3d_stress_acc_init(gp_dem3d_stress_acc *a, const double *xyzr);
-void gp_dem3d_stress_acc_add(gp_dem3d_stress_acc *a, const gp_dem3d_contact *c, size_t nc);
+void gp_dem3d_stress_acc_add(gp_dem3d_stress_acc *a, const gp_contact3d *c, size_t nc);
 /* S = -sum / volume (volume <= 0: -sum) */
 void gp_dem3d_stress_acc_finish(const gp_dem3d_stress_acc *a, double volume, double S[3][3]);
 

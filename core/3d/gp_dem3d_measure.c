@@ -119,18 +119,12 @@ gp_status gp_dem3d_find_pairs(const double *xyzr, size_t n, double gap, size_t *
     return GP_OK;
 }
 
-/* the caller's cancel flag (another thread raises it with an atomic store) */
-static int cancel_due(const volatile int *cancel)
-{
-    return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED);
-}
-
 void gp_dem3d_fabric_acc_init(gp_dem3d_fabric_acc *a)
 {
     memset(a, 0, sizeof *a);
 }
 
-void gp_dem3d_fabric_acc_add(gp_dem3d_fabric_acc *acc, const gp_dem3d_contact *c, size_t nc)
+void gp_dem3d_fabric_acc_add(gp_dem3d_fabric_acc *acc, const gp_contact3d *c, size_t nc)
 {
     for (size_t k = 0; k < nc; k++) {
         double w = c[k].j >= 0 ? 2 : 1; /* seen by both spheres, or by one (a wall) */
@@ -154,7 +148,7 @@ void gp_dem3d_stress_acc_init(gp_dem3d_stress_acc *a, const double *xyzr)
     a->xyzr = xyzr;
 }
 
-void gp_dem3d_stress_acc_add(gp_dem3d_stress_acc *acc, const gp_dem3d_contact *c, size_t nc)
+void gp_dem3d_stress_acc_add(gp_dem3d_stress_acc *acc, const gp_contact3d *c, size_t nc)
 {
     const double *xyzr = acc->xyzr;
     for (size_t k = 0; k < nc; k++) {
@@ -182,52 +176,22 @@ void gp_dem3d_stress_acc_finish(const gp_dem3d_stress_acc *acc, double volume, d
             S[a][b] = volume > 0 ? acc->sum[a][b] / volume : acc->sum[a][b];
 }
 
-/* the array functions: the accumulators over blocks of CANCEL_BLOCK contacts, the cancel flag
- * looked at before each (a pass over the ~50 million contacts of a 20-million-sphere tiling
- * takes a second; the block boundaries do not change the sums) */
-#define CANCEL_BLOCK 65536
-
-void gp_dem3d_fabric(const gp_dem3d_contact *c, size_t nc, double F[3][3])
-{
-    gp_dem3d_fabric_ex(c, nc, F, NULL);
-}
-
-gp_status gp_dem3d_fabric_ex(const gp_dem3d_contact *c, size_t nc, double F[3][3],
-                             const volatile int *cancel)
+/* the array functions: the accumulators over the whole array */
+void gp_dem3d_fabric(const gp_contact3d *c, size_t nc, double F[3][3])
 {
     gp_dem3d_fabric_acc acc;
     gp_dem3d_fabric_acc_init(&acc);
-    for (size_t k = 0; k < nc; k += CANCEL_BLOCK) {
-        if (cancel_due(cancel)) {
-            memcpy(F, acc.sum, sizeof acc.sum); /* half summed, as documented */
-            return GP_ERR_CANCELLED;
-        }
-        gp_dem3d_fabric_acc_add(&acc, c + k, nc - k < CANCEL_BLOCK ? nc - k : CANCEL_BLOCK);
-    }
+    gp_dem3d_fabric_acc_add(&acc, c, nc);
     gp_dem3d_fabric_acc_finish(&acc, F);
-    return GP_OK;
 }
 
-void gp_dem3d_stress(const gp_dem3d_contact *c, size_t nc, const double *xyzr, double volume,
+void gp_dem3d_stress(const gp_contact3d *c, size_t nc, const double *xyzr, double volume,
                      double S[3][3])
-{
-    gp_dem3d_stress_ex(c, nc, xyzr, volume, S, NULL);
-}
-
-gp_status gp_dem3d_stress_ex(const gp_dem3d_contact *c, size_t nc, const double *xyzr,
-                             double volume, double S[3][3], const volatile int *cancel)
 {
     gp_dem3d_stress_acc acc;
     gp_dem3d_stress_acc_init(&acc, xyzr);
-    for (size_t k = 0; k < nc; k += CANCEL_BLOCK) {
-        if (cancel_due(cancel)) {
-            memcpy(S, acc.sum, sizeof acc.sum);
-            return GP_ERR_CANCELLED;
-        }
-        gp_dem3d_stress_acc_add(&acc, c + k, nc - k < CANCEL_BLOCK ? nc - k : CANCEL_BLOCK);
-    }
+    gp_dem3d_stress_acc_add(&acc, c, nc);
     gp_dem3d_stress_acc_finish(&acc, volume, S);
-    return GP_OK;
 }
 
 static double cap_volume(double r, double dist)

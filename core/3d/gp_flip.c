@@ -25,14 +25,8 @@ static int cancel_raised(const volatile int *cancel)
 }
 
 gp_status gp_flip_tile(const double *xyzr, size_t n, const double box[3], const int tiles[3],
-                       size_t max_spheres, double **out, size_t *nout, gp_error *err)
-{
-    return gp_flip_tile_ex(xyzr, n, box, tiles, max_spheres, NULL, out, nout, err);
-}
-
-gp_status gp_flip_tile_ex(const double *xyzr, size_t n, const double box[3], const int tiles[3],
-                          size_t max_spheres, const volatile int *cancel, double **out,
-                          size_t *nout, gp_error *err)
+                       size_t max_spheres, const volatile int *cancel, double **out,
+                       size_t *nout, gp_error *err)
 {
     *out = NULL;
     *nout = 0;
@@ -97,7 +91,7 @@ static void tile_strides(const int tiles[3], size_t stride[3])
 }
 
 /* the sample's contacts in the order of every tile's run; *ord is malloc'ed (nc entries) */
-static gp_status sort_keys(const gp_dem3d_contact *c, size_t nc, size_t n, const int tiles[3],
+static gp_status sort_keys(const gp_contact3d *c, size_t nc, size_t n, const int tiles[3],
                            flip_key **ord, gp_error *err)
 {
     size_t stride[3];
@@ -124,8 +118,8 @@ enum { MADE_NONE = 0, MADE_PAIR = 1, MADE_WALL = 2 };
  * an image pair (across an inner face, made by the lower of the two tiles so that it is listed
  * once), MADE_WALL for a contact with an outer wall, MADE_NONE where the image pair is the
  * lower neighbour's. */
-static int map_contact(const gp_dem3d_contact *s, const int k[3], size_t t, size_t n,
-                       const int tiles[3], const size_t stride[3], gp_dem3d_contact *e)
+static int map_contact(const gp_contact3d *s, const int k[3], size_t t, size_t n,
+                       const int tiles[3], const size_t stride[3], gp_contact3d *e)
 {
     int side = 0, a = 0, kn = 0;
     if (s->j < 0) {
@@ -159,7 +153,7 @@ static int map_contact(const gp_dem3d_contact *s, const int k[3], size_t t, size
 }
 
 typedef struct emitter {
-    gp_dem3d_contact *buf;
+    gp_contact3d *buf;
     size_t cap, k;
     gp_flip_visit_fn visit;
     void *user;
@@ -175,7 +169,7 @@ static gp_status flush(emitter *m)
 
 /* One pass over the tiles in index order: MADE_PAIR walks the sorted keys, MADE_WALL the
  * sample's wall contacts in their order. */
-static gp_status walk(const gp_dem3d_contact *c, const flip_key *ord, size_t nc, size_t n,
+static gp_status walk(const gp_contact3d *c, const flip_key *ord, size_t nc, size_t n,
                       const int tiles[3], int made, const volatile int *cancel, emitter *m)
 {
     size_t stride[3];
@@ -188,7 +182,7 @@ static gp_status walk(const gp_dem3d_contact *c, const flip_key *ord, size_t nc,
                 int k[3] = {kx, ky, kz};
                 size_t t = ((size_t)kz * (size_t)tiles[1] + (size_t)ky) * (size_t)tiles[0] + (size_t)kx;
                 for (size_t r = 0; r < nc; r++) {
-                    const gp_dem3d_contact *s = made == MADE_PAIR ? c + ord[r].q : c + r;
+                    const gp_contact3d *s = made == MADE_PAIR ? c + ord[r].q : c + r;
                     if (made == MADE_WALL && s->j >= 0)
                         continue;
                     if (map_contact(s, k, t, n, tiles, stride, m->buf + m->k) != made)
@@ -201,12 +195,10 @@ static gp_status walk(const gp_dem3d_contact *c, const flip_key *ord, size_t nc,
     return GP_OK;
 }
 
-gp_status gp_flip_contacts_each(const gp_dem3d_contact *c, size_t nc, const double *xyzr,
-                                size_t n, const int tiles[3], const volatile int *cancel,
-                                gp_dem3d_contact *buf, size_t cap, gp_flip_visit_fn visit,
-                                void *user, gp_error *err)
+gp_status gp_flip_contacts_each(const gp_contact3d *c, size_t nc, size_t n, const int tiles[3],
+                                const volatile int *cancel, gp_contact3d *buf, size_t cap,
+                                gp_flip_visit_fn visit, void *user, gp_error *err)
 {
-    (void)xyzr;
     size_t nt = 0;
     gp_status st = check_tiles(tiles, n, &nt, err);
     if (st)
@@ -226,19 +218,12 @@ gp_status gp_flip_contacts_each(const gp_dem3d_contact *c, size_t nc, const doub
     return st;
 }
 
-gp_status gp_flip_contacts(const gp_dem3d_contact *c, size_t nc, const double *xyzr, size_t n,
-                           const int tiles[3], gp_dem3d_contact **out, size_t *nout,
-                           gp_error *err)
-{
-    return gp_flip_contacts_ex(c, nc, xyzr, n, tiles, NULL, out, nout, err);
-}
-
 typedef struct collector {
-    gp_dem3d_contact *o;
+    gp_contact3d *o;
     size_t m;
 } collector;
 
-static gp_status collect(void *user, const gp_dem3d_contact *chunk, size_t k, gp_error *err)
+static gp_status collect(void *user, const gp_contact3d *chunk, size_t k, gp_error *err)
 {
     (void)err;
     collector *cl = user;
@@ -249,9 +234,9 @@ static gp_status collect(void *user, const gp_dem3d_contact *chunk, size_t k, gp
 
 #define COLLECT_CHUNK 4096
 
-gp_status gp_flip_contacts_ex(const gp_dem3d_contact *c, size_t nc, const double *xyzr, size_t n,
-                              const int tiles[3], const volatile int *cancel,
-                              gp_dem3d_contact **out, size_t *nout, gp_error *err)
+gp_status gp_flip_contacts(const gp_contact3d *c, size_t nc, size_t n, const int tiles[3],
+                           const volatile int *cancel, gp_contact3d **out, size_t *nout,
+                           gp_error *err)
 {
     *out = NULL;
     *nout = 0;
@@ -259,25 +244,24 @@ gp_status gp_flip_contacts_ex(const gp_dem3d_contact *c, size_t nc, const double
     gp_status st = check_tiles(tiles, n, &nt, err);
     if (st)
         return st;
-    if (nc && nt > ((size_t)-1) / sizeof(gp_dem3d_contact) / nc)
+    if (nc && nt > ((size_t)-1) / sizeof(gp_contact3d) / nc)
         return gp_error_set(err, GP_ERR_INVALID, "tiling: too many contacts");
     /* every sample contact makes at most one contact per tile: nt nc bounds the count (pages
      * past the end are never touched, and the block is shrunk to fit) */
     size_t cap = nt * nc;
     collector cl = {malloc((cap ? cap : 1) * sizeof *cl.o), 0};
-    gp_dem3d_contact *buf = malloc(COLLECT_CHUNK * sizeof *buf);
+    gp_contact3d *buf = malloc(COLLECT_CHUNK * sizeof *buf);
     if (!cl.o || !buf) {
         free(cl.o); free(buf);
         return gp_error_set(err, GP_ERR_NOMEM, "flip: out of memory (%zu contacts)", cap);
     }
-    st = gp_flip_contacts_each(c, nc, xyzr, n, tiles, cancel, buf, COLLECT_CHUNK, collect, &cl,
-                               err);
+    st = gp_flip_contacts_each(c, nc, n, tiles, cancel, buf, COLLECT_CHUNK, collect, &cl, err);
     free(buf);
     if (st) {
         free(cl.o);
         return st;
     }
-    gp_dem3d_contact *fit = realloc(cl.o, (cl.m ? cl.m : 1) * sizeof *fit);
+    gp_contact3d *fit = realloc(cl.o, (cl.m ? cl.m : 1) * sizeof *fit);
     *out = fit ? fit : cl.o;
     *nout = cl.m;
     return GP_OK;

@@ -8,6 +8,12 @@
  * kept (with gp_dem3d's mirror wall law it is the same force to the last bit of arithmetic).
  *
  * Sphere index in the tiled packing: t * n + i, t = (kz * ny + ky) * nx + kx.
+ *
+ * Cancel: each function reads the caller's flag *cancel (may be NULL) atomically between
+ * tiles and stops with GP_ERR_CANCELLED when it is up, leaving nothing allocated (a tiling of
+ * 20 million spheres takes seconds); results do not depend on it. Ownership: inputs are only
+ * read; arrays handed out are malloc'ed and the caller's to free. Thread safety: no state;
+ * concurrent calls are safe.
  */
 #ifndef GP_FLIP_H
 #define GP_FLIP_H
@@ -20,38 +26,28 @@
 /* Tiles xyzr[4n] (box [0, box]) into *out (4 * n * nx * ny * nz, malloc'ed). max_spheres caps
  * the result (GP_ERR_INVALID beyond it). */
 gp_status gp_flip_tile(const double *xyzr, size_t n, const double box[3], const int tiles[3],
-                       size_t max_spheres, double **out, size_t *nout, gp_error *err);
+                       size_t max_spheres, const volatile int *cancel, double **out,
+                       size_t *nout, gp_error *err);
 
-/* Maps the sample's contacts to the tiled packing: every sphere contact to each tile (normal
- * and force mirrored), every wall contact to a contact with the sphere's image across an inner
- * face (full overlap 2 delta, the same normal force, Eq. 13) or to the tiled box's wall on the
- * outer faces. Sphere pairs first (i < j, sorted), then wall contacts (by sphere). xyzr: the
- * sample's spheres (n of them). */
-gp_status gp_flip_contacts(const gp_dem3d_contact *c, size_t nc, const double *xyzr, size_t n,
-                           const int tiles[3], gp_dem3d_contact **out, size_t *nout,
+/* Maps the sample's contacts (n spheres) to the tiled packing: every sphere contact to each
+ * tile (normal and force mirrored), every wall contact to a contact with the sphere's image
+ * across an inner face (full overlap 2 delta, the same normal force, Eq. 13) or to the tiled
+ * box's wall on the outer faces. Sphere pairs first (i < j, sorted), then wall contacts (by
+ * sphere), in *out (malloc'ed). The array holds up to tiles x nc contacts (72 bytes each; ~2 GB
+ * for 7.5 million spheres), so a caller that only needs measures over the contacts should
+ * stream them instead (gp_flip_contacts_each). */
+gp_status gp_flip_contacts(const gp_contact3d *c, size_t nc, size_t n, const int tiles[3],
+                           const volatile int *cancel, gp_contact3d **out, size_t *nout,
                            gp_error *err);
-
-/* The same two, stopping with GP_ERR_CANCELLED (nothing allocated is left) when *cancel (read
- * atomically between tiles; may be NULL) becomes non-zero: a tiling of 20 million spheres
- * takes seconds. The results do not depend on cancel. gp_flip_contacts_ex collects what
- * gp_flip_contacts_each streams: its array holds up to tiles x nc contacts (72 bytes each;
- * ~2 GB for 7.5 million spheres), so a caller that only needs measures over the contacts
- * should stream them instead. */
-gp_status gp_flip_tile_ex(const double *xyzr, size_t n, const double box[3], const int tiles[3],
-                          size_t max_spheres, const volatile int *cancel, double **out,
-                          size_t *nout, gp_error *err);
-gp_status gp_flip_contacts_ex(const gp_dem3d_contact *c, size_t nc, const double *xyzr, size_t n,
-                              const int tiles[3], const volatile int *cancel,
-                              gp_dem3d_contact **out, size_t *nout, gp_error *err);
 
 /* Receives the next k (1 <= k <= cap) contacts of the tiled packing in chunk, which is the
  * caller's buffer and is overwritten after the call returns. Returns GP_OK to go on; any other
  * status stops the walk and is returned by gp_flip_contacts_each as it is (the visitor sets
  * err itself). */
-typedef gp_status (*gp_flip_visit_fn)(void *user, const gp_dem3d_contact *chunk, size_t k,
+typedef gp_status (*gp_flip_visit_fn)(void *user, const gp_contact3d *chunk, size_t k,
                                       gp_error *err);
 
-/* The streaming form of gp_flip_contacts_ex: the same contacts in the same order (so the
+/* The streaming form of gp_flip_contacts: the same contacts in the same order (so the
  * same multiset, and sums over them in the same order give the same bits), handed to visit
  * in chunks of at most cap through the caller's buffer buf[cap] (cap >= 1), with no
  * allocation that grows with the tiling: memory O(nc) for the sample's contacts sorted once,
@@ -62,14 +58,13 @@ typedef gp_status (*gp_flip_visit_fn)(void *user, const gp_dem3d_contact *chunk,
  * which does not depend on t. Sorting the sample's contacts by that key once therefore gives
  * every tile's sorted run by a filtered walk. Pass 1 walks the tiles for the sphere and
  * image pairs, pass 2 walks them again for the contacts with the outer walls (by tile, then
- * in the sample's order), as gp_flip_contacts_ex lists them.
+ * in the sample's order), as gp_flip_contacts lists them.
  * *cancel (may be NULL) is read atomically between tiles: GP_ERR_CANCELLED, nothing left
  * allocated (what was already visited stays visited). Errors: GP_ERR_INVALID (tiles, cap,
  * buf), GP_ERR_NOMEM, or the visitor's status. Thread safety: reads c only; concurrent calls
- * with different buffers are safe. xyzr is not read (kept for symmetry with the others). */
-gp_status gp_flip_contacts_each(const gp_dem3d_contact *c, size_t nc, const double *xyzr,
-                                size_t n, const int tiles[3], const volatile int *cancel,
-                                gp_dem3d_contact *buf, size_t cap, gp_flip_visit_fn visit,
-                                void *user, gp_error *err);
+ * with different buffers are safe. */
+gp_status gp_flip_contacts_each(const gp_contact3d *c, size_t nc, size_t n, const int tiles[3],
+                                const volatile int *cancel, gp_contact3d *buf, size_t cap,
+                                gp_flip_visit_fn visit, void *user, gp_error *err);
 
 #endif /* GP_FLIP_H */

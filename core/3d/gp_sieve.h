@@ -12,6 +12,8 @@
  *     share, so the curve by weight is met at every sieve and the few largest grains are not
  *     left to chance.
  * Diameters and volumes in any consistent unit; percentages in [0, 100].
+ * Ownership and thread safety: inputs are only read, outputs are the caller's; no state, so
+ * concurrent calls are safe given one gp_rng per thread.
  */
 #ifndef GP_SIEVE_H
 #define GP_SIEVE_H

@@ -23,9 +23,14 @@
  *  Durations are in units of sqrt(d50 / g), not in steps, so that a wide sieve (whose time
  *  step follows its small grains) gets the same physical time as the paper's.
  *  phase 2, tiling: gp_flip.
+ * Code: gp_specimen3d_build() runs one function per phase over one build_run (read_spec,
+ * draw_sample, place_sample, start_dem, deposit, compact, relax, collect_sample, tile_sample,
+ * measure_final); the measures of the final packing are one pass over its contacts (measure).
  */
 #include "gp_specimen3d.h"
 
+#include "gp_alloc.h"
+#include "gp_clock.h"
 #include "gp_dem3d.h"
 #include "gp_flip.h"
 #include "gp_rng.h"
@@ -34,7 +39,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -94,19 +98,14 @@ void gp_spec3d_defaults(gp_spec3d *s)
     s->tile_relax_steps = 0;
 }
 
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-typedef struct run_ctx {
+/* the caller's progress callback and cancel flag; report() calls the callback at most every
+ * 0.05 s (unless forced) and returns non-zero when the run is to stop */
+typedef struct progress_ctx {
     gp_progress_fn fn;
     void *user;
     const volatile int *cancel;
     double last;
-} run_ctx;
+} progress_ctx;
 
 /* the caller's cancel flag, raised by another thread with an atomic store */
 static int cancel_raised(const volatile int *cancel)
@@ -114,14 +113,14 @@ static int cancel_raised(const volatile int *cancel)
     return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
 }
 
-static int report(run_ctx *c, const char *phase, double fraction, long steps, double porosity,
+static int report(progress_ctx *c, const char *phase, double fraction, long steps, double porosity,
                   double sc, int force)
 {
     if (cancel_raised(c->cancel))
         return 1;
     if (!c->fn)
         return 0;
-    double t = now();
+    double t = gp_clock_seconds();
     if (!force && t - c->last < 0.05)
         return 0;
     c->last = t;
@@ -268,7 +267,7 @@ static gp_status measure_init(measure_acc *m, unsigned outputs, const double *xy
 }
 
 /* gp_flip_visit_fn: one chunk into every measure */
-static gp_status measure_add(void *user, const gp_dem3d_contact *c, size_t k, gp_error *err)
+static gp_status measure_add(void *user, const gp_contact3d *c, size_t k, gp_error *err)
 {
     measure_acc *m = user;
     if (cancel_raised(m->cancel))
@@ -284,20 +283,14 @@ static gp_status measure_add(void *user, const gp_dem3d_contact *c, size_t k, gp
     if (m->out) {
         if (k > m->cap - m->nout) /* cannot happen: cap bounds the count */
             return gp_error_set(err, GP_ERR_INTERNAL, "contacts: more than %zu", m->cap);
-        for (size_t q = 0; q < k; q++) {
-            gp_contact3d *o = m->out + m->nout++;
-            o->i = c[q].i;
-            o->j = c[q].j;
-            memcpy(o->normal, c[q].normal, sizeof o->normal);
-            o->overlap = c[q].overlap;
-            memcpy(o->force, c[q].force, sizeof o->force);
-        }
+        memcpy(m->out + m->nout, c, k * sizeof *c);
+        m->nout += k;
     }
     return GP_OK;
 }
 
 /* the same, over an array, chunk by chunk (the cancel flag is looked at between them) */
-static gp_status measure_array(measure_acc *m, const gp_dem3d_contact *c, size_t nc,
+static gp_status measure_array(measure_acc *m, const gp_contact3d *c, size_t nc,
                                gp_error *err)
 {
     gp_status st = GP_OK;
@@ -328,18 +321,18 @@ static void measure_finish(measure_acc *m, size_t n, double volume, gp_specimen3
 }
 
 /* The measures of the final packing (nf spheres fx). stream: the contacts are the sample's
- * (c, nc; n spheres xyzr), mapped to the tiling on the fly; else c is the final list. */
-static gp_status measure(const gp_spec3d *spec, int stream, const gp_dem3d_contact *c,
-                         size_t nc, const double *xyzr, size_t n, const double *fx, size_t nf,
-                         const volatile int *cancel, gp_specimen3d *res, gp_error *err)
+ * (c, nc; n spheres), mapped to the tiling on the fly; else c is the final list. */
+static gp_status measure(const gp_spec3d *spec, int stream, const gp_contact3d *c, size_t nc,
+                         size_t n, const double *fx, size_t nf, const volatile int *cancel,
+                         gp_specimen3d *res, gp_error *err)
 {
     size_t ntile = (size_t)spec->tiling[0] * (size_t)spec->tiling[1] * (size_t)spec->tiling[2];
     measure_acc m;
     gp_status st = measure_init(&m, spec->outputs, fx, stream ? ntile * nc : nc, cancel, err);
     if (!st && stream) {
-        gp_dem3d_contact *buf = malloc(MEASURE_CHUNK * sizeof *buf);
-        st = buf ? gp_flip_contacts_each(c, nc, xyzr, n, spec->tiling, cancel, buf,
-                                         MEASURE_CHUNK, measure_add, &m, err)
+        gp_contact3d *buf = malloc(MEASURE_CHUNK * sizeof *buf);
+        st = buf ? gp_flip_contacts_each(c, nc, n, spec->tiling, cancel, buf, MEASURE_CHUNK,
+                                         measure_add, &m, err)
                  : gp_error_set(err, GP_ERR_NOMEM, "out of memory");
         free(buf);
     } else if (!st) {
@@ -354,9 +347,9 @@ static gp_status measure(const gp_spec3d *spec, int stream, const gp_dem3d_conta
 /* the optional DEM relaxation of the tiled packing (tile_relax_steps): moves the spheres of
  * tiled in the box [0, hi], and gives the DEM's own contacts (*tcon, malloc'ed), which the
  * measures then use */
-static gp_status relax_tiled(const gp_spec3d *spec, const gp_dem3d_params *dp, run_ctx *rc,
+static gp_status relax_tiled(const gp_spec3d *spec, const gp_dem3d_params *dp, progress_ctx *rc,
                              gp_stats3d *S, double *tiled, size_t ntiled, const double hi[3],
-                             gp_dem3d_contact **tcon, size_t *ntcon, gp_error *err)
+                             gp_contact3d **tcon, size_t *ntcon, gp_error *err)
 {
     const double lo[3] = {0, 0, 0};
     gp_dem3d *dem = NULL;
@@ -432,232 +425,283 @@ static gp_status validate(const gp_spec3d *s, gp_error *err)
         return gp_error_set(err, GP_ERR_INVALID, "sieve: need at least 2 rows");
     return GP_OK;
 }
+/* ---- the build: one run struct, a function per phase ----
+ * gp_specimen3d_build() runs the phases below in order over one build_run. A phase returns
+ * GP_OK to go on, or the status of a failure that leaves no specimen (bad spec, out of
+ * memory, cancelled, a DEM error). An end that still gives a specimen (target_too_dense,
+ * max_steps, target_too_loose) is kept in R->outcome and R->reason, and the later phases go
+ * on as the protocol says. Everything a phase allocates is the run's until
+ * build_run_release(); the result (R->res) moves to *out on success. */
+typedef struct build_run {
+    const gp_spec3d *spec;
+    const volatile int *cancel;
+    progress_ctx rc;
+    gp_error *err;
+    double *sd, *sw;         /* the sieve: diameters, percent passing (spec->nsieve rows) */
+    size_t ntile;            /* tiles of the flip */
+    double p, vs;            /* target porosity; solid volume (1 - p) V (Eq. 8 corrected, NOTES.md) */
+    gp_specimen3d *res;      /* the result being filled */
+    gp_rng *rng;
+    double *diam;            /* the n drawn diameters, sorted from the largest */
+    size_t n;
+    double *xyzr;            /* the sample's spheres, 4n */
+    /* phases 0-1 and relaxation */
+    gp_dem3d_params dp;
+    gp_dem3d *dem;
+    gp_dem3d_state ds;       /* the DEM's state after its last chunk */
+    double lam;              /* radius scale of the placement */
+    double H0;               /* height of the deposition box */
+    double d50;              /* median diameter by weight; the time unit is sqrt(d50 / g) */
+    long grow_steps, settle_steps, ladder_steps, stall_steps, max_steps;
+    double lid_speed;        /* the top wall's speed limit */
+    double area, sigma0;     /* the top wall's area and servo stress (phase 1 on) */
+    int pushed;              /* the top wall has pressed on grains */
+    int reached;             /* the top wall reached b_z (or stalled within POROSITY_SLACK) */
+    gp_status outcome;       /* GP_OK, GP_ERR_INFEASIBLE or GP_ERR_NOT_CONVERGED */
+    const char *reason;      /* stats.stop_reason */
+    /* phase 2 */
+    gp_contact3d *con, *tcon; /* the sample's contacts; the relaxed tiling's */
+    size_t ncon, ntcon;
+    double *tiled;           /* the tiled spheres, 4 ntiled */
+    size_t ntiled;
+    int tile, relaxed;       /* the sample is tiled; the tiling is relaxed by the DEM */
+} build_run;
 
-gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress_fn progress, void *user,
-                              const volatile int *cancel, gp_specimen3d **out, gp_error *err)
+static void build_run_release(build_run *R)
 {
-    double t0 = now();
-    *out = NULL;
-    if (!spec)
-        return gp_error_set(err, GP_ERR_INVALID, "spec is NULL");
-    gp_status st = validate(spec, err);
+    gp_dem3d_destroy(R->dem);
+    free(R->con); free(R->tcon); free(R->tiled); free(R->xyzr); free(R->diam);
+    free(R->sd); free(R->sw);
+    gp_rng_destroy(R->rng);
+}
+
+/* the spec's checks, and its sieve as two arrays (R->sd, R->sw) */
+static gp_status read_spec(build_run *R)
+{
+    const gp_spec3d *spec = R->spec;
+    gp_status st = validate(spec, R->err);
     if (st)
         return st;
     size_t ns = spec->nsieve;
-    double *sd = malloc(ns * sizeof *sd), *sw = malloc(ns * sizeof *sw);
-    if (!sd || !sw) {
-        free(sd); free(sw);
-        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-    }
-    for (size_t k = 0; k < ns; k++) {
-        sd[k] = spec->sieve[k].diameter;
-        sw[k] = spec->sieve[k].passing;
-    }
-    st = gp_sieve_validate(sd, sw, ns, err);
-    if (st) {
-        free(sd); free(sw);
+    double **const sieve[] = {&R->sd, &R->sw};
+    if ((st = gp_alloc_doubles(ns, sieve, 2, R->err)))
         return st;
+    for (size_t k = 0; k < ns; k++) {
+        R->sd[k] = spec->sieve[k].diameter;
+        R->sw[k] = spec->sieve[k].passing;
     }
+    st = gp_sieve_validate(R->sd, R->sw, ns, R->err);
+    if (st)
+        return st;
     const double *B = spec->box;
     double bmin = fmin(B[0], fmin(B[1], B[2]));
-    double dmax = sd[ns - 1];
-    if (dmax > bmin) {
-        free(sd); free(sw);
-        return gp_error_set(err, GP_ERR_INVALID,
+    double dmax = R->sd[ns - 1];
+    if (dmax > bmin)
+        return gp_error_set(R->err, GP_ERR_INVALID,
                             "box: its smallest side (%g m) is smaller than the largest grain "
                             "(%g m, the last sieve)", bmin, dmax);
-    }
-    size_t ntile = (size_t)spec->tiling[0] * (size_t)spec->tiling[1] * (size_t)spec->tiling[2];
-    double p = spec->porosity;
+    R->ntile = (size_t)spec->tiling[0] * (size_t)spec->tiling[1] * (size_t)spec->tiling[2];
+    R->p = spec->porosity;
     double V = B[0] * B[1] * B[2];
-    double vs = (1 - p) * V; /* Eq. 8 corrected (NOTES.md) */
+    R->vs = (1 - R->p) * V; /* Eq. 8 corrected (NOTES.md) */
+    return GP_OK;
+}
 
-    gp_specimen3d *res = calloc(1, sizeof *res);
-    gp_rng *rng = gp_rng_create(spec->seed, 0, err);
-    double *diam = NULL, *xyzr = NULL;
-    gp_dem3d *dem = NULL;
-    gp_dem3d_contact *con = NULL, *tcon = NULL;
-    double *tiled = NULL;
-    size_t n = 0, ncon = 0, ntcon = 0, ntiled = 0;
-    gp_status ret = GP_OK;
-    if (!res || !rng) {
-        ret = res ? (err ? err->code : GP_ERR_NOMEM) : gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-        if (ret == GP_OK) ret = GP_ERR_NOMEM;
-        goto fail;
-    }
-    st = gp_sieve_draw(sd, sw, ns, vs, MAX_SAMPLE_SPHERES, rng, &diam, &n, err);
-    if (st) {
-        ret = st;
-        goto fail;
-    }
-    if (n * ntile > MAX_TILED_SPHERES) {
-        ret = gp_error_set(err, GP_ERR_INVALID, "tiling: %zu tiles of %zu spheres exceed the limit "
-                           "of %d spheres", ntile, n, MAX_TILED_SPHERES);
-        goto fail;
-    }
-    /* PSD: targets and achieved (by the drawn sample) */
-    gp_psd3d *psd = &res->stats.psd;
+/* the result, the random stream, the sieve drawn for V_s (sorted from the largest), and the
+ * PSD: targets and achieved (by the drawn sample) */
+static gp_status draw_sample(build_run *R)
+{
+    gp_error *err = R->err;
+    const double *B = R->spec->box;
+    R->res = calloc(1, sizeof *R->res);
+    R->rng = gp_rng_create(R->spec->seed, 0, err);
+    if (!R->res)
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    if (!R->rng)
+        return GP_ERR_NOMEM; /* err set by gp_rng_create */
+    size_t ns = R->spec->nsieve;
+    gp_status st = gp_sieve_draw(R->sd, R->sw, ns, R->vs, MAX_SAMPLE_SPHERES, R->rng, &R->diam,
+                                 &R->n, err);
+    if (st)
+        return st;
+    if (R->n * R->ntile > MAX_TILED_SPHERES)
+        return gp_error_set(err, GP_ERR_INVALID, "tiling: %zu tiles of %zu spheres exceed the limit "
+                            "of %d spheres", R->ntile, R->n, MAX_TILED_SPHERES);
+    gp_psd3d *psd = &R->res->stats.psd;
     psd->n = ns;
-    psd->diameter = malloc(ns * sizeof(double));
-    psd->target_weight = malloc(ns * sizeof(double));
-    psd->target_number = malloc(ns * sizeof(double));
-    psd->target_number_midbin = malloc(ns * sizeof(double));
-    psd->achieved_weight = malloc(ns * sizeof(double));
-    psd->achieved_number = malloc(ns * sizeof(double));
-    xyzr = malloc(4 * n * sizeof *xyzr);
-    if (!psd->diameter || !psd->target_weight || !psd->target_number || !psd->target_number_midbin
-        || !psd->achieved_weight || !psd->achieved_number || !xyzr) {
-        ret = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    memcpy(psd->diameter, sd, ns * sizeof *sd);
-    memcpy(psd->target_weight, sw, ns * sizeof *sw);
-    gp_sieve_weight_to_number(sd, sw, ns, GP_SIEVE_UNIFORM, psd->target_number, NULL);
-    gp_sieve_weight_to_number(sd, sw, ns, GP_SIEVE_MIDBIN, psd->target_number_midbin, NULL);
-    gp_sieve_passing(diam, n, sd, ns, psd->achieved_weight, psd->achieved_number);
-    qsort(diam, n, sizeof *diam, cmp_desc);
+    double **const cols[] = {&psd->diameter,        &psd->target_weight,   &psd->target_number,
+                             &psd->target_number_midbin, &psd->achieved_weight,
+                             &psd->achieved_number};
+    if (gp_alloc_doubles(ns, cols, 6, err) || !(R->xyzr = malloc(4 * R->n * sizeof *R->xyzr)))
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    memcpy(psd->diameter, R->sd, ns * sizeof *R->sd);
+    memcpy(psd->target_weight, R->sw, ns * sizeof *R->sw);
+    gp_sieve_weight_to_number(R->sd, R->sw, ns, GP_SIEVE_UNIFORM, psd->target_number, NULL);
+    gp_sieve_weight_to_number(R->sd, R->sw, ns, GP_SIEVE_MIDBIN, psd->target_number_midbin, NULL);
+    gp_sieve_passing(R->diam, R->n, R->sd, ns, psd->achieved_weight, psd->achieved_number);
+    qsort(R->diam, R->n, sizeof *R->diam, cmp_desc);
 
-    gp_stats3d *S = &res->stats;
-    S->porosity_target = p;
-    S->sample_particles = n;
-    res->sample_box[0] = B[0];
-    res->sample_box[1] = B[1];
-    res->sample_box[2] = B[2];
-    run_ctx rc = {progress, user, cancel, 0};
-    const char *reason = "stable";
+    gp_stats3d *S = &R->res->stats;
+    S->porosity_target = R->p;
+    S->sample_particles = R->n;
+    for (int a = 0; a < 3; a++)
+        R->res->sample_box[a] = B[a];
+    return GP_OK;
+}
 
-    /* ---- phase 0: placement and deposition ---- */
-    double H0 = fmax(1.15 * B[2], B[2] * (1 - p) / 0.5);
-    double L[3] = {B[0], B[1], H0};
+/* ---- phase 0: placement and deposition ---- */
+
+/* the spheres placed at random without overlap at radius scale R->lam (GROW_FROM, times 0.85
+ * for each failed try, at most 12) in the deposition box: the sample's plan, height R->H0 */
+static gp_status place_sample(build_run *R)
+{
+    const double *B = R->spec->box;
+    R->H0 = fmax(1.15 * B[2], B[2] * (1 - R->p) / 0.5);
+    double L[3] = {B[0], B[1], R->H0};
     double lam = GROW_FROM;
     int tries = 0;
     int pl;
-    while ((pl = place(diam, n, lam, L, rng, cancel, xyzr)) != 0) {
-        if (pl < 0) {
-            ret = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        if (pl == 2) {
-            ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-            goto fail;
-        }
-        if (++tries > 12) {
-            ret = gp_error_set(err, GP_ERR_INTERNAL, "deposition: cannot place the spheres");
-            goto fail;
-        }
+    while ((pl = place(R->diam, R->n, lam, L, R->rng, R->cancel, R->xyzr)) != 0) {
+        if (pl < 0)
+            return gp_error_set(R->err, GP_ERR_NOMEM, "out of memory");
+        if (pl == 2)
+            return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
+        if (++tries > 12)
+            return gp_error_set(R->err, GP_ERR_INTERNAL, "deposition: cannot place the spheres");
         lam *= 0.85;
     }
+    R->lam = lam;
+    return GP_OK;
+}
+
+/* the DEM over the placed spheres at full radii (it scales them), and the protocol's durations
+ * in its steps */
+static gp_status start_dem(build_run *R)
+{
+    const gp_spec3d *spec = R->spec;
+    const double *diam = R->diam;
+    size_t n = R->n;
     /* density scaling radius (see gp_dem3d.h): the median radius by number, but no less than
      * rmax / MAX_SCALED_RATIO. With the paper's sieve the median is rmax / 3.4; with a size
      * ratio of 20 it can be rmax / 12, and then dt (set by the scaled radius) is so small next
      * to the time the large grains need to move that the protocol costs 3-4 times more steps
      * than the sieve's range requires. Raising the small grains' inertia does not change the
      * static state (gravity acts on the true mass). */
-    gp_dem3d_params dp;
-    gp_dem3d_params_defaults(&dp);
-    dp.density = spec->material.density;
-    dp.young = spec->material.young;
-    dp.ks_kn = spec->material.poisson;
-    dp.friction_deg = spec->material.friction_deg;
-    dp.damping = spec->material.damping;
-    dp.gravity[2] = -GRAVITY;
-    dp.scaled_radius = fmax(0.5 * diam[n / 2], 0.5 * diam[0] / MAX_SCALED_RATIO);
-    dp.skin = 0.5 * diam[n - 1]; /* the smallest radius (rebuilds against candidates; results
-                                    do not depend on it) */
-    dp.dt_safety = DT_SAFETY;
-    dp.threads = spec->threads > 0 ? spec->threads : 1;
+    gp_dem3d_params *dp = &R->dp;
+    gp_dem3d_params_defaults(dp);
+    dp->density = spec->material.density;
+    dp->young = spec->material.young;
+    dp->ks_kn = spec->material.poisson;
+    dp->friction_deg = spec->material.friction_deg;
+    dp->damping = spec->material.damping;
+    dp->gravity[2] = -GRAVITY;
+    dp->scaled_radius = fmax(0.5 * diam[n / 2], 0.5 * diam[0] / MAX_SCALED_RATIO);
+    dp->skin = 0.5 * diam[n - 1]; /* the smallest radius (rebuilds against candidates; results
+                                     do not depend on it) */
+    dp->dt_safety = DT_SAFETY;
+    dp->threads = spec->threads > 0 ? spec->threads : 1;
     for (size_t i = 0; i < n; i++)
-        xyzr[4 * i + 3] = 0.5 * diam[i]; /* full radii; the DEM scales them */
+        R->xyzr[4 * i + 3] = 0.5 * diam[i]; /* full radii; the DEM scales them */
     double lo[3] = {0, 0, 0};
-    st = gp_dem3d_create(&dp, xyzr, n, lo, L, &dem, err);
-    if (st) {
-        ret = st;
-        goto fail;
-    }
-    gp_dem3d_set_cancel(dem, cancel); /* a chunk of 100 steps of a large sample takes seconds */
+    double L[3] = {spec->box[0], spec->box[1], R->H0};
+    gp_status st = gp_dem3d_create(dp, R->xyzr, n, lo, L, &R->dem, R->err);
+    if (st)
+        return st;
+    gp_dem3d_set_cancel(R->dem, R->cancel); /* a chunk of 100 steps of a large sample takes seconds */
     /* Every duration of the protocol is a multiple of the skeleton's time sqrt(d50 / g) (d50 the
      * median diameter by weight: the grains that carry the load), the time a grain takes to
      * fall its own size. In steps this unit is ~860 for the paper's sieve and ~2300 for a size
      * ratio of 20, where dt follows the small grains: counted in steps, the windows that judge
      * progress were too short there, and the deposit never had the time to settle. */
     double d50 = diam[n - 1];
-    {
-        double tot = 0, acc = 0;
-        for (size_t i = 0; i < n; i++)
-            tot += diam[i] * diam[i] * diam[i];
-        for (size_t i = 0; i < n; i++) { /* diam is sorted from the largest */
-            acc += diam[i] * diam[i] * diam[i];
-            if (acc >= 0.5 * tot) {
-                d50 = diam[i];
-                break;
-            }
+    double tot = 0, acc = 0;
+    for (size_t i = 0; i < n; i++)
+        tot += diam[i] * diam[i] * diam[i];
+    for (size_t i = 0; i < n; i++) { /* diam is sorted from the largest */
+        acc += diam[i] * diam[i] * diam[i];
+        if (acc >= 0.5 * tot) {
+            d50 = diam[i];
+            break;
         }
     }
-    double tu = sqrt(d50 / GRAVITY) / gp_dem3d_dt(dem); /* steps per time unit */
-    long grow_steps = 10 * (long)ceil(GROW_T * tu / 10);
-    long settle_steps = CHUNK * (long)ceil(SETTLE_T * tu / CHUNK);
-    long ladder_steps = CHUNK * (long)ceil(LADDER_T * tu / CHUNK);
-    long stall_steps = CHUNK * (long)ceil(STALL_T * tu / CHUNK);
-    double lid_speed = LID_SPEED * sqrt(GRAVITY * d50);
-    long max_steps = spec->max_steps > 0 ? spec->max_steps
-                                         : (long)fmax(400000, MAX_T * tu);
-    gp_dem3d_state ds;
-    double t_phase = now();
+    R->d50 = d50;
+    double tu = sqrt(d50 / GRAVITY) / gp_dem3d_dt(R->dem); /* steps per time unit */
+    R->grow_steps = 10 * (long)ceil(GROW_T * tu / 10);
+    R->settle_steps = CHUNK * (long)ceil(SETTLE_T * tu / CHUNK);
+    R->ladder_steps = CHUNK * (long)ceil(LADDER_T * tu / CHUNK);
+    R->stall_steps = CHUNK * (long)ceil(STALL_T * tu / CHUNK);
+    R->lid_speed = LID_SPEED * sqrt(GRAVITY * d50);
+    R->max_steps = spec->max_steps > 0 ? spec->max_steps : (long)fmax(400000, MAX_T * tu);
+    return GP_OK;
+}
+
+/* the radii grow to full size under gravity (GROW_T), then the deposit settles (SETTLE_T, or
+ * until S_c < SETTLE_SC) */
+static gp_status deposit(build_run *R)
+{
+    gp_dem3d *dem = R->dem;
+    gp_dem3d_state *ds = &R->ds;
+    double lam = R->lam;
+    long grow_steps = R->grow_steps, settle_steps = R->settle_steps;
+    gp_status st;
+    double t_phase = gp_clock_seconds();
     for (long s = 0; s < grow_steps; s += 10) {
         gp_dem3d_set_radius_scale(dem, lam + (1 - lam) * (double)(s + 10) / grow_steps);
-        if ((st = gp_dem3d_run(dem, 10, err))) {
-            ret = st;
-            goto fail;
-        }
-        if (report(&rc, "deposition", 0.1 * s / grow_steps, s, 0, 0, 0)) {
-            ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-            goto fail;
-        }
+        if ((st = gp_dem3d_run(dem, 10, R->err)))
+            return st;
+        if (report(&R->rc, "deposition", 0.1 * s / grow_steps, s, 0, 0, 0))
+            return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
     }
     gp_dem3d_set_radius_scale(dem, 1.0);
     for (long s = 0; s < settle_steps; s += CHUNK) {
-        if ((st = gp_dem3d_run(dem, CHUNK, err))) {
-            ret = st;
-            goto fail;
-        }
-        gp_dem3d_get_state(dem, &ds);
-        if (report(&rc, "deposition", 0.1 + 0.1 * s / settle_steps, ds.steps, 0, ds.stability, 0)) {
-            ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-            goto fail;
-        }
-        if (ds.stability < SETTLE_SC)
+        if ((st = gp_dem3d_run(dem, CHUNK, R->err)))
+            return st;
+        gp_dem3d_get_state(dem, ds);
+        if (report(&R->rc, "deposition", 0.1 + 0.1 * s / settle_steps, ds->steps, 0,
+                   ds->stability, 0))
+            return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
+        if (ds->stability < SETTLE_SC)
             break;
     }
-    res->t_deposition = now() - t_phase;
+    R->res->t_deposition = gp_clock_seconds() - t_phase;
+    return GP_OK;
+}
 
-    /* ---- phase 1: compaction with the servo top wall (Eq. 10) and a friction ladder ---- */
-    t_phase = now();
+/* ---- phase 1: compaction with the servo top wall (Eq. 10) and a friction ladder ----
+ * Sets R->reached, or R->outcome and R->reason (target_too_dense, max_steps); phase 0's
+ * porosity is read where the wall comes to rest on the deposit. */
+static gp_status compact(build_run *R)
+{
+    const gp_spec3d *spec = R->spec;
+    const double *B = spec->box;
+    gp_dem3d *dem = R->dem;
+    gp_dem3d_state *ds = &R->ds;
+    gp_stats3d *S = &R->res->stats;
+    double p = R->p, vs = R->vs, H0 = R->H0, d50 = R->d50, lid_speed = R->lid_speed;
+    gp_status st;
+    double t_phase = gp_clock_seconds();
     double area = B[0] * B[1];
     double sigma0 = COMPACTION_STRESS * (1 - p) * spec->material.density * GRAVITY * B[2];
+    R->area = area;
+    R->sigma0 = sigma0;
     gp_dem3d_set_servo(dem, 5, sigma0 * area, lid_speed);
     gp_dem3d_set_servo_limit(dem, 5, B[2]);
     double phi = spec->material.friction_deg;
     double h_touch = NAN, h_prev = H0, h_win = H0;
-    int pushed = 0; /* the wall has pressed on grains */
-    int reached = 0;
     long win_steps = 0, stall_steps_done = 0;
     double por_cp = 1;
-    while (!reached) {
-        if ((st = gp_dem3d_run(dem, CHUNK, err))) {
-            ret = st;
-            goto fail;
-        }
-        gp_dem3d_get_state(dem, &ds);
+    while (!R->reached) {
+        if ((st = gp_dem3d_run(dem, CHUNK, R->err)))
+            return st;
+        gp_dem3d_get_state(dem, ds);
         double h = gp_dem3d_wall(dem, 5);
         double por = 1 - vs / (area * h);
-        if (report(&rc, "compaction", 0.2 + 0.4 * fmin(1, (H0 - h) / (H0 - B[2])), ds.steps, por,
-                   ds.stability, 0)) {
-            ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-            goto fail;
-        }
-        pushed |= ds.wall_force[5] > 0;
+        if (report(&R->rc, "compaction", 0.2 + 0.4 * fmin(1, (H0 - h) / (H0 - B[2])), ds->steps,
+                   por, ds->stability, 0))
+            return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
+        R->pushed |= ds->wall_force[5] > 0;
         if (h <= B[2]) {
-            reached = 1;
+            R->reached = 1;
             break;
         }
         /* The wall slows down as it nears b_z (it may not close the remaining gap faster than
@@ -669,7 +713,7 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress_fn progress, vo
         /* The wall rests on the deposit when it carries half its force and has slowed to less
          * than half its free speed (a grain still bouncing can push it, but not stop it):
          * phase 0's porosity, and the start of the ladder. */
-        if (isnan(h_touch) && ds.wall_force[5] >= 0.5 * sigma0 * area
+        if (isnan(h_touch) && ds->wall_force[5] >= 0.5 * sigma0 * area
             && h_prev - h < 0.5 * lid_speed * gp_dem3d_dt(dem) * CHUNK) {
             h_touch = h;
             h_win = h;
@@ -684,7 +728,7 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress_fn progress, vo
          * away from the wall during relaxation, as a loose heap pushed there without friction
          * can (it is not jammed at the target height, and keeps compacting under gravity:
          * with a size ratio of 20 the wall then lost every contact at once). */
-        if (!isnan(h_touch) && phi > 0 && (win_steps += CHUNK) >= ladder_steps) {
+        if (!isnan(h_touch) && phi > 0 && (win_steps += CHUNK) >= R->ladder_steps) {
             double left = fmax(h - B[2], LADDER_MIN_LEFT * B[2]);
             if (h_win - h < LADDER_FRACTION * left) {
                 phi = phi * LADDER_FACTOR < LADDER_MIN_DEG ? 0 : phi * LADDER_FACTOR;
@@ -699,176 +743,225 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress_fn progress, vo
          * by less than STALL_FRACTION of what remains to the target: the target is denser
          * than this sieve packs here (unless it is within POROSITY_SLACK: then this is the
          * sample's height) */
-        if (phi == 0 && (stall_steps_done += CHUNK) >= stall_steps) {
+        if (phi == 0 && (stall_steps_done += CHUNK) >= R->stall_steps) {
             if (por_cp - por < STALL_FRACTION * (por - p) && por - p <= POROSITY_SLACK) {
-                reached = 1;
+                R->reached = 1;
                 break;
             }
             if (por_cp - por < STALL_FRACTION * (por - p)) {
-                reason = "target_too_dense";
-                ret = gp_error_set(err, GP_ERR_INFEASIBLE,
-                                   "porosity %g is denser than this sieve packs in this box "
-                                   "without friction (stalled at %.4f)", p, por);
+                R->reason = "target_too_dense";
+                R->outcome = gp_error_set(R->err, GP_ERR_INFEASIBLE,
+                                          "porosity %g is denser than this sieve packs in this box "
+                                          "without friction (stalled at %.4f)", p, por);
                 break;
             }
             por_cp = por;
             stall_steps_done = 0;
         }
-        if (ds.steps > max_steps) {
-            reason = "max_steps";
-            ret = gp_error_set(err, GP_ERR_NOT_CONVERGED, "compaction: %ld steps without reaching "
-                               "porosity %g (at %.4f)", ds.steps, p, por);
+        if (ds->steps > R->max_steps) {
+            R->reason = "max_steps";
+            R->outcome = gp_error_set(R->err, GP_ERR_NOT_CONVERGED, "compaction: %ld steps without "
+                                      "reaching porosity %g (at %.4f)", ds->steps, p, por);
             break;
         }
     }
     S->deposition_porosity = 1 - vs / (area * (isnan(h_touch) ? gp_dem3d_wall(dem, 5) : h_touch));
     S->compaction_friction_deg = phi;
-    res->t_compaction = now() - t_phase;
+    R->res->t_compaction = gp_clock_seconds() - t_phase;
+    return GP_OK;
+}
 
-    /* ---- relaxation at the target height, friction restored ---- */
-    t_phase = now();
-    if (reached) {
-        /* The top wall stays a servo wall pressing with sigma0 (never below b_z): it keeps
-         * the packing confined as it was compacted, and if the packing pushes harder it rises,
-         * so the box it reports is the one the spheres fill. */
+/* ---- relaxation at the target height, friction restored ----
+ * Only when the wall reached b_z. The top wall stays a servo wall pressing with sigma0 (never
+ * below b_z): it keeps the packing confined as it was compacted, and if the packing pushes
+ * harder it rises, so the box it reports is the one the spheres fill. Pass 0: the wall never
+ * below b_z. Pass 1, only if the packing settled away from the wall although the wall had
+ * pressed on it: the wall follows it down, at most to the height of porosity
+ * p - POROSITY_SLACK, and relaxation goes on; the porosity is then that of the lower box,
+ * still within the tolerance of the target. Sets R->outcome and R->reason on max_steps or
+ * target_too_loose. */
+static gp_status relax(build_run *R)
+{
+    const gp_spec3d *spec = R->spec;
+    gp_dem3d *dem = R->dem;
+    gp_dem3d_state *ds = &R->ds;
+    double p = R->p, vs = R->vs, area = R->area;
+    double t_phase = gp_clock_seconds();
+    if (R->reached) {
         gp_dem3d_set_friction(dem, spec->material.friction_deg);
         gp_dem3d_set_damping(dem, fmax(spec->material.damping, RELAX_DAMPING));
-        /* pass 0: the wall never below b_z. Pass 1, only if the packing settled away from the
-         * wall although the wall had pressed on it: the wall follows it down,
-         * at most to the height of porosity p - POROSITY_SLACK, and relaxation goes on; the
-         * porosity is then that of the lower box, still within the tolerance of the target. */
         double h_sink = vs / (area * (1 - (p - POROSITY_SLACK)));
-        for (int pass = 0; pass < 2 && ret == GP_OK; pass++) {
+        for (int pass = 0; pass < 2 && R->outcome == GP_OK; pass++) {
             if (pass == 1) {
-                if (ds.wall_force[5] > 0 || !pushed)
+                if (ds->wall_force[5] > 0 || !R->pushed)
                     break;
                 gp_dem3d_set_servo_limit(dem, 5, h_sink);
             }
             for (;;) {
-                if ((st = gp_dem3d_run(dem, CHUNK, err))) {
-                    ret = st;
-                    goto fail;
-                }
-                gp_dem3d_get_state(dem, &ds);
-                double sc = ds.stability;
+                gp_status st = gp_dem3d_run(dem, CHUNK, R->err);
+                if (st)
+                    return st;
+                gp_dem3d_get_state(dem, ds);
+                double sc = ds->stability;
                 double fr = log(fmax(sc, STABILITY) / 1.0) / log(STABILITY);
-                if (report(&rc, "relaxation", 0.6 + 0.3 * fmin(1, fmax(0, fr)), ds.steps,
-                           1 - vs / (area * gp_dem3d_wall(dem, 5)), sc, 0)) {
-                    ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-                    goto fail;
-                }
+                if (report(&R->rc, "relaxation", 0.6 + 0.3 * fmin(1, fmax(0, fr)), ds->steps,
+                           1 - vs / (area * gp_dem3d_wall(dem, 5)), sc, 0))
+                    return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
                 /* (pass 1: and the wall is back on the packing, or as low as it may go) */
                 if (sc <= STABILITY
-                    && (pass == 0 || ds.wall_force[5] > 0 || gp_dem3d_wall(dem, 5) <= h_sink))
+                    && (pass == 0 || ds->wall_force[5] > 0 || gp_dem3d_wall(dem, 5) <= h_sink))
                     break;
-                if (ds.steps > max_steps) {
-                    reason = "max_steps";
-                    ret = gp_error_set(err, GP_ERR_NOT_CONVERGED,
-                                       "relaxation: S_c = %.3g after %ld steps (> 1e-4)", sc,
-                                       ds.steps);
+                if (ds->steps > R->max_steps) {
+                    R->reason = "max_steps";
+                    R->outcome = gp_error_set(R->err, GP_ERR_NOT_CONVERGED,
+                                              "relaxation: S_c = %.3g after %ld steps (> 1e-4)",
+                                              sc, ds->steps);
                     break;
                 }
             }
         }
-        if (ret == GP_OK && !(ds.wall_force[5] > 0)) {
+        if (R->outcome == GP_OK && !(ds->wall_force[5] > 0)) {
             /* the wall never touched a grain above b_z: the deposit is denser than the target;
              * or (pass 1) the packing settled further than POROSITY_SLACK */
-            reason = "target_too_loose";
-            ret = gp_error_set(err, GP_ERR_INFEASIBLE,
-                               "porosity %g is looser than this sieve holds at friction %g deg: "
-                               "the packing settles below the top wall (%s)", p,
-                               spec->material.friction_deg,
-                               !pushed ? "the deposit is denser"
-                                       : "after compaction to the target height");
+            R->reason = "target_too_loose";
+            R->outcome = gp_error_set(R->err, GP_ERR_INFEASIBLE,
+                                      "porosity %g is looser than this sieve holds at friction "
+                                      "%g deg: the packing settles below the top wall (%s)", p,
+                                      spec->material.friction_deg,
+                                      !R->pushed ? "the deposit is denser"
+                                                 : "after compaction to the target height");
         }
     }
-    res->t_relaxation = now() - t_phase;
-    gp_dem3d_get_state(dem, &ds);
-    S->stability = ds.stability;
-    S->steps = ds.steps;
-    S->dt = gp_dem3d_dt(dem);
-    S->stop_reason = reason;
-    gp_dem3d_spheres(dem, xyzr);
-    res->sample_box[2] = gp_dem3d_wall(dem, 5);
-    st = gp_dem3d_contacts(dem, &con, &ncon, err);
-    if (st) {
-        ret = st;
-        goto fail;
-    }
-    gp_dem3d_destroy(dem);
-    dem = NULL;
-    {
-        double hi[3] = {res->sample_box[0], res->sample_box[1], res->sample_box[2]};
-        double Vb = hi[0] * hi[1] * hi[2];
-        S->sample_porosity = 1 - gp_dem3d_solid_volume(xyzr, n, lo, hi) / Vb;
-    }
+    R->res->t_relaxation = gp_clock_seconds() - t_phase;
+    return GP_OK;
+}
 
-    /* ---- phase 2: flip tiling ---- */
-    t_phase = now();
+/* the sample as the DEM leaves it: its statistics, spheres, box (up to where the wall ended),
+ * contacts and porosity; the DEM is released */
+static gp_status collect_sample(build_run *R)
+{
+    gp_specimen3d *res = R->res;
+    gp_stats3d *S = &res->stats;
+    gp_dem3d *dem = R->dem;
+    gp_dem3d_get_state(dem, &R->ds);
+    S->stability = R->ds.stability;
+    S->steps = R->ds.steps;
+    S->dt = gp_dem3d_dt(dem);
+    S->stop_reason = R->reason;
+    gp_dem3d_spheres(dem, R->xyzr);
+    res->sample_box[2] = gp_dem3d_wall(dem, 5);
+    gp_status st = gp_dem3d_contacts(dem, &R->con, &R->ncon, R->err);
+    if (st)
+        return st;
+    gp_dem3d_destroy(dem);
+    R->dem = NULL;
+    double lo[3] = {0, 0, 0};
+    double hi[3] = {res->sample_box[0], res->sample_box[1], res->sample_box[2]};
+    double Vb = hi[0] * hi[1] * hi[2];
+    S->sample_porosity = 1 - gp_dem3d_solid_volume(R->xyzr, R->n, lo, hi) / Vb;
+    return GP_OK;
+}
+
+/* ---- phase 2: flip tiling ----
+ * When tiled (and the sample is not infeasible): the tiled spheres, the tiled box, the
+ * optional DEM relaxation of the tiling, and its porosity; else the sample's porosity. */
+static gp_status tile_sample(build_run *R)
+{
+    const gp_spec3d *spec = R->spec;
+    gp_specimen3d *res = R->res;
+    gp_stats3d *S = &res->stats;
     for (int a = 0; a < 3; a++)
         res->box[a] = res->sample_box[a];
-    int tile = ntile > 1 && (ret == GP_OK || ret == GP_ERR_NOT_CONVERGED);
-    int relaxed = tile && spec->tile_relax_steps > 0; /* measured on the DEM's contacts */
-    if (tile) {
-        report(&rc, "tiling", 0.9, S->steps, p, S->stability, 1);
-        st = gp_flip_tile_ex(xyzr, n, res->sample_box, spec->tiling, MAX_TILED_SPHERES, cancel,
-                             &tiled, &ntiled, err);
-        /* (the reports between the steps show the phase: a tiling of 10^7 spheres takes
-         * seconds, and the first report may have come too soon after the last to be shown) */
-        if (!st && report(&rc, "tiling", 0.93, S->steps, p, S->stability, 0))
-            st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-        for (int a = 0; a < 3; a++)
-            res->box[a] = res->sample_box[a] * spec->tiling[a];
-        if (!st && relaxed)
-            st = relax_tiled(spec, &dp, &rc, S, tiled, ntiled, res->box, &tcon, &ntcon, err);
-        if (!st)
-            st = tiled_porosity(spec->tiling, res->sample_box, res->box, tiled, n, cancel,
-                                &S->porosity, err);
-        if (st) {
-            ret = st;
-            goto fail;
-        }
-    } else {
+    R->tile = R->ntile > 1 && (R->outcome == GP_OK || R->outcome == GP_ERR_NOT_CONVERGED);
+    R->relaxed = R->tile && spec->tile_relax_steps > 0; /* measured on the DEM's contacts */
+    if (!R->tile) {
         S->porosity = S->sample_porosity;
+        return GP_OK;
     }
+    report(&R->rc, "tiling", 0.9, S->steps, R->p, S->stability, 1);
+    gp_status st = gp_flip_tile(R->xyzr, R->n, res->sample_box, spec->tiling,
+                                MAX_TILED_SPHERES, R->cancel, &R->tiled, &R->ntiled, R->err);
+    /* (the reports between the steps show the phase: a tiling of 10^7 spheres takes
+     * seconds, and the first report may have come too soon after the last to be shown) */
+    if (!st && report(&R->rc, "tiling", 0.93, S->steps, R->p, S->stability, 0))
+        st = gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
+    for (int a = 0; a < 3; a++)
+        res->box[a] = res->sample_box[a] * spec->tiling[a];
+    if (!st && R->relaxed)
+        st = relax_tiled(spec, &R->dp, &R->rc, S, R->tiled, R->ntiled, res->box, &R->tcon,
+                         &R->ntcon, R->err);
+    if (!st)
+        st = tiled_porosity(spec->tiling, res->sample_box, res->box, R->tiled, R->n, R->cancel,
+                            &S->porosity, R->err);
+    return st;
+}
 
-    /* ---- measures on the final packing ---- */
-    /* Without a tiled relaxation the tiled contacts are the sample's, mapped by the flip as
-     * they are measured (never all held unless the list is an output); t_tiling counts that
-     * pass too. */
-    if (report(&rc, "tiling", 0.96, S->steps, p, S->stability, 0)) {
-        ret = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
-        goto fail;
+/* ---- measures on the final packing ----
+ * Without a tiled relaxation the tiled contacts are the sample's, mapped by the flip as they
+ * are measured (never all held unless the list is an output). */
+static gp_status measure_final(build_run *R)
+{
+    gp_stats3d *S = &R->res->stats;
+    if (report(&R->rc, "tiling", 0.96, S->steps, R->p, S->stability, 0))
+        return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
+    S->particles = R->tile ? R->ntiled : R->n;
+    R->res->count = S->particles;
+    return measure(R->spec, R->tile && !R->relaxed, R->relaxed ? R->tcon : R->con,
+                   R->relaxed ? R->ntcon : R->ncon, R->n, R->tile ? R->tiled : R->xyzr,
+                   S->particles, R->cancel, R->res, R->err);
+}
+
+/* the final spheres move to the result (GP_OUT3_SPHERES) */
+static void hand_out_spheres(build_run *R)
+{
+    if (!(R->spec->outputs & GP_OUT3_SPHERES))
+        return;
+    if (R->tile) {
+        R->res->spheres = R->tiled;
+        R->tiled = NULL;
+    } else {
+        R->res->spheres = R->xyzr;
+        R->xyzr = NULL;
     }
-    S->particles = tile ? ntiled : n;
-    res->count = S->particles;
-    st = measure(spec, tile && !relaxed, relaxed ? tcon : con, relaxed ? ntcon : ncon, xyzr, n,
-                 tile ? tiled : xyzr, S->particles, cancel, res, err);
+}
+
+gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress_fn progress, void *user,
+                              const volatile int *cancel, gp_specimen3d **out, gp_error *err)
+{
+    double t0 = gp_clock_seconds();
+    *out = NULL;
+    if (!spec)
+        return gp_error_set(err, GP_ERR_INVALID, "spec is NULL");
+    build_run R;
+    memset(&R, 0, sizeof R);
+    R.spec = spec;
+    R.cancel = cancel;
+    R.rc = (progress_ctx){progress, user, cancel, 0};
+    R.err = err;
+    R.outcome = GP_OK;
+    R.reason = "stable";
+    gp_status st = read_spec(&R);
+    if (!st) st = draw_sample(&R);
+    if (!st) st = place_sample(&R);
+    if (!st) st = start_dem(&R);
+    if (!st) st = deposit(&R);
+    if (!st) st = compact(&R);
+    if (!st) st = relax(&R);
+    if (!st) st = collect_sample(&R);
+    double t_phase = gp_clock_seconds(); /* t_tiling: the tiling and the measures */
+    if (!st) st = tile_sample(&R);
+    if (!st) st = measure_final(&R);
+    gp_specimen3d *res = R.res;
     if (st) {
-        ret = st;
-        goto fail;
+        gp_specimen3d_destroy(res);
+        build_run_release(&R);
+        return st;
     }
-    res->t_tiling = now() - t_phase;
-    if (spec->outputs & GP_OUT3_SPHERES) {
-        if (tile) {
-            res->spheres = tiled;
-            tiled = NULL;
-        } else {
-            res->spheres = xyzr;
-            xyzr = NULL;
-        }
-    }
-    report(&rc, "tiling", 1.0, S->steps, S->porosity, S->stability, 1);
-    free(con); free(tcon); free(tiled); free(xyzr); free(diam); free(sd); free(sw);
-    gp_rng_destroy(rng);
-    res->t_total = now() - t0;
+    res->t_tiling = gp_clock_seconds() - t_phase;
+    hand_out_spheres(&R);
+    report(&R.rc, "tiling", 1.0, res->stats.steps, res->stats.porosity, res->stats.stability, 1);
+    build_run_release(&R);
+    res->t_total = gp_clock_seconds() - t0;
     *out = res;
-    return ret;
-
-fail:
-    gp_dem3d_destroy(dem);
-    free(con); free(tcon); free(tiled); free(xyzr); free(diam); free(sd); free(sw);
-    if (rng) gp_rng_destroy(rng);
-    gp_specimen3d_destroy(res);
-    return ret;
+    return R.outcome;
 }

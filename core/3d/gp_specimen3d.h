@@ -9,6 +9,13 @@
  *
  * Axes: x, y horizontal, z vertical. box[2] is the height; gravity is -9.81 m/s^2 along z. (The
  * paper's y is vertical: its fabric "yy" is our "zz".) The box spans [0, box[i]] on each axis.
+ *
+ * Invariants: the same spec and seed give the same specimen bit for bit, whatever
+ * spec->threads and whichever outputs are asked (the measures do not depend on
+ * GP_OUT3_CONTACTS). Ownership: the spec and its sieve are only read; a gp_specimen3d and
+ * every array in it are the caller's, freed by gp_specimen3d_destroy; its contacts are the
+ * DEM's type (gp_contact3d, gp_dem3d.h). Thread safety: no global state; builds on different
+ * threads are independent (each runs spec->threads DEM workers of its own).
  */
 #ifndef GP_SPECIMEN3D_H
 #define GP_SPECIMEN3D_H
@@ -16,6 +23,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "gp_dem3d.h" /* gp_contact3d */
 #include "gp_error.h"
 #include "gp_progress.h"
 
@@ -79,18 +87,6 @@ typedef struct gp_psd3d {
     double *achieved_number;
 } gp_psd3d;
 
-/* A contact. j >= 0: sphere j (i < j); j < 0: wall -1 - j, walls 0..5 = x-, x+, y-, y+, z-, z+
- * of the (tiled) box. normal points from sphere i to j (or to the wall). overlap is the full
- * overlap R_i + R_j - |O_i O_j| (for a wall: R_i - |O_i W|, Eq. 12; Eq. 11's penetration is half
- * the sphere-sphere overlap). force is the force on sphere i (normal + shear), N. */
-typedef struct gp_contact3d {
-    size_t i;
-    long j;
-    double normal[3];
-    double overlap;
-    double force[3];
-} gp_contact3d;
-
 typedef struct gp_stats3d {
     double porosity_target;
     double porosity;             /* achieved, final packing (tiled when tiled): 1 - solid/box,
@@ -122,7 +118,7 @@ typedef struct gp_specimen3d {
     size_t count;                /* number of spheres in the final packing (even without output) */
     double box[3];               /* the final (tiled) box, m */
     double sample_box[3];        /* the sample box, m */
-    gp_contact3d *contacts;      /* with GP_OUT3_CONTACTS */
+    gp_contact3d *contacts;      /* with GP_OUT3_CONTACTS (the type: gp_dem3d.h) */
     size_t ncontacts;
     gp_stats3d stats;
     /* timings, seconds */

@@ -9,7 +9,6 @@
 #include <string.h>
 
 #define CACHE_BYTES (64u * 1024u)
-#define WRITE_CHUNK (64u * 1024u)
 
 /* ------------------------------------------------------------------ registry */
 
@@ -342,6 +341,34 @@ int gp_xw_printf(gp_export *e, const char *fmt, ...)
     }
 }
 
+/* the line-per-item formats (gp_export_internal.h) */
+static int next_grain(gp_export *e, const gp_xlines *f)
+{
+    return f->grain ? f->grain(e) : gp_xr_grain(e, e->index, &e->grain);
+}
+
+int gp_xw_lines(gp_export *e, const gp_xlines *f)
+{
+    if (e->section == 0) {
+        e->section = 1;
+        e->index = e->sub = 0;
+        if (f->header(e)) return -1;
+        if (e->nitems == 0) return 1;
+        return e->dim == 2 ? next_grain(e, f) : 0;
+    }
+    if (e->dim == 3) {
+        double q[4];
+        if (gp_xr_sphere(e, e->index, q) || f->sphere(e, q)) return -1;
+        return ++e->index >= e->nitems;
+    }
+    double d[3];
+    if (gp_xr_disc(e, e->grain.disc_first + e->sub, d) || f->disc(e, d)) return -1;
+    if (++e->sub < e->grain.disc_count) return 0;
+    e->sub = 0;
+    if (++e->index >= e->nitems) return 1;
+    return next_grain(e, f);
+}
+
 /* ------------------------------------------------------------------ stream */
 
 gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_export **out,
@@ -413,9 +440,7 @@ gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_exp
     }
     switch (f) {
     case GP_EXPORT_LAMMPS:
-        e->step = e->dim == 3 ? gp_export_step_lammps3d : gp_export_step_lammps2d;
-        break;
-    case GP_EXPORT_LIGGGHTS: e->step = gp_export_step_lammps3d; break;
+    case GP_EXPORT_LIGGGHTS: e->step = gp_export_step_lammps; break;
     case GP_EXPORT_YADE: e->step = gp_export_step_yade; break;
     case GP_EXPORT_VTK: e->step = e->dim == 3 ? gp_export_step_vtk3d : gp_export_step_vtk2d; break;
     default: e->step = gp_export_step_csv; break;
@@ -423,10 +448,6 @@ gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_exp
     *out = e;
     return GP_OK;
 }
-
-int gp_export_dim(const gp_export *e) { return e->dim; }
-uint64_t gp_export_items(const gp_export *e) { return e->nitems; }
-uint64_t gp_export_discs(const gp_export *e) { return e->ndiscs; }
 
 gp_status gp_export_read(gp_export *e, char *buf, size_t cap, size_t *n, gp_error *err)
 {
@@ -464,31 +485,4 @@ void gp_export_destroy(gp_export *e)
     free(e->cache);
     free(e->buf);
     free(e);
-}
-
-gp_status gp_export_write_all(gp_export_format f, const void *pack, size_t len,
-                              int (*write)(void *user, const char *buf, size_t n), void *user,
-                              gp_error *err)
-{
-    gp_export_source src = gp_export_memory_source(pack, len);
-    gp_export *e;
-    gp_status st = gp_export_open(f, &src, &e, err);
-    if (st) return st;
-    char *buf = malloc(WRITE_CHUNK);
-    if (!buf) {
-        gp_export_destroy(e);
-        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-    }
-    for (;;) {
-        size_t n;
-        st = gp_export_read(e, buf, WRITE_CHUNK, &n, err);
-        if (st || n == 0) break;
-        if (write(user, buf, n)) {
-            st = gp_error_set(err, GP_ERR_INVALID, "writing the export failed");
-            break;
-        }
-    }
-    free(buf);
-    gp_export_destroy(e);
-    return st;
 }

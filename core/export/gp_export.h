@@ -16,6 +16,11 @@
  * (gp_export_internal.h). Everything is SI, as in the JSON result; reals are written with
  * %.17g, which reads back bit for bit.
  *
+ * Ownership: a pack is malloc'ed by gp_export_pack_*() and is the caller's to free; an export
+ * neither copies nor owns its source, which must outlive it (gp_export_destroy frees the
+ * export's own buffers). Thread safety: no global state; one thread at a time per gp_export,
+ * and any number of exports (of the same pack too) may run concurrently.
+ *
  * Pack layout (native byte order and IEEE doubles, as the daemon reads what it wrote on the
  * same machine; the header carries a byte-order mark and a version, checked on open):
  *
@@ -107,21 +112,10 @@ typedef struct gp_export gp_export;
 gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_export **out,
                          gp_error *err);
 
-/* The pack's dimension (2 or 3), item count (spheres or grains) and disc count (2D). */
-int gp_export_dim(const gp_export *e);
-uint64_t gp_export_items(const gp_export *e);
-uint64_t gp_export_discs(const gp_export *e);
-
 /* Copies up to cap (> 0) bytes of the file into buf; *n = 0 means the end. GP_ERR_INVALID when the
  * source failed or the pack is inconsistent (the file is then incomplete: drop it). */
 gp_status gp_export_read(gp_export *e, char *buf, size_t cap, size_t *n, gp_error *err);
 
 void gp_export_destroy(gp_export *e);
-
-/* Convenience: the whole export of an in-memory pack through a write callback (e.g. fwrite
- * to a file), in 64 KiB pieces. The callback returns 0 on success. */
-gp_status gp_export_write_all(gp_export_format f, const void *pack, size_t len,
-                              int (*write)(void *user, const char *buf, size_t n), void *user,
-                              gp_error *err);
 
 #endif /* GP_EXPORT_H */

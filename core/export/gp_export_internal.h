@@ -61,9 +61,26 @@ int gp_xr_grain(gp_export *e, uint64_t g, gp_xgrain *out);
 int gp_xr_point(gp_export *e, uint64_t k, double p[2]);
 int gp_xr_disc(gp_export *e, uint64_t k, double d[3]);
 
+/* A format that is a header, then one line per sphere (3D) or per ODEC disc (2D, grain by
+ * grain, disc e->sub of grain e->index): lammps / liggghts, yade and csv. gp_xw_lines() is the
+ * step of such a format: section 0 writes the header and loads grain 0 (2D), then each call
+ * writes the line of the next sphere or disc, loading the next grain after a grain's last
+ * disc. The writers return 0, or -1 with e->err set:
+ *   header  the header record (e->index and e->sub are 0);
+ *   sphere  the line of sphere e->index, q = x, y, z, r;
+ *   disc    the line of disc e->sub of grain e->index (in e->grain), d = x, y, r;
+ *   grain   loads grain e->index into e->grain (NULL: gp_xr_grain alone). */
+typedef struct gp_xlines {
+    int (*header)(gp_export *e);
+    int (*sphere)(gp_export *e, const double q[4]);
+    int (*disc)(gp_export *e, const double d[3]);
+    int (*grain)(gp_export *e);
+} gp_xlines;
+
+int gp_xw_lines(gp_export *e, const gp_xlines *f);
+
 /* The step functions of the families. */
-int gp_export_step_lammps3d(gp_export *e);   /* lammps and liggghts */
-int gp_export_step_lammps2d(gp_export *e);
+int gp_export_step_lammps(gp_export *e);     /* lammps (3D and 2D) and liggghts */
 int gp_export_step_yade(gp_export *e);
 int gp_export_step_vtk3d(gp_export *e);
 int gp_export_step_vtk2d(gp_export *e);

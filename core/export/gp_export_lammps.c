@@ -16,40 +16,73 @@
 
 #include <math.h>
 
-int gp_export_step_lammps3d(gp_export *e)
+/* The counts, the box and the Atoms line, common to both headers (natoms atoms; z bounds zlo,
+ * zhi; the atom style's name). */
+static int write_box(gp_export *e, uint64_t natoms, double zlo, double zhi, const char *style)
 {
-    if (e->section == 0) {
-        int lig = e->format == GP_EXPORT_LIGGGHTS;
-        int rc = gp_xw_printf(
-            e,
-            "%s data file from grainpack (spheres-3d): %llu spheres, SI units\n"
-            "# read with: units si / atom_style sphere / %sread_data FILE\n"
-            "# atom line: id type diameter(m) density(kg/m^3) x y z (m)\n"
-            "\n"
-            "%llu atoms\n"
-            "1 atom types\n"
-            "\n"
-            "%.17g %.17g xlo xhi\n"
-            "%.17g %.17g ylo yhi\n"
-            "%.17g %.17g zlo zhi\n"
-            "\n"
-            "Atoms # sphere\n"
-            "\n",
-            lig ? "LIGGGHTS" : "LAMMPS", (unsigned long long)e->nitems,
-            lig ? "atom_modify map array sort 0 0 / boundary f f f / " : "",
-            (unsigned long long)e->nitems,
-            e->lo[0], e->hi[0], e->lo[1], e->hi[1], e->lo[2], e->hi[2]);
-        e->section = 1;
-        e->index = 0;
-        if (rc) return -1;
-        return e->nitems == 0;
-    }
-    double q[4];
-    if (gp_xr_sphere(e, e->index, q)) return -1;
-    if (gp_xw_printf(e, "%llu 1 %.17g %.17g %.17g %.17g %.17g\n",
-                     (unsigned long long)e->index + 1, 2.0 * q[3], e->density, q[0], q[1], q[2]))
+    return gp_xw_printf(e,
+                        "\n"
+                        "%llu atoms\n"
+                        "1 atom types\n"
+                        "\n"
+                        "%.17g %.17g xlo xhi\n"
+                        "%.17g %.17g ylo yhi\n"
+                        "%.17g %.17g zlo zhi\n"
+                        "\n"
+                        "Atoms # %s\n"
+                        "\n",
+                        (unsigned long long)natoms, e->lo[0], e->hi[0], e->lo[1], e->hi[1], zlo,
+                        zhi, style);
+}
+
+static int header_3d(gp_export *e)
+{
+    int lig = e->format == GP_EXPORT_LIGGGHTS;
+    if (gp_xw_printf(e,
+                     "%s data file from grainpack (spheres-3d): %llu spheres, SI units\n"
+                     "# read with: units si / atom_style sphere / %sread_data FILE\n"
+                     "# atom line: id type diameter(m) density(kg/m^3) x y z (m)\n",
+                     lig ? "LIGGGHTS" : "LAMMPS", (unsigned long long)e->nitems,
+                     lig ? "atom_modify map array sort 0 0 / boundary f f f / " : ""))
         return -1;
-    return ++e->index >= e->nitems;
+    return write_box(e, e->nitems, e->lo[2], e->hi[2], "sphere");
+}
+
+static int header_2d(gp_export *e)
+{
+    double half = 0.5 * fmax(e->hi[0] - e->lo[0], e->hi[1] - e->lo[1]);
+    if (gp_xw_printf(
+            e,
+            "LAMMPS data file from grainpack (fourier-voronoi-2d): %llu grains as rigid bodies "
+            "of %llu ODEC discs, SI units\n"
+            "# atom line: id type x y z diameter(m) density(kg/m^3) molecule (= grain id + 1)\n"
+            "# a grain's discs weigh %.17g kg/m^3 * grain area * 1 m (2D, unit thickness)\n"
+            "# read with:\n"
+            "#   dimension 2\n"
+            "#   units si\n"
+            "#   atom_style hybrid sphere molecular\n"
+            "#   read_data FILE\n"
+            "#   pair_style gran/hooke/history <kn> NULL <gamman> NULL <mu> 0 ; pair_coeff * *\n"
+            "#   neigh_modify exclude molecule/intra all\n"
+            "#   comm_modify vel yes cutoff %.6g\n"
+            "#   fix grains all rigid/small molecule\n"
+            "#   fix plane all enforce2d\n",
+            (unsigned long long)e->nitems, (unsigned long long)e->ndiscs, e->density,
+            1.5 * e->max_extent))
+        return -1;
+    return write_box(e, e->ndiscs, -half, half, "hybrid");
+}
+
+static int lammps_header(gp_export *e)
+{
+    return e->dim == 3 ? header_3d(e) : header_2d(e);
+}
+
+/* 3D atom line: id type diameter density x y z */
+static int lammps_sphere(gp_export *e, const double q[4])
+{
+    return gp_xw_printf(e, "%llu 1 %.17g %.17g %.17g %.17g %.17g\n",
+                        (unsigned long long)e->index + 1, 2.0 * q[3], e->density, q[0], q[1], q[2]);
 }
 
 /* Loads grain e->index into e->grain and its disc density scale into e->aux. */
@@ -66,55 +99,19 @@ static int load_grain(gp_export *e)
     return 0;
 }
 
-int gp_export_step_lammps2d(gp_export *e)
+/* 2D atom line: id type x y z diameter density molecule */
+static int lammps_disc(gp_export *e, const double d[3])
 {
-    if (e->section == 0) {
-        double half = 0.5 * fmax(e->hi[0] - e->lo[0], e->hi[1] - e->lo[1]);
-        int rc = gp_xw_printf(
-            e,
-            "LAMMPS data file from grainpack (fourier-voronoi-2d): %llu grains as rigid bodies "
-            "of %llu ODEC discs, SI units\n"
-            "# atom line: id type x y z diameter(m) density(kg/m^3) molecule (= grain id + 1)\n"
-            "# a grain's discs weigh %.17g kg/m^3 * grain area * 1 m (2D, unit thickness)\n"
-            "# read with:\n"
-            "#   dimension 2\n"
-            "#   units si\n"
-            "#   atom_style hybrid sphere molecular\n"
-            "#   read_data FILE\n"
-            "#   pair_style gran/hooke/history <kn> NULL <gamman> NULL <mu> 0 ; pair_coeff * *\n"
-            "#   neigh_modify exclude molecule/intra all\n"
-            "#   comm_modify vel yes cutoff %.6g\n"
-            "#   fix grains all rigid/small molecule\n"
-            "#   fix plane all enforce2d\n"
-            "\n"
-            "%llu atoms\n"
-            "1 atom types\n"
-            "\n"
-            "%.17g %.17g xlo xhi\n"
-            "%.17g %.17g ylo yhi\n"
-            "%.17g %.17g zlo zhi\n"
-            "\n"
-            "Atoms # hybrid\n"
-            "\n",
-            (unsigned long long)e->nitems, (unsigned long long)e->ndiscs, e->density,
-            1.5 * e->max_extent, (unsigned long long)e->ndiscs, e->lo[0], e->hi[0], e->lo[1],
-            e->hi[1], -half, half);
-        e->section = 1;
-        e->index = e->sub = 0;
-        if (rc) return -1;
-        if (e->nitems == 0) return 1;
-        return load_grain(e);
-    }
-    double d[3];
-    if (gp_xr_disc(e, e->grain.disc_first + e->sub, d)) return -1;
     /* mass = (4/3) pi r^3 rho' = rho * scale * pi r^2, see the file comment */
     double rho = e->density * e->aux * 0.75 / d[2];
-    if (gp_xw_printf(e, "%llu 1 %.17g %.17g 0 %.17g %.17g %llu\n",
-                     (unsigned long long)(e->grain.disc_first + e->sub + 1), d[0], d[1],
-                     2.0 * d[2], rho, (unsigned long long)e->index + 1))
-        return -1;
-    if (++e->sub < e->grain.disc_count) return 0;
-    e->sub = 0;
-    if (++e->index >= e->nitems) return 1;
-    return load_grain(e);
+    return gp_xw_printf(e, "%llu 1 %.17g %.17g 0 %.17g %.17g %llu\n",
+                        (unsigned long long)(e->grain.disc_first + e->sub + 1), d[0], d[1],
+                        2.0 * d[2], rho, (unsigned long long)e->index + 1);
+}
+
+static const gp_xlines lammps_lines = {lammps_header, lammps_sphere, lammps_disc, load_grain};
+
+int gp_export_step_lammps(gp_export *e)
+{
+    return gp_xw_lines(e, &lammps_lines);
 }

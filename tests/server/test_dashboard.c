@@ -1,14 +1,17 @@
 /* test_dashboard.c -- the dashboard page: self-contained HTML that polls the job list, submits,
- * cancels and shows SVG views and exports; a finished job's warnings (amber) and fit table; and
- * dashboard.c is in sync with dashboard.html. With node installed, the page's script also runs
- * against a stand-in DOM (tests/server/dashboard_check.js) to check how a finished job is drawn. */
+ * cancels and shows SVG views and exports; a finished job's warnings (amber) and fit table;
+ * the kinds, their examples, views and export formats filled in from the daemon's kind table
+ * (server/page.c), none of them written in the page itself; and dashboard.c is in sync with
+ * dashboard.html. With node installed, the page's script also runs against a stand-in DOM
+ * (tests/server/dashboard_check.js) to check how a finished job is drawn. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "../../server/dashboard.c"
+#include "dashboard.h"
 #include "gp_test.h"
+#include "page.h"
 
 /* a path relative to this file's directory */
 static void here(char *path, size_t n, const char *rel)
@@ -18,22 +21,19 @@ static void here(char *path, size_t n, const char *rel)
     snprintf(path, n, "%.*s/%s", slash ? (int)(slash - me) : 1, slash ? me : ".", rel);
 }
 
-/* server/dashboard.html, two levels up from this file */
-static char *read_html(void)
+/* a whole file (relative to this one's directory), NUL-terminated; NULL when unreadable */
+static char *slurp(const char *rel)
 {
     char path[1024];
-    here(path, sizeof path, "../../server/dashboard.html");
+    here(path, sizeof path, rel);
     FILE *f = fopen(path, "rb");
-    if (!f) {
-        fprintf(stderr, "cannot open %s\n", path);
-        return NULL;
-    }
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = malloc((size_t)n + 1);
+    char *buf = NULL;
+    long n = -1;
+    if (f && fseek(f, 0, SEEK_END) == 0) n = ftell(f);
+    if (n >= 0 && fseek(f, 0, SEEK_SET) == 0) buf = malloc((size_t)n + 1);
     if (buf && fread(buf, 1, (size_t)n, f) == (size_t)n) buf[n] = 0;
-    fclose(f);
+    if (f) fclose(f);
+    if (!buf) fprintf(stderr, "cannot read %s\n", path);
     return buf;
 }
 
@@ -46,9 +46,9 @@ static void run_in_node(const char *page)
     }
     char html[] = "/tmp/gp_test_dashboard_XXXXXX";
     int fd = mkstemp(html);
-    CHECK(fd >= 0);
-    if (fd < 0) return;
-    FILE *f = fdopen(fd, "w");
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    CHECK(f != NULL);
+    if (!f) return;
     fputs(page, f);
     fclose(f);
     char js[1024], cmd[2200];
@@ -58,49 +58,57 @@ static void run_in_node(const char *page)
     unlink(html);
 }
 
+/* every string of a NULL-terminated list is in h */
+static void check_all(const char *h, const char *const *want)
+{
+    for (; *want; want++) {
+        int ok = strstr(h, *want) != NULL;
+        CHECK(ok);
+        if (!ok) fprintf(stderr, "not in the page: %s\n", *want);
+    }
+}
+
 int main(void)
 {
-    const char *h = gp_dashboard_html();
-    CHECK(h != NULL && strlen(h) > 1000);
+    const char *tpl = gp_dashboard_html(), *h = gpd_page_html();
+    CHECK(tpl != NULL && h != NULL && strlen(h) > strlen(tpl));
+    if (!tpl || !h) return gp_test_summary();
+    static const char *const page[] = {
+        "<!DOCTYPE html>", "</html>", "<meta charset=\"utf-8\">",
+        /* polling, every second */
+        "setInterval(refresh, POLL_MS)", "POLL_MS = 1000",
+        /* the endpoints it uses */
+        "\"/v1/jobs?limit=50\"", "api(\"POST\", \"/v1/jobs\"", "api(\"DELETE\", \"/v1/jobs/\"",
+        "/svg?view=", "/export?format=", "/v1/health", ".fraction",
+        /* a finished job: warnings from its progress detail in amber, the fit report */
+        "jobDetail(job).warnings", "--amber: #bf8700", ".bar.done.warn > div { background: var(--amber)",
+        "\"warnmark\"", "s-warn", "cell_area", "grain_area", "cell_orientation",
+        "grain_orientation", "passing", "ks_critical", "max_error_pp", "w1", "fitTable(fit)",
+        "b.ks > b.ks_critical",
+        /* filled in from the kind table: every kind, view and export format of api.md, and the
+         * api.md example specs */
+        "\"fourier-voronoi-2d\":{\"example\":", "\"spheres-3d\":{\"example\":", "\"packing\"",
+        "\"cells\"", "\"size\"", "\"orientation\"", "\"descriptors\"", "\"section\"", "\"psd\"",
+        "\"lammps\"", "\"liggghts\"", "\"yade\"", "\"vtk\"", "\"csv\"", "\"solid_fraction\":0.65",
+        "\"porosity\":0.38", "{\"name\":\"packing\",\"options\":[\"color\"]}", NULL};
     CHECK(strncmp(h, "<!DOCTYPE html>", 15) == 0);
-    CHECK(strstr(h, "</html>") != NULL);
-    CHECK(strstr(h, "<meta charset=\"utf-8\">") != NULL);
-    /* polling, every second */
-    CHECK(strstr(h, "setInterval(refresh, POLL_MS)") != NULL);
-    CHECK(strstr(h, "POLL_MS = 1000") != NULL);
-    /* the endpoints it uses */
-    CHECK(strstr(h, "\"/v1/jobs?limit=50\"") != NULL);
-    CHECK(strstr(h, "api(\"POST\", \"/v1/jobs\"") != NULL);
-    CHECK(strstr(h, "api(\"DELETE\", \"/v1/jobs/\"") != NULL);
-    CHECK(strstr(h, "/svg?view=") != NULL);
-    CHECK(strstr(h, "/export?format=") != NULL);
-    CHECK(strstr(h, "/v1/health") != NULL);
-    CHECK(strstr(h, "\"fraction\"") != NULL || strstr(h, ".fraction") != NULL);
-    /* every view and export format of api.md */
-    const char *names[] = {"packing", "cells", "size", "orientation", "descriptors", "section", "psd",
-                           "lammps", "liggghts", "yade", "vtk", "csv"};
-    for (size_t i = 0; i < sizeof names / sizeof *names; i++) CHECK(strstr(h, names[i]) != NULL);
-    /* the api.md example spec */
-    CHECK(strstr(h, "solid_fraction: 0.65") != NULL && strstr(h, "porosity: 0.38") != NULL);
-    /* a finished job: warnings from its progress detail in amber, the fit report as a table */
-    CHECK(strstr(h, "detail.warnings") != NULL || strstr(h, "jobDetail(job).warnings") != NULL);
-    CHECK(strstr(h, "--amber: #bf8700") != NULL && strstr(h, ".bar.done.warn > div { background: var(--amber)"));
-    CHECK(strstr(h, "\"warnmark\"") != NULL && strstr(h, "s-warn") != NULL);
-    const char *fit_keys[] = {"cell_area", "grain_area", "cell_orientation", "grain_orientation",
-                              "passing", "ks_critical", "max_error_pp", "w1", "fitTable(fit)"};
-    for (size_t i = 0; i < sizeof fit_keys / sizeof *fit_keys; i++) CHECK(strstr(h, fit_keys[i]) != NULL);
-    CHECK(strstr(h, "b.ks > b.ks_critical") != NULL);
+    check_all(h, page);
+    /* the page itself names no kind: it takes them from the daemon */
+    CHECK(strstr(tpl, "fourier-voronoi-2d") == NULL && strstr(tpl, "spheres-3d") == NULL);
+    CHECK(strstr(tpl, "var KINDS = /*@KINDS@*/{};") != NULL);
     run_in_node(h);
-    /* self-contained: nothing fetched from elsewhere */
+    /* self-contained: nothing fetched from elsewhere, nothing that would close the script */
     CHECK(strstr(h, "http://") == NULL && strstr(h, "https://") == NULL);
     CHECK(strstr(h, "<script src") == NULL && strstr(h, "<link") == NULL);
+    CHECK(strstr(strstr(h, "<script>"), "</script>") == strstr(h, "</script>"));
+    /* its policy: the inline script by its hash, nothing from elsewhere */
+    const char *csp = gpd_page_csp();
+    CHECK(csp && strstr(csp, "script-src 'sha256-") && strstr(csp, "default-src 'self'"));
     /* in sync with the HTML source */
-    char *src = read_html();
-    CHECK(src != NULL);
-    if (src) {
-        CHECK(strcmp(src, h) == 0);
-        if (strcmp(src, h)) fprintf(stderr, "server/dashboard.c is stale: run python3 server/dashboard_gen.py\n");
-    }
+    char *src = slurp("../../server/dashboard.html");
+    CHECK(src != NULL && strcmp(src, tpl) == 0);
+    if (src && strcmp(src, tpl))
+        fprintf(stderr, "server/dashboard.c is stale: run python3 server/dashboard_gen.py\n");
     free(src);
     return gp_test_summary();
 }

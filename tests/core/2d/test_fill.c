@@ -54,7 +54,8 @@ static double edge_clearance(const gp_vec2 *p, size_t n, gp_vec2 q)
 }
 
 /* largest |contour_i - curve_i| / r0 for the curve the result describes: the caller's
- * phases with res->phases[2..7], turned by res->rotation */
+ * phases with res->phases[2..7], turned by res->rotation. r(theta) by the direct cosine sum on
+ * purpose, an independent check of the filling's tables */
 static double curve_mismatch(const gp_fill_result *r, const double *ph, const gp_vec2 *contour)
 {
     double worst = 0.0;

@@ -324,7 +324,9 @@ static void test_mec(void)
     CHECK(gp_min_enclosing_circle(NULL, 0, &c, &r, &e) == GP_ERR_INVALID);
 }
 
-/* reference pole of inaccessibility: textbook polylabel with the d + h sqrt 2 bound */
+/* reference pole of inaccessibility: textbook polylabel with the d + h sqrt 2 bound. An
+ * independent check of gp_max_inscribed_circle on purpose: its own bounding box, cells and
+ * point-in-polygon test (naive_contains), nothing shared with the library's. */
 static double ref_sdist(const gp_vec2 *p, size_t n, double x, double y)
 {
     gp_vec2 q = {x, y};

@@ -212,12 +212,11 @@ static void hard(const char *name, const gp_vec2 *outer, size_t no, const gp_vec
 
 static int cb_calls = 0;
 static long cb_last = 0;
-static int progress_cb(void *user, long steps, double error)
+static int progress_cb(void *user, const gp_progress *p)
 {
-    (void)error;
     cb_calls++;
-    cb_last = steps;
-    return user ? (steps >= 8192) : 0;
+    cb_last = p->steps;
+    return user ? (p->steps >= 8192) : 0;
 }
 
 int main(void)

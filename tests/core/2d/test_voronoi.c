@@ -59,6 +59,8 @@ static double bf_cell_area(const gp_vec2 *box, int nbox, const gp_vec2 *s, int n
     return ar;
 }
 
+/* crossing-number point-in-polygon, deliberately not gp_poly_contains: the cells are checked
+ * against an independent test */
 static int poly_pip(const gp_vec2 *p, size_t n, gp_vec2 q)
 {
     int c = 0;
@@ -494,13 +496,9 @@ static void property_moves(const char *name, const gp_vec2 *outer, size_t no, co
                            const size_t *nh, size_t nholes, int N, int moves, int full_every)
 {
     gp_vec2 *s = malloc((size_t)N * sizeof *s);
-    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-    for (size_t k = 0; k < no; k++) {
-        x0 = fmin(x0, outer[k].x);
-        x1 = fmax(x1, outer[k].x);
-        y0 = fmin(y0, outer[k].y);
-        y1 = fmax(y1, outer[k].y);
-    }
+    gp_vec2 lo, hi;
+    gp_poly_bbox(outer, no, &lo, &hi, NULL);
+    double x0 = lo.x, y0 = lo.y, x1 = hi.x, y1 = hi.y;
     for (int i = 0; i < N; i++) s[i] = rand_in(outer, no, nholes ? holes[0] : NULL, nholes ? nh[0] : 0, x0, y0, x1, y1);
     gp_error e;
     gp_voronoi *v = gp_voronoi_create(outer, no, holes, nh, nholes, s, (size_t)N, &e);

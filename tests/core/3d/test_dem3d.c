@@ -17,6 +17,16 @@ static gp_dem3d_params base(void)
     return p;
 }
 
+/* a DEM of the n spheres s in the box [0, hi]; NULL when it could not be made */
+static gp_dem3d *in_box(const gp_dem3d_params *p, const double *s, size_t n, const double hi[3])
+{
+    const double lo[3] = {0, 0, 0};
+    gp_dem3d *d = NULL;
+    gp_error e;
+    CHECK(gp_dem3d_create(p, s, n, lo, hi, &d, &e) == GP_OK);
+    return d;
+}
+
 /* Head-on collision without damping or gravity: a linear spring k_n = E R (equal spheres)
  * between masses m gives restitution 1 and contact time pi sqrt((m/2) / k_n). */
 static void test_collision(void)
@@ -26,12 +36,11 @@ static void test_collision(void)
     p.gravity[2] = 0;
     double R = 0.01, u = 0.5;
     double s[8] = {0.1 - R - 1e-4, 0.1, 0.1, R, 0.1 + R + 1e-4, 0.1, 0.1, R};
-    double lo[3] = {0, 0, 0}, hi[3] = {0.2, 0.2, 0.2};
-    gp_dem3d *d;
-    gp_error e;
-    CHECK(gp_dem3d_create(&p, s, 2, lo, hi, &d, &e) == GP_OK);
+    double hi[3] = {0.2, 0.2, 0.2};
+    gp_dem3d *d = in_box(&p, s, 2, hi);
     if (!d)
         return;
+    gp_error e;
     double m = 4.0 / 3.0 * M_PI * R * R * R * p.density, kn = p.young * R;
     double tc = M_PI * sqrt(0.5 * m / kn);
     double dt = gp_dem3d_dt(d);
@@ -43,7 +52,7 @@ static void test_collision(void)
     gp_dem3d_destroy(d);
     double ov = 1e-4;
     double s2[8] = {0.1 - R + ov / 2, 0.1, 0.1, R, 0.1 + R - ov / 2, 0.1, 0.1, R};
-    CHECK(gp_dem3d_create(&p, s2, 2, lo, hi, &d, &e) == GP_OK);
+    d = in_box(&p, s2, 2, hi);
     long steps = 0;
     double xyzr[8];
     gp_dem3d_state st;
@@ -70,12 +79,11 @@ static void test_rest(void)
     gp_dem3d_params p = base();
     double R = 0.02;
     double s[8] = {0.05, 0.05, R, R, 0.05, 0.05, 3 * R, R};
-    double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.3};
-    gp_dem3d *d;
-    gp_error e;
-    CHECK(gp_dem3d_create(&p, s, 2, lo, hi, &d, &e) == GP_OK);
+    double hi[3] = {0.1, 0.1, 0.3};
+    gp_dem3d *d = in_box(&p, s, 2, hi);
     if (!d)
         return;
+    gp_error e;
     gp_dem3d_run(d, 20000, &e);
     gp_dem3d_state st;
     gp_dem3d_get_state(d, &st);
@@ -86,7 +94,7 @@ static void test_rest(void)
     gp_dem3d_spheres(d, x);
     CHECK_REL(R - x[2], 2 * m * g / (2 * p.young * R), 1e-5);      /* floor: 2 m g */
     CHECK_REL(2 * R - (x[6] - x[2]), m * g / (p.young * R), 1e-5); /* pair: m g, k_n = E R */
-    gp_dem3d_contact *c;
+    gp_contact3d *c;
     size_t nc;
     CHECK(gp_dem3d_contacts(d, &c, &nc, &e) == GP_OK);
     CHECK(nc == 2);
@@ -123,14 +131,13 @@ static void test_shear(void)
      * pair overlaps by ov and each wall by ov / 2 (same force 2 E R ov/2 = E R ov) */
     double W = 4 * R - 2 * ov;
     double s[8] = {R - ov / 2, 0.1, 0.1, R, W - R + ov / 2, 0.1, 0.1, R};
-    double lo[3] = {0, 0, 0}, hi[3] = {W, 0.2, 0.2};
-    gp_dem3d *d;
-    gp_error e;
-    CHECK(gp_dem3d_create(&p, s, 2, lo, hi, &d, &e) == GP_OK);
+    double hi[3] = {W, 0.2, 0.2};
+    gp_dem3d *d = in_box(&p, s, 2, hi);
     if (!d)
         return;
+    gp_error e;
     gp_dem3d_run(d, 50, &e);
-    gp_dem3d_contact *c;
+    gp_contact3d *c;
     size_t nc;
     gp_dem3d_contacts(d, &c, &nc, &e);
     CHECK(nc == 3);
@@ -149,12 +156,11 @@ static void test_servo(void)
     p.gravity[2] = 0;
     double R = 0.01;
     double s[12] = {0.02, 0.02, R, R, 0.02, 0.02, 3 * R + 1e-3, R, 0.02, 0.02, 5 * R + 2e-3, R};
-    double lo[3] = {0, 0, 0}, hi[3] = {0.04, 0.04, 0.08};
-    gp_dem3d *d;
-    gp_error e;
-    CHECK(gp_dem3d_create(&p, s, 3, lo, hi, &d, &e) == GP_OK);
+    double hi[3] = {0.04, 0.04, 0.08};
+    gp_dem3d *d = in_box(&p, s, 3, hi);
     if (!d)
         return;
+    gp_error e;
     double F = 50;
     gp_dem3d_set_servo(d, 5, F, 0.5);
     gp_dem3d_run(d, 30000, &e);
@@ -167,7 +173,7 @@ static void test_servo(void)
     double h = gp_dem3d_wall(d, 5);
     /* three spheres, two pair contacts and two wall contacts, each carrying F */
     CHECK_REL(h, 6 * R - 2 * F / (p.young * R) - 2 * F / (2 * p.young * R), 1e-5);
-    gp_dem3d_contact *c;
+    gp_contact3d *c;
     size_t nc;
     gp_dem3d_contacts(d, &c, &nc, &e);
     double S[3][3];

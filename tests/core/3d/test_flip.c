@@ -42,13 +42,11 @@ static size_t make_sample(double *xyzr, size_t nmax, const double b[3], uint64_t
 
 /* ---- the streaming form (gp_flip_contacts_each) ---- */
 
-/* a sample and its DEM contacts (one step without gravity: the forces of the law) */
-static size_t small_sample(const double b[3], uint64_t seed, double **xyzr, gp_dem3d_contact **c,
-                           size_t *nc)
+/* the DEM's contacts (*c, malloc'ed) of the n spheres s in the box [0, b] after one step
+ * without gravity: the forces of the law, nothing moved measurably (s gets the positions) */
+static void one_step_contacts(double *s, size_t n, const double b[3], gp_contact3d **c,
+                              size_t *nc)
 {
-    uint64_t rs = seed;
-    double *s = malloc(4 * 150 * sizeof *s);
-    size_t n = make_sample(s, 150, b, &rs);
     gp_dem3d_params p;
     gp_dem3d_params_defaults(&p);
     p.gravity[2] = 0;
@@ -60,14 +58,24 @@ static size_t small_sample(const double b[3], uint64_t seed, double **xyzr, gp_d
     gp_dem3d_spheres(d, s);
     gp_dem3d_contacts(d, c, nc, &e);
     gp_dem3d_destroy(d);
+}
+
+/* a sample and its DEM contacts */
+static size_t small_sample(const double b[3], uint64_t seed, double **xyzr, gp_contact3d **c,
+                           size_t *nc)
+{
+    uint64_t rs = seed;
+    double *s = malloc(4 * 150 * sizeof *s);
+    size_t n = make_sample(s, 150, b, &rs);
+    one_step_contacts(s, n, b, c, nc);
     *xyzr = s;
     return n;
 }
 
 /* the mapping written out plainly (Eq. 13; what gp_flip.h says), one tile at a time, no
  * order: the reference for the multiset */
-static size_t ref_contacts(const gp_dem3d_contact *c, size_t nc, size_t n, const int T[3],
-                           gp_dem3d_contact *o)
+static size_t ref_contacts(const gp_contact3d *c, size_t nc, size_t n, const int T[3],
+                           gp_contact3d *o)
 {
     size_t m = 0;
     for (int kz = 0; kz < T[2]; kz++)
@@ -76,7 +84,7 @@ static size_t ref_contacts(const gp_dem3d_contact *c, size_t nc, size_t n, const
                 int k[3] = {kx, ky, kz};
                 size_t t = ((size_t)kz * T[1] + ky) * T[0] + kx;
                 for (size_t q = 0; q < nc; q++) {
-                    gp_dem3d_contact e = c[q];
+                    gp_contact3d e = c[q];
                     for (int a = 0; a < 3; a++)
                         if (k[a] % 2) {
                             e.normal[a] = -e.normal[a];
@@ -106,14 +114,14 @@ static size_t ref_contacts(const gp_dem3d_contact *c, size_t nc, size_t n, const
 
 static int cmp_ij(const void *pa, const void *pb)
 {
-    const gp_dem3d_contact *a = pa, *b = pb;
+    const gp_contact3d *a = pa, *b = pb;
     if (a->i != b->i) return a->i < b->i ? -1 : 1;
     return a->j < b->j ? -1 : a->j > b->j;
 }
 
 /* what a visitor sees: the contacts, chunk sizes, the measures as accumulators */
 typedef struct sink {
-    gp_dem3d_contact *all;
+    gp_contact3d *all;
     size_t m, cap, chunks, bad_chunk;
     size_t pairs, walls;
     gp_dem3d_fabric_acc F;
@@ -122,7 +130,7 @@ typedef struct sink {
     int fail_at;               /* return GP_ERR_INTERNAL at this chunk (0 = never) */
 } sink;
 
-static gp_status sink_visit(void *user, const gp_dem3d_contact *c, size_t k, gp_error *err)
+static gp_status sink_visit(void *user, const gp_contact3d *c, size_t k, gp_error *err)
 {
     sink *s = user;
     s->chunks++;
@@ -145,7 +153,7 @@ static gp_status sink_visit(void *user, const gp_dem3d_contact *c, size_t k, gp_
 }
 
 /* the measures summed plainly in long double: an independent check of the formulas */
-static void brute_measures(const gp_dem3d_contact *c, size_t nc, const double *x, double V,
+static void brute_measures(const gp_contact3d *c, size_t nc, const double *x, double V,
                            double F[3][3], double S[3][3])
 {
     long double f[3][3] = {{0}}, st[3][3] = {{0}}, w = 0;
@@ -172,7 +180,7 @@ static void test_streaming(void)
 {
     const double b[3] = {0.12, 0.1, 0.14};
     double *s;
-    gp_dem3d_contact *c;
+    gp_contact3d *c;
     size_t nc, n = small_sample(b, 7, &s, &c, &nc), nwall = 0;
     for (size_t k = 0; k < nc; k++)
         nwall += c[k].j < 0;
@@ -180,21 +188,21 @@ static void test_streaming(void)
     const int T[3] = {2, 3, 2};
     size_t nt = 12 * n, cap = 12 * nc;
     gp_error e;
-    gp_dem3d_contact *ex, *ref = malloc(cap * sizeof *ref);
+    gp_contact3d *ex, *ref = malloc(cap * sizeof *ref);
     size_t nex, nref = ref_contacts(c, nc, n, T, ref);
-    CHECK(gp_flip_contacts_ex(c, nc, s, n, T, NULL, &ex, &nex, &e) == GP_OK);
+    CHECK(gp_flip_contacts(c, nc, n, T, NULL, &ex, &nex, &e) == GP_OK);
     double *t;
-    CHECK(gp_flip_tile(s, n, b, T, 10000000, &t, &nt, &e) == GP_OK);
+    CHECK(gp_flip_tile(s, n, b, T, 10000000, NULL, &t, &nt, &e) == GP_OK);
     double V = 12 * b[0] * b[1] * b[2];
-    /* (a) every chunk size gives the array of gp_flip_contacts_ex, in its order; sorted, it
+    /* (a) every chunk size gives the array of gp_flip_contacts, in its order; sorted, it
      * is the reference multiset */
     const size_t caps[4] = {1, 7, 4096, 100000};
     for (int r = 0; r < 4; r++) {
         sink k = {malloc(cap * sizeof *k.all), 0, caps[r], 0, 0, 0, 0, {{{0}}, 0}, {0}, NULL, 0};
         gp_dem3d_fabric_acc_init(&k.F);
         gp_dem3d_stress_acc_init(&k.S, t);
-        gp_dem3d_contact *buf = malloc(caps[r] * sizeof *buf);
-        CHECK(gp_flip_contacts_each(c, nc, s, n, T, NULL, buf, caps[r], sink_visit, &k, &e) == GP_OK);
+        gp_contact3d *buf = malloc(caps[r] * sizeof *buf);
+        CHECK(gp_flip_contacts_each(c, nc, n, T, NULL, buf, caps[r], sink_visit, &k, &e) == GP_OK);
         CHECK(k.bad_chunk == 0 && k.m == nex && k.m == nref);
         CHECK(k.chunks == (nex + caps[r] - 1) / caps[r]);
         CHECK(memcmp(k.all, ex, nex * sizeof *ex) == 0);
@@ -229,31 +237,31 @@ static void test_streaming(void)
     /* (d) cancel: a raised flag stops before the first tile; a flag raised by the visitor
      * stops at the next tile; a visitor's error comes back as it is (ASan: nothing leaks) */
     volatile int flag = 1;
-    gp_dem3d_contact buf[16];
+    gp_contact3d buf[16];
     sink k = {NULL, 0, 16, 0, 0, 0, 0, {{{0}}, 0}, {0}, NULL, 0};
     gp_dem3d_stress_acc_init(&k.S, t);
-    CHECK(gp_flip_contacts_each(c, nc, s, n, T, &flag, buf, 16, sink_visit, &k, &e) == GP_ERR_CANCELLED);
+    CHECK(gp_flip_contacts_each(c, nc, n, T, &flag, buf, 16, sink_visit, &k, &e) == GP_ERR_CANCELLED);
     CHECK(k.chunks == 0);
-    gp_dem3d_contact *o2 = ex;
+    gp_contact3d *o2 = ex;
     size_t no2 = 1;
-    CHECK(gp_flip_contacts_ex(c, nc, s, n, T, &flag, &o2, &no2, &e) == GP_ERR_CANCELLED);
+    CHECK(gp_flip_contacts(c, nc, n, T, &flag, &o2, &no2, &e) == GP_ERR_CANCELLED);
     CHECK(o2 == NULL && no2 == 0);
     flag = 0;
     k.raise_after = &flag;
-    CHECK(gp_flip_contacts_each(c, nc, s, n, T, &flag, buf, 16, sink_visit, &k, &e) == GP_ERR_CANCELLED);
+    CHECK(gp_flip_contacts_each(c, nc, n, T, &flag, buf, 16, sink_visit, &k, &e) == GP_ERR_CANCELLED);
     CHECK(k.chunks >= 1 && k.m < nex);
     sink f = {NULL, 0, 16, 0, 0, 0, 0, {{{0}}, 0}, {0}, NULL, 3};
     gp_dem3d_stress_acc_init(&f.S, t);
-    CHECK(gp_flip_contacts_each(c, nc, s, n, T, NULL, buf, 16, sink_visit, &f, &e) == GP_ERR_INTERNAL);
+    CHECK(gp_flip_contacts_each(c, nc, n, T, NULL, buf, 16, sink_visit, &f, &e) == GP_ERR_INTERNAL);
     CHECK(f.chunks == 3 && strstr(e.message, "visitor") != NULL);
-    CHECK(gp_flip_contacts_each(c, nc, s, n, T, NULL, buf, 0, sink_visit, &f, &e) == GP_ERR_INVALID);
+    CHECK(gp_flip_contacts_each(c, nc, n, T, NULL, buf, 0, sink_visit, &f, &e) == GP_ERR_INVALID);
     const int bad[3] = {2, 0, 1};
-    CHECK(gp_flip_contacts_each(c, nc, s, n, bad, NULL, buf, 16, sink_visit, &f, &e) == GP_ERR_INVALID);
+    CHECK(gp_flip_contacts_each(c, nc, n, bad, NULL, buf, 16, sink_visit, &f, &e) == GP_ERR_INVALID);
     /* tiling 1 x 1 x 1: the sample's own contacts, as they are */
     const int one[3] = {1, 1, 1};
     sink u = {malloc((nc ? nc : 1) * sizeof *u.all), 0, 16, 0, 0, 0, 0, {{{0}}, 0}, {0}, NULL, 0};
     gp_dem3d_stress_acc_init(&u.S, s);
-    CHECK(gp_flip_contacts_each(c, nc, s, n, one, NULL, buf, 16, sink_visit, &u, &e) == GP_OK);
+    CHECK(gp_flip_contacts_each(c, nc, n, one, NULL, buf, 16, sink_visit, &u, &e) == GP_OK);
     CHECK(u.m == nc && memcmp(u.all, c, nc * sizeof *c) == 0);
     free(u.all);
     free(t);
@@ -272,19 +280,13 @@ int main(void)
     size_t n = make_sample(s, 400, b, &rs);
     CHECK(n > 250);
     /* forces from the DEM law (one step, no gravity, so nothing moves measurably) */
-    gp_dem3d_params p;
+    gp_contact3d *c;
+    size_t nc;
+    one_step_contacts(s, n, b, &c, &nc);
+    gp_dem3d_params p; /* the law's E, as one_step_contacts used it */
     gp_dem3d_params_defaults(&p);
-    p.gravity[2] = 0;
-    gp_dem3d *d;
     gp_error e;
     double lo[3] = {0, 0, 0};
-    CHECK(gp_dem3d_create(&p, s, n, lo, b, &d, &e) == GP_OK);
-    gp_dem3d_run(d, 1, &e);
-    gp_dem3d_spheres(d, s);
-    gp_dem3d_contact *c;
-    size_t nc;
-    gp_dem3d_contacts(d, &c, &nc, &e);
-    gp_dem3d_destroy(d);
     size_t nwall = 0;
     for (size_t k = 0; k < nc; k++)
         nwall += c[k].j < 0;
@@ -293,11 +295,11 @@ int main(void)
     const int tiles[3] = {4, 4, 4};
     double *t;
     size_t nt;
-    CHECK(gp_flip_tile(s, n, b, tiles, 10000000, &t, &nt, &e) == GP_OK);
+    CHECK(gp_flip_tile(s, n, b, tiles, 10000000, NULL, &t, &nt, &e) == GP_OK);
     CHECK(nt == 64 * n);
-    gp_dem3d_contact *tc;
+    gp_contact3d *tc;
     size_t ntc;
-    CHECK(gp_flip_contacts(c, nc, s, n, tiles, &tc, &ntc, &e) == GP_OK);
+    CHECK(gp_flip_contacts(c, nc, n, tiles, NULL, &tc, &ntc, &e) == GP_OK);
 
     /* porosity: clipped solid volume, sample vs tiled (each copy clipped to its tile) */
     double vs = gp_dem3d_solid_volume(s, n, lo, b), vt = 0;
@@ -385,8 +387,8 @@ int main(void)
     const int bad_tiles[3] = {0, 1, 1};
     double *t2;
     size_t nt2;
-    CHECK(gp_flip_tile(s, n, b, bad_tiles, 10000000, &t2, &nt2, &e) == GP_ERR_INVALID);
-    CHECK(gp_flip_tile(s, n, b, tiles, 1000, &t2, &nt2, &e) == GP_ERR_INVALID);
+    CHECK(gp_flip_tile(s, n, b, bad_tiles, 10000000, NULL, &t2, &nt2, &e) == GP_ERR_INVALID);
+    CHECK(gp_flip_tile(s, n, b, tiles, 1000, NULL, &t2, &nt2, &e) == GP_ERR_INVALID);
     free(t);
     free(tc);
     free(c);

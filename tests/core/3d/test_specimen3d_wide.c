@@ -8,6 +8,7 @@
  */
 #include "gp_specimen3d.h"
 #include "gp_test.h"
+#include "specimen3d_test.h"
 
 #include <math.h>
 #include <string.h>
@@ -69,12 +70,8 @@ static void test_size_ratio_20(void)
      * wall fixed there the packing settled away from it. */
     static const gp_sieve_row wide[4] = {{0.001, 0}, {0.005, 1}, {0.010, 10}, {0.020, 100}};
     gp_spec3d s;
-    gp_spec3d_defaults(&s);
+    spec_in_cube(&s, 0.1, wide, 4, 0.46);
     s.seed = 1;
-    s.box[0] = s.box[1] = s.box[2] = 0.1;
-    s.sieve = wide;
-    s.nsieve = 4;
-    s.porosity = 0.46;
     s.outputs = GP_OUT3_SPHERES | GP_OUT3_CONTACTS | GP_OUT3_FABRIC;
     gp_specimen3d *r = NULL;
     gp_error e;
@@ -128,13 +125,8 @@ static void test_tile_relax(void)
     /* one-size 8 mm spheres at 0.45 (the frictionless packing of this 7.5-grain box is ~0.43),
      * tiled 2 x 2 x 2 and relaxed: the copies now carry the weight of the tiles above, so the
      * packing moves, but by elastic amounts (E = 15 MPa, a few kPa): the porosity stays */
-    static const gp_sieve_row one[2] = {{0.008 - 1e-6, 0}, {0.008, 100}};
     gp_spec3d s;
-    gp_spec3d_defaults(&s);
-    s.box[0] = s.box[1] = s.box[2] = 0.06;
-    s.sieve = one;
-    s.nsieve = 2;
-    s.porosity = 0.45;
+    spec_in_cube(&s, 0.06, ONE_SIZE_8MM, 2, 0.45);
     s.tiling[0] = s.tiling[1] = s.tiling[2] = 2;
     s.tile_relax_steps = 1000;
     s.outputs = GP_OUT3_SPHERES;
@@ -151,13 +143,7 @@ static void test_tile_relax(void)
     CHECK(S->tiled_stability > 0 && S->tiled_stability < 0.1);
     CHECK_NEAR(S->porosity, S->sample_porosity, 0.002);
     /* every sphere still in the tiled box, up to its wall overlap */
-    size_t out = 0;
-    for (size_t i = 0; i < r->count; i++)
-        for (int a = 0; a < 3; a++) {
-            const double *q = r->spheres + 4 * i;
-            if (q[a] - q[3] < -0.05 * q[3] || q[a] + q[3] > r->box[a] + 0.05 * q[3])
-                out++;
-        }
+    size_t out = spheres_outside(r);
     CHECK(out == 0);
     /* the whole box's porosity, from the spheres (caps beyond the outer faces removed; the
      * lenses where mirror copies overlap across inner faces are counted twice, a bound of

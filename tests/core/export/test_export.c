@@ -36,24 +36,19 @@ static gp_vec2 tri[3] = {{2, 0}, {3, 0}, {2, 1}};
 static double d0[6] = {0.3, 0.5, 0.3, 0.7, 0.5, 0.3};
 static double d1[3] = {2.3, 0.3, 0.29};
 
+static gp_grain2d grain(gp_vec2 *contour, size_t ncontour, double area, double orientation_deg,
+                        gp_descriptors descriptors, double *discs, size_t ndiscs)
+{
+    return (gp_grain2d){.contour = contour, .ncontour = ncontour, .area = area,
+                        .orientation_deg = orientation_deg, .descriptors = descriptors,
+                        .discs = discs, .ndiscs = ndiscs};
+}
+
 static void make2d(gp_specimen2d *s, gp_grain2d g[2], gp_spec2d *spec)
 {
     memset(s, 0, sizeof *s);
-    memset(g, 0, 2 * sizeof *g);
-    g[0].contour = sq;
-    g[0].ncontour = 4;
-    g[0].area = 1.0;
-    g[0].orientation_deg = 0;
-    g[0].descriptors = (gp_descriptors){1.0, 0.5, 0.9, 0.1};
-    g[0].discs = d0;
-    g[0].ndiscs = 2;
-    g[1].contour = tri;
-    g[1].ncontour = 3;
-    g[1].area = 0.5;
-    g[1].orientation_deg = 45;
-    g[1].descriptors = (gp_descriptors){0.5, 0.4, 0.8, 0.2};
-    g[1].discs = d1;
-    g[1].ndiscs = 1;
+    g[0] = grain(sq, 4, 1.0, 0, (gp_descriptors){1.0, 0.5, 0.9, 0.1}, d0, 2);
+    g[1] = grain(tri, 3, 0.5, 45, (gp_descriptors){0.5, 0.4, 0.8, 0.2}, d1, 1);
     s->grains = g;
     s->ngrains = 2;
     memset(spec, 0, sizeof *spec); /* pack_2d reads the container and the outputs */
@@ -113,6 +108,22 @@ static int count_lines(const char *t)
     int n = 0;
     for (; *t; t++) n += *t == '\n';
     return n;
+}
+
+/* the hand-made 2D specimen packed (density 2650) and exported in format f, read in pieces
+ * of `piece` bytes (malloc'ed; NULL on failure) */
+static char *export2d(gp_export_format f, size_t piece)
+{
+    gp_specimen2d s;
+    gp_grain2d g[2];
+    gp_spec2d spec;
+    make2d(&s, g, &spec);
+    void *pack;
+    size_t len;
+    CHECK(gp_export_pack_2d(&s, &spec, 2650, &pack, &len, NULL) == GP_OK);
+    char *t = export_in_pieces(f, pack, len, piece);
+    free(pack);
+    return t;
 }
 
 /* ---- tests ---- */
@@ -202,14 +213,7 @@ static void test_pieces_identical(void)
  * (4/3) pi r^3 * density (the mass LAMMPS gives an atom) = 2650 * grain area. */
 static void test_lammps2d_masses(void)
 {
-    gp_specimen2d s;
-    gp_grain2d g[2];
-    gp_spec2d spec;
-    make2d(&s, g, &spec);
-    void *pack;
-    size_t len;
-    CHECK(gp_export_pack_2d(&s, &spec, 2650, &pack, &len, NULL) == GP_OK);
-    char *t = export_in_pieces(GP_EXPORT_LAMMPS, pack, len, 4096);
+    char *t = export2d(GP_EXPORT_LAMMPS, 4096);
     CHECK(t != NULL);
     if (t) {
         CHECK(strstr(t, "\n3 atoms\n") != NULL);
@@ -240,19 +244,11 @@ static void test_lammps2d_masses(void)
         CHECK_REL(mass[2], 2650 * 0.5, 1e-12);
     }
     free(t);
-    free(pack);
 }
 
 static void test_vtk2d_structure(void)
 {
-    gp_specimen2d s;
-    gp_grain2d g[2];
-    gp_spec2d spec;
-    make2d(&s, g, &spec);
-    void *pack;
-    size_t len;
-    CHECK(gp_export_pack_2d(&s, &spec, 2650, &pack, &len, NULL) == GP_OK);
-    char *t = export_in_pieces(GP_EXPORT_VTK, pack, len, 100);
+    char *t = export2d(GP_EXPORT_VTK, 100);
     CHECK(t != NULL);
     if (t) {
         CHECK(strstr(t, "POINTS 10 double\n") != NULL);   /* 7 contour points + 3 discs */
@@ -268,7 +264,6 @@ static void test_vtk2d_structure(void)
         CHECK(count_lines(t) > 40);
     }
     free(t);
-    free(pack);
 }
 
 static void test_refusals(void)

@@ -1,0 +1,127 @@
+/* kind.h -- the job kinds of grainpackd: one type object per kind, and their table.
+ *
+ * A kind is everything the daemon knows of one pipeline: its name (the spec's "kind"), how its
+ * spec is bounded and parsed for the core (schema/gp_spec.h), how a job of it is built,
+ * reported, written (the result JSON, result_json.h) and packed for export (core/export), the
+ * SVG views of its result, its export formats and the example spec the dashboard offers. The
+ * HTTP front, the workers, the SVG renderer and the dashboard look a kind up once, by name
+ * (gpd_kind_find), and go through its struct: no other file names a kind. A new kind is one
+ * file (kind_<name>.c, defining its gpd_kind) and one line of the table in kinds.c.
+ *
+ * The pointers a kind hands around for its spec and its specimen (void *) are its own core
+ * structs (gp_spec2d / gp_specimen2d, ...); only its own functions look inside. */
+#ifndef GPD_KIND_H
+#define GPD_KIND_H
+
+#include <stddef.h>
+
+#include <jansson.h>
+
+#include "gp_error.h"
+#include "gp_progress.h"
+#include "gp_spec.h"
+#include "svg.h"
+
+/* A view of the SVG renderer: ?view=name draws it. */
+typedef struct gpd_view {
+    const char *name;
+    const char *options; /* the query options it reads besides width, comma-separated ("" none) */
+    gp_svg_view_fn open;
+} gpd_view;
+
+typedef struct gpd_kind {
+    const char *name;
+    /* a spec of this kind (JSON): the dashboard's example */
+    const char *example;
+
+    /* ---- POST /v1/jobs: a valid effective spec (gp_spec_with_defaults) ---- */
+    /* Its estimated result against max_bytes: 0, or -1 with *p (422 too_large, or from the
+     * estimate itself); both kinds use schema's gp_spec_check_result */
+    int (*bounds)(const json_t *spec, double max_bytes, gp_spec_problem *p);
+
+    /* ---- running a job (workers.c), in this order ---- */
+    /* GPD_KIND_CORE_OPS: the glue to the kind's core pipeline (GPD_KIND_CORE below) */
+    size_t spec_size; /* the core's spec struct */
+    /* Parses the stored spec into *spec (spec_size zeroed bytes) for the core, threads 1 (the
+     * pool is the parallelism): 0, or -1 with *p; free_spec releases what it holds either way */
+    int (*read_spec)(const json_t *json, void *spec, gp_spec_problem *p);
+    void (*free_spec)(void *spec);
+    /* Builds the specimen (the core's build): *st GP_OK, or a failure with err; the specimen may
+     * come back with a failure too (freed with destroy) */
+    void *(*build)(const void *spec, gp_progress_fn progress, void *user,
+                   const volatile int *cancel, gp_status *st, gp_error *err);
+    void (*destroy)(void *specimen);
+    /* The "detail" of a progress report (a new object) */
+    json_t *(*progress_detail)(const gp_progress *p);
+    /* 1 when writing the result takes long enough (~0.5 s and more) to show as a phase */
+    int (*large_result)(const void *specimen);
+    /* The result JSON (result_json.h), stopping early when *cancel comes up (the tree returned
+     * is then partial); NULL on out of memory */
+    json_t *(*result)(const void *specimen, const void *spec, const json_t *spec_json,
+                      const volatile int *cancel);
+    /* The export pack (core/export): 0 with a malloc'ed *pack, 1 when the spec asked for no
+     * output a pack is made of (*pack left NULL), -1 with err */
+    int (*pack)(const void *specimen, const void *spec, void **pack, size_t *len,
+                gp_error *err);
+    /* The "detail" of the final "done" progress (a new object; NULL: none, {}) */
+    json_t *(*done_detail)(const char *id, const void *specimen);
+    /* A note appended to the message of a failed build (may be NULL) */
+    void (*failure_note)(const void *specimen, char *buf, size_t n);
+
+    /* ---- a finished job ---- */
+    /* its SVG views, ending with a NULL name; the first is the dashboard's default */
+    const gpd_view *views;
+    /* 1 when a result without a "kind" member is of this kind (NULL: never) */
+    int (*owns_result)(const json_t *result);
+    /* the dimension of its packs: its export formats (gp_export_format_supports) */
+    int export_dim;
+    /* a job without a pack: "job ... has no <pack_what> to export ... with <pack_output> in
+     * outputs" */
+    const char *pack_what, *pack_output;
+} gpd_kind;
+
+/* The glue between a kind and its core pipeline, the same for every kind but for the names: a
+ * kind file says GPD_KIND_CORE(its spec type, reader, freer, specimen type, builder,
+ * destroyer) to define its read_spec, free_spec, build and destroy, and puts
+ * GPD_KIND_CORE_OPS(its spec type) in its gpd_kind. */
+#define GPD_KIND_CORE(SPEC, READ, FREE, SPECIMEN, BUILD, DESTROY)                              \
+    static int read_spec(const json_t *json, void *spec, gp_spec_problem *p)                  \
+    {                                                                                          \
+        int rc = READ(json, spec, p);                                                          \
+        ((SPEC *)spec)->threads = 1;                                                           \
+        return rc;                                                                             \
+    }                                                                                          \
+    static void free_spec(void *spec) { FREE(spec); }                                          \
+    static void *build(const void *spec, gp_progress_fn progress, void *user,                  \
+                       const volatile int *cancel, gp_status *st, gp_error *err)               \
+    {                                                                                          \
+        SPECIMEN *out = NULL;                                                                  \
+        *st = BUILD(spec, progress, user, cancel, &out, err);                                  \
+        return out;                                                                            \
+    }                                                                                          \
+    static void destroy(void *specimen) { DESTROY(specimen); }
+
+#define GPD_KIND_CORE_OPS(SPEC)                                                                \
+    .spec_size = sizeof(SPEC), .read_spec = read_spec, .free_spec = free_spec, .build = build,  \
+    .destroy = destroy
+
+/* The kind of that name, or NULL. */
+const gpd_kind *gpd_kind_find(const char *name);
+/* The kind of a result without a "kind" member: the first that owns it, else the first of the
+ * table. */
+const gpd_kind *gpd_kind_guess(const json_t *result);
+/* k's view of that name, or NULL. */
+const gpd_view *gpd_kind_view(const gpd_kind *k, const char *name);
+
+/* The names of k's views, ", "-separated ("packing, cells, ..."), into buf. */
+void gpd_kind_view_list(const gpd_kind *k, char *buf, size_t n);
+/* The names of the kinds, each between quote and quote, sep between two, into buf (e.g. quote
+ * "\"", sep ", ": "\"a\", \"b\""). */
+void gpd_kind_names(char *buf, size_t n, const char *quote, const char *sep);
+
+/* What the dashboard knows of the kinds (a new object, NULL on out of memory):
+ * {"<name>": {"example": <spec>, "views": [{"name", "options": [...]}, ...],
+ *             "exports": ["lammps", ...]}, ...} in table order. */
+json_t *gpd_kinds_json(void);
+
+#endif /* GPD_KIND_H */

@@ -1,0 +1,375 @@
+/* kind_fv2d.c -- the 2D kind, "fourier-voronoi-2d": Fourier-Voronoi specimens (core/2d) with
+ * their result, export pack, progress and SVG views (svg_views2d.c).
+ *
+ * The result (result_json.h for the conventions):
+ * {"kind": "fourier-voronoi-2d", "seed": 42, "outputs": [...],
+ *  "container": <the spec's container, echoed>,
+ *  "stats": {
+ *    "particles":       {"target": N (`particles`, or the cell count a sieve law gives),
+ *                        "achieved": number of grains},
+ *    "imc_error":       {"target": the threshold used, "achieved": e,
+ *                        "measure": "AD|E1|E2|E3", "floor": f,
+ *                        "stop_reason": "threshold|max_steps|floor|..."},
+ *    "imc_steps":       {"max": max_steps, "achieved": steps},
+ *    "solid_fraction":  {"target": F_S, "achieved": grain area / container area},
+ *    "container_area":  A,
+ *    "cells_target_met": k,            cells whose grain reached F_S
+ *    "mean_orientation_gap_deg": g,
+ *    "size_histogram":        {"edges": [k+1], "target": [k], "achieved": [k]}  (cell areas)
+ *    "grain_size_histogram":  {"edges", "target", "achieved"}                   (grain areas)
+ *    "orientation_histogram": {"edges" (deg), "target", "achieved"}
+ *    "descriptors": {"elongation": {"mean", "edges", "target", "achieved"}, "roundness": ...,
+ *                    "circularity": ..., "regularity": ...}       (with output "descriptors")
+ *    "fit": {                                           (api.md; a block only when measured)
+ *      "cell_area": {"law": "lognormal|normal|uniform|sieve",
+ *                    "target": {"mean", "cov"}, "achieved": {"mean", "cov"},
+ *                    "ks", "ks_critical" (1.36 / sqrt(n)), "w1" (/ target mean), "n",
+ *                    "range": {"achieved": [min, max], "target_p001_p999": [q001, q999]},
+ *                    "cdf": {"x": [k] (area, increasing), "target": [k] F(x),
+ *                            "achieved": [k] empirical CDF at x}},
+ *      "grain_area": the same, against the grains' law (absent when no grains were built),
+ *      "cell_orientation":  {"target": {"mean_deg", "anisotropy"}, "ks", "ks_critical", "n"},
+ *      "grain_orientation": the same,
+ *      "passing": {"diameters": [m], "target": [m] %, "achieved": [m] %, "max_error_pp"}
+ *                 (grains by mass; sieve law only)}
+ *  },
+ *  "warnings": ["one line each: a target not reached and how close it came", ...]
+ *              (always there; [] when every target was met),
+ *  "timings": {"tessellation", "imc", "fill", "odec", "descriptors", "total"}  (seconds),
+ *  "grains": [{"id", "cell", "contour": [[x,y],...], "area", "orientation_deg",
+ *              "cell_fraction", "descriptors": {...} (output descriptors),
+ *              "discs": [[x,y,r],...] (output odec)}]   (with any of grains/odec/descriptors),
+ *  "cells": [{"id", "seed": [x,y], "polygons": [[[x,y],...],...], "area",
+ *             "orientation_deg"}]                      (with output "cells")}
+ * Histogram "target" is null where there is no target.
+ */
+#include "kind_fv2d.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gp_export.h"
+#include "gp_spec.h"
+#include "kind.h"
+#include "result_json.h"
+#include "svg_views.h"
+#include "util.h"
+
+#define KIND_NAME "fourier-voronoi-2d"
+
+/* ------------------------------------------------------------------ the result */
+
+static json_t *hist_json(const gp_hist *h)
+{
+    if (!h || h->nclasses == 0 || !h->edges) return json_null();
+    return json_pack("{s:o, s:o, s:o}", "edges", gpd_jreals(h->edges, h->nclasses + 1), "target",
+                     gpd_jreals(h->target, h->nclasses), "achieved", gpd_jreals(h->achieved, h->nclasses));
+}
+
+static json_t *point(gp_vec2 p)
+{
+    return json_pack("[o, o]", gpd_jreal(p.x), gpd_jreal(p.y));
+}
+
+static json_t *ring(const gp_vec2 *p, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; i < n; i++) json_array_append_new(a, point(p[i]));
+    return a;
+}
+
+static json_t *descriptors(const gp_descriptors *d)
+{
+    return json_pack("{s:o, s:o, s:o, s:o}", "elongation", gpd_jreal(d->elongation), "roundness",
+                     gpd_jreal(d->roundness), "circularity", gpd_jreal(d->circularity),
+                     "regularity", gpd_jreal(d->regularity));
+}
+
+/* the measure's name: the core's string, else the spec's kind */
+static const char *imc_measure(const gp_specimen2d *s, gp_imc_error_kind k)
+{
+    if (s->imc_error_kind && *s->imc_error_kind) return s->imc_error_kind;
+    switch (k) {
+    case GP_IMC_E1: return "E1";
+    case GP_IMC_E2: return "E2";
+    case GP_IMC_E3: return "E3";
+    default: return "AD";
+    }
+}
+
+static json_t *mean_cov(double mean, double cov)
+{
+    return json_pack("{s:o, s:o}", "mean", gpd_jreal(mean), "cov", gpd_jreal(cov));
+}
+
+static json_t *pair(double a, double b)
+{
+    return json_pack("[o, o]", gpd_jreal(a), gpd_jreal(b));
+}
+
+static json_t *fit_area(const gp_fit_area *a, int with_curves)
+{
+    const char *law = gp_law_name(a->law);
+    json_t *o = json_pack("{s:s, s:o, s:o, s:o, s:o, s:o, s:I}", "law", law ? law : "",
+                          "target", mean_cov(a->target_mean, a->target_cov), "achieved",
+                          mean_cov(a->mean, a->cov), "ks", gpd_jreal(a->ks), "ks_critical",
+                          gpd_jreal(a->ks_critical), "w1", gpd_jreal(a->w1), "n",
+                          (json_int_t)a->n);
+    if (!o) return NULL;
+    json_object_set_new(o, "range", json_pack("{s:o, s:o}", "achieved", pair(a->min, a->max),
+                                              "target_p001_p999", pair(a->q001, a->q999)));
+    if (with_curves && a->ncurve > 0 && a->curve_x && a->curve_target && a->curve_achieved)
+        json_object_set_new(o, "cdf",
+                            json_pack("{s:o, s:o, s:o}", "x", gpd_jreals(a->curve_x, a->ncurve),
+                                      "target", gpd_jreals(a->curve_target, a->ncurve), "achieved",
+                                      gpd_jreals(a->curve_achieved, a->ncurve)));
+    return o;
+}
+
+static json_t *fit_orient(const gp_fit_orient *o)
+{
+    return json_pack("{s:{s:o, s:o}, s:o, s:o, s:I}", "target", "mean_deg",
+                     gpd_jreal(o->target_mean_deg), "anisotropy",
+                     gpd_jreal(o->target_anisotropy), "ks", gpd_jreal(o->ks), "ks_critical",
+                     gpd_jreal(o->ks_critical), "n", (json_int_t)o->n);
+}
+
+static json_t *fit_passing(const gp_fit_passing *p)
+{
+    return json_pack("{s:o, s:o, s:o, s:o}", "diameters", gpd_jreals(p->diameters, p->n), "target",
+                     gpd_jreals(p->target, p->n), "achieved", gpd_jreals(p->achieved, p->n),
+                     "max_error_pp", gpd_jreal(p->max_error_pp));
+}
+
+json_t *gpd_fit_2d(const gp_fit2d *f, int with_curves)
+{
+    json_t *o = json_object();
+    if (!o || !f) return o;
+    if (f->cell_area.present)
+        json_object_set_new(o, "cell_area", fit_area(&f->cell_area, with_curves));
+    if (f->grain_area.present)
+        json_object_set_new(o, "grain_area", fit_area(&f->grain_area, with_curves));
+    if (f->cell_orientation.present)
+        json_object_set_new(o, "cell_orientation", fit_orient(&f->cell_orientation));
+    if (f->grain_orientation.present)
+        json_object_set_new(o, "grain_orientation", fit_orient(&f->grain_orientation));
+    if (f->passing.n > 0) json_object_set_new(o, "passing", fit_passing(&f->passing));
+    return o;
+}
+
+json_t *gpd_warnings_2d(const gp_specimen2d *s)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; a && s->warnings && i < s->nwarnings; i++)
+        if (s->warnings[i]) json_array_append_new(a, json_string(s->warnings[i]));
+    return a;
+}
+
+/* the number of cells asked for: `particles`, or derived from a sieve law */
+static size_t target_particles(const gp_specimen2d *s, const gp_spec2d *spec)
+{
+    if (spec->particles > 0) return spec->particles;
+    double area;
+    size_t n = 0;
+    gp_error err;
+    if (gp_spec2d_cell_count(spec, &area, &n, &err) == GP_OK) return n;
+    return s->fit.cell_area.n;
+}
+
+static json_t *imc_error(const gp_specimen2d *s, const gp_spec2d *spec)
+{
+    double thr = isfinite(s->imc_threshold) && s->imc_threshold > 0 ? s->imc_threshold
+                                                                    : spec->imc_threshold;
+    return json_pack("{s:o, s:o, s:s, s:o, s:s}", "target", gpd_jreal(thr), "achieved",
+                     gpd_jreal(s->imc_error), "measure", imc_measure(s, spec->imc_error),
+                     "floor", gpd_jreal(s->imc_error_floor), "stop_reason",
+                     s->imc_stop_reason ? s->imc_stop_reason : "");
+}
+
+/* stats: the targets against what was achieved */
+static json_t *stats_2d(const gp_specimen2d *s, const gp_spec2d *spec)
+{
+    json_t *st = json_object();
+    /* achieved: the cells the IMC made (the grains, when they were asked for, are as many) */
+    json_object_set_new(st, "particles",
+                        json_pack("{s:I, s:I}", "target",
+                                  (json_int_t)target_particles(s, spec), "achieved",
+                                  (json_int_t)s->fit.cell_area.n));
+    json_object_set_new(st, "imc_error", imc_error(s, spec));
+    json_object_set_new(st, "imc_steps",
+                        json_pack("{s:I, s:I}", "max", (json_int_t)spec->imc_max_steps,
+                                  "achieved", (json_int_t)s->imc_steps));
+    /* without grains nothing was filled: achieved is null, not 0 */
+    json_object_set_new(st, "solid_fraction",
+                        json_pack("{s:o, s:o}", "target", gpd_jreal(spec->solid_fraction),
+                                  "achieved", s->ngrains ? gpd_jreal(s->solid_fraction) : json_null()));
+    json_object_set_new(st, "container_area", gpd_jreal(s->container_area));
+    json_object_set_new(st, "cells_target_met", json_integer((json_int_t)s->cells_target_met));
+    json_object_set_new(st, "mean_orientation_gap_deg", gpd_jreal(s->mean_orientation_gap_deg));
+    json_object_set_new(st, "size_histogram", hist_json(&s->size_hist));
+    json_object_set_new(st, "grain_size_histogram", hist_json(&s->grain_size_hist));
+    json_object_set_new(st, "orientation_histogram", hist_json(&s->orientation_hist));
+    if (spec->outputs & GP_OUT2_DESCRIPTORS) {
+        static const char *names[4] = {"elongation", "roundness", "circularity", "regularity"};
+        const double means[4] = {s->descriptor_mean.elongation, s->descriptor_mean.roundness,
+                                 s->descriptor_mean.circularity, s->descriptor_mean.regularity};
+        json_t *d = json_object();
+        for (int k = 0; k < 4; k++) {
+            json_t *h = hist_json(&s->descriptor_hist[k]);
+            if (!json_is_object(h)) {
+                json_decref(h);
+                h = json_object();
+            }
+            json_object_set_new(h, "mean", gpd_jreal(means[k]));
+            json_object_set_new(d, names[k], h);
+        }
+        json_object_set_new(st, "descriptors", d);
+    }
+    json_object_set_new(st, "fit", gpd_fit_2d(&s->fit, 1));
+    return st;
+}
+
+static json_t *grain_json(size_t i, const gp_grain2d *g, unsigned out)
+{
+    json_t *gj = json_object();
+    json_object_set_new(gj, "id", json_integer((json_int_t)i));
+    json_object_set_new(gj, "cell", json_integer((json_int_t)g->cell));
+    json_object_set_new(gj, "contour", ring(g->contour, g->ncontour));
+    json_object_set_new(gj, "area", gpd_jreal(g->area));
+    json_object_set_new(gj, "orientation_deg", gpd_jreal(g->orientation_deg));
+    json_object_set_new(gj, "cell_fraction", gpd_jreal(g->cell_fraction));
+    if (out & GP_OUT2_DESCRIPTORS)
+        json_object_set_new(gj, "descriptors", descriptors(&g->descriptors));
+    if (out & GP_OUT2_ODEC) {
+        json_t *da = json_array();
+        for (size_t k = 0; k < g->ndiscs && g->discs; k++)
+            json_array_append_new(da, json_pack("[o, o, o]", gpd_jreal(g->discs[3 * k]),
+                                                gpd_jreal(g->discs[3 * k + 1]),
+                                                gpd_jreal(g->discs[3 * k + 2])));
+        json_object_set_new(gj, "discs", da);
+    }
+    return gj;
+}
+
+static json_t *cell_json(size_t i, const gp_cell2d *cl)
+{
+    json_t *polys = json_array();
+    for (size_t k = 0; k < cl->npolygons; k++)
+        json_array_append_new(polys, ring(cl->polygons[k].pts, cl->polygons[k].n));
+    return json_pack("{s:I, s:o, s:o, s:o, s:o}", "id", (json_int_t)i, "seed", point(cl->seed),
+                     "polygons", polys, "area", gpd_jreal(cl->area), "orientation_deg",
+                     gpd_jreal(cl->orientation_deg));
+}
+
+json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_t *spec_json,
+                      const volatile int *cancel)
+{
+    json_t *r = gpd_result_new(KIND_NAME, spec->seed, spec_json);
+    if (!r) return NULL;
+    unsigned out = spec->outputs;
+    json_t *c = json_object_get(spec_json, "container");
+    if (c) json_object_set(r, "container", c);
+    json_object_set_new(r, "stats", stats_2d(s, spec));
+    json_object_set_new(r, "warnings", gpd_warnings_2d(s));
+    json_object_set_new(
+        r, "timings",
+        json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}", "tessellation", gpd_jreal(s->t_tessellation),
+                  "imc", gpd_jreal(s->t_imc), "fill", gpd_jreal(s->t_fill), "odec",
+                  gpd_jreal(s->t_odec), "descriptors", gpd_jreal(s->t_descriptors), "total",
+                  gpd_jreal(s->t_total)));
+    /* the arrays are filled in place: a cancelled tree goes back partial, dropped with r */
+    if (out & (GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS)) {
+        json_t *ga = json_array();
+        json_object_set_new(r, "grains", ga);
+        for (size_t i = 0; i < s->ngrains; i++) {
+            /* a grain is ~70 us at 128 contour points, ~2 ms at 4096 */
+            if (i % 16 == 0 && gpd_cancel_raised(cancel)) return r;
+            json_array_append_new(ga, grain_json(i, &s->grains[i], out));
+        }
+    }
+    if ((out & GP_OUT2_CELLS) && s->cells) {
+        json_t *ca = json_array();
+        json_object_set_new(r, "cells", ca);
+        for (size_t i = 0; i < s->ncells; i++) {
+            if (i % 256 == 0 && gpd_cancel_raised(cancel)) return r;
+            json_array_append_new(ca, cell_json(i, &s->cells[i]));
+        }
+    }
+    return r;
+}
+
+/* ------------------------------------------------------------------ the kind */
+
+GPD_KIND_CORE(gp_spec2d, gp_spec2d_read, gp_spec2d_free, gp_specimen2d, gp_specimen2d_build,
+              gp_specimen2d_destroy)
+
+/* {steps, error} */
+static json_t *progress_detail(const gp_progress *p)
+{
+    return json_pack("{s:I, s:o}", "steps", (json_int_t)p->steps, "error", gpd_jreal(p->error));
+}
+
+/* the result's size in points, roughly: ~0.5 s a million */
+static int large_result(const void *specimen)
+{
+    const gp_specimen2d *s = specimen;
+    size_t np = s->ncells * 12;
+    for (size_t i = 0; i < s->ngrains; i++) np += s->grains[i].ncontour + s->grains[i].ndiscs;
+    return np > 1000000;
+}
+
+static json_t *result(const void *specimen, const void *spec, const json_t *spec_json,
+                      const volatile int *cancel)
+{
+    return gpd_result_2d(specimen, spec, spec_json, cancel);
+}
+
+/* exports need the ODEC discs; without them there is no pack and GET .../export answers 409
+ * naming the output to ask for */
+static int pack(const void *specimen, const void *spec, void **pack, size_t *len, gp_error *err)
+{
+    if (!(((const gp_spec2d *)spec)->outputs & GP_OUT2_ODEC)) return 1;
+    return gp_export_pack_2d(specimen, spec, GP_EXPORT_DEFAULT_DENSITY, pack, len, err) ? -1 : 0;
+}
+
+/* How the IMC ended, the warnings and the fit summary (stats.fit without its CDF curves), so
+ * that a poller of GET /v1/jobs/{id} sees them without the result. */
+static json_t *done_detail(const char *id, const void *specimen)
+{
+    const gp_specimen2d *s = specimen;
+    json_t *w = gpd_warnings_2d(s);
+    for (size_t i = 0; i < json_array_size(w); i++)
+        gpd_log(GPD_LOG_WARN, "job %s: %s", id, json_string_value(json_array_get(w, i)));
+    return json_pack("{s:I, s:o, s:s, s:o, s:o}", "steps", (json_int_t)s->imc_steps, "error",
+                     gpd_jreal(s->imc_error), "stop_reason",
+                     s->imc_stop_reason ? s->imc_stop_reason : "", "warnings", w ? w : json_array(),
+                     "fit", gpd_fit_2d(&s->fit, 0));
+}
+
+static const gpd_view views[] = {
+    {"packing", "color", svg_view_packing},
+    {"cells", "", svg_view_cells},
+    {"size", "", svg_view_size},
+    {"orientation", "", svg_view_orientation},
+    {"descriptors", "", svg_view_descriptors},
+    {NULL, NULL, NULL},
+};
+
+/* the api.md example */
+static const char example[] =
+    "{\"kind\": \"fourier-voronoi-2d\", \"seed\": 42,"
+    " \"container\": {\"polygon\": [[0, 0], [1, 0], [1, 1], [0, 1]], \"holes\": []},"
+    " \"particles\": 500, \"size\": {\"cov\": 0.8},"
+    " \"orientation\": {\"mean_deg\": 0, \"anisotropy\": 1.0},"
+    " \"shape\": {\"D2\": 0.1, \"D3\": 0.05, \"D8\": 0.02, \"alpha\": -2, \"beta\": -2},"
+    " \"solid_fraction\": 0.65,"
+    " \"imc\": {\"error\": \"E3\", \"threshold\": 0.002, \"max_steps\": 1000000,"
+    " \"init\": \"uniform\"},"
+    " \"contour_points\": 128, \"outputs\": [\"grains\", \"odec\", \"descriptors\", \"cells\"]}";
+
+const gpd_kind gpd_kind_fv2d = {
+    .name = KIND_NAME, .example = example, .bounds = gp_spec_check_result,
+    GPD_KIND_CORE_OPS(gp_spec2d), .progress_detail = progress_detail,
+    .large_result = large_result, .result = result, .pack = pack, .done_detail = done_detail,
+    .views = views, .export_dim = 2, .pack_what = "ODEC discs", .pack_output = "odec"};

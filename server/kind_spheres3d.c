@@ -1,0 +1,192 @@
+/* kind_spheres3d.c -- the 3D kind, "spheres-3d": sphere packings by DEM deposition, compaction
+ * and flip tiling (core/3d), with their result, export pack, progress and SVG views
+ * (svg_views3d.c).
+ *
+ * The result (result_json.h for the conventions):
+ * {"kind": "spheres-3d", "seed": 7, "outputs": [...],
+ *  "box": [bx, by, bz] (m, the final (tiled) box), "sample_box": [bx, by, bz],
+ *  "tiling": [nx, ny, nz],
+ *  "stats": {
+ *    "porosity": {"target", "achieved" (final packing), "sample", "deposition"},
+ *    "coordination_number": z (wall contacts counted), "coordination_spheres": z,
+ *    "fabric": [[3x3]] (output fabric), "stress": [[3x3]] Pa (output stress),
+ *    "psd": {"diameters": [n] (m), "target_weight", "achieved_weight", "target_number",
+ *            "target_number_midbin", "achieved_number"}  (percent passing),
+ *    "particles": n (final packing), "sample_particles", "contacts", "wall_contacts",
+ *    "stop_reason", "stability", "tiled_stability", "compaction_friction_deg", "steps", "dt"},
+ *  "timings": {"deposition", "compaction", "relaxation", "tiling", "total"} (seconds),
+ *  "spheres": [[x, y, z, r], ...] (output spheres),
+ *  "contacts": [{"i", "j", "normal": [3], "overlap", "force": [3]}] (output contacts; j < 0 is
+ *              wall -1-j, walls 0..5 = x-, x+, y-, y+, z-, z+)}
+ */
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "gp_export.h"
+#include "gp_spec.h"
+#include "gp_specimen3d.h"
+#include "kind.h"
+#include "result_json.h"
+#include "svg_views.h"
+
+#define KIND_NAME "spheres-3d"
+
+/* ------------------------------------------------------------------ the result */
+
+static json_t *vec3(const double *v)
+{
+    return json_pack("[o, o, o]", gpd_jreal(v[0]), gpd_jreal(v[1]), gpd_jreal(v[2]));
+}
+
+static json_t *mat3(const double m[3][3])
+{
+    return json_pack("[o, o, o]", vec3(m[0]), vec3(m[1]), vec3(m[2]));
+}
+
+static json_t *psd_json(const gp_psd3d *p)
+{
+    return json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}", "diameters", gpd_jreals(p->diameter, p->n),
+                     "target_weight", gpd_jreals(p->target_weight, p->n), "achieved_weight",
+                     gpd_jreals(p->achieved_weight, p->n), "target_number",
+                     gpd_jreals(p->target_number, p->n), "target_number_midbin",
+                     gpd_jreals(p->target_number_midbin, p->n), "achieved_number",
+                     gpd_jreals(p->achieved_number, p->n));
+}
+
+static json_t *stats_3d(const gp_stats3d *t, unsigned out)
+{
+    json_t *st = json_object();
+    json_object_set_new(st, "porosity",
+                        json_pack("{s:o, s:o, s:o, s:o}", "target", gpd_jreal(t->porosity_target),
+                                  "achieved", gpd_jreal(t->porosity), "sample",
+                                  gpd_jreal(t->sample_porosity), "deposition",
+                                  gpd_jreal(t->deposition_porosity)));
+    json_object_set_new(st, "coordination_number", gpd_jreal(t->coordination_number));
+    json_object_set_new(st, "coordination_spheres", gpd_jreal(t->coordination_spheres));
+    if (out & GP_OUT3_FABRIC) json_object_set_new(st, "fabric", mat3(t->fabric));
+    if (out & GP_OUT3_STRESS) json_object_set_new(st, "stress", mat3(t->stress));
+    json_object_set_new(st, "psd", psd_json(&t->psd));
+    json_object_set_new(st, "particles", json_integer((json_int_t)t->particles));
+    json_object_set_new(st, "sample_particles", json_integer((json_int_t)t->sample_particles));
+    json_object_set_new(st, "contacts", json_integer((json_int_t)t->contacts));
+    json_object_set_new(st, "wall_contacts", json_integer((json_int_t)t->wall_contacts));
+    json_object_set_new(st, "stop_reason", json_string(t->stop_reason ? t->stop_reason : ""));
+    json_object_set_new(st, "stability", gpd_jreal(t->stability));
+    json_object_set_new(st, "tiled_stability", gpd_jreal(t->tiled_stability));
+    json_object_set_new(st, "compaction_friction_deg", gpd_jreal(t->compaction_friction_deg));
+    json_object_set_new(st, "steps", json_integer((json_int_t)t->steps));
+    json_object_set_new(st, "dt", gpd_jreal(t->dt));
+    return st;
+}
+
+static json_t *contact_json(const gp_contact3d *c)
+{
+    return json_pack("{s:I, s:I, s:o, s:o, s:o}", "i", (json_int_t)c->i, "j", (json_int_t)c->j,
+                     "normal", vec3(c->normal), "overlap", gpd_jreal(c->overlap), "force",
+                     vec3(c->force));
+}
+
+static json_t *result(const void *specimen, const void *spec_, const json_t *spec_json,
+                      const volatile int *cancel)
+{
+    const gp_specimen3d *s = specimen;
+    const gp_spec3d *spec = spec_;
+    json_t *r = gpd_result_new(KIND_NAME, spec->seed, spec_json);
+    if (!r) return NULL;
+    unsigned out = spec->outputs;
+    json_object_set_new(r, "box", vec3(s->box));
+    json_object_set_new(r, "sample_box", vec3(s->sample_box));
+    json_object_set_new(r, "tiling", json_pack("[i, i, i]", spec->tiling[0], spec->tiling[1],
+                                               spec->tiling[2]));
+    json_object_set_new(r, "stats", stats_3d(&s->stats, out));
+    json_object_set_new(r, "timings",
+                        json_pack("{s:o, s:o, s:o, s:o, s:o}", "deposition",
+                                  gpd_jreal(s->t_deposition), "compaction",
+                                  gpd_jreal(s->t_compaction), "relaxation",
+                                  gpd_jreal(s->t_relaxation), "tiling", gpd_jreal(s->t_tiling),
+                                  "total", gpd_jreal(s->t_total)));
+    /* the arrays are filled in place: a cancelled tree goes back partial, dropped with r */
+    if ((out & GP_OUT3_SPHERES) && s->spheres) {
+        json_t *a = json_array();
+        json_object_set_new(r, "spheres", a);
+        for (size_t i = 0; i < s->count; i++) {
+            if (i % 4096 == 0 && gpd_cancel_raised(cancel)) return r;
+            const double *q = s->spheres + 4 * i;
+            json_array_append_new(a, json_pack("[o, o, o, o]", gpd_jreal(q[0]), gpd_jreal(q[1]),
+                                               gpd_jreal(q[2]), gpd_jreal(q[3])));
+        }
+    }
+    if ((out & GP_OUT3_CONTACTS) && s->contacts) {
+        json_t *a = json_array();
+        json_object_set_new(r, "contacts", a);
+        for (size_t i = 0; i < s->ncontacts; i++) {
+            if (i % 2048 == 0 && gpd_cancel_raised(cancel)) return r;
+            json_array_append_new(a, contact_json(&s->contacts[i]));
+        }
+    }
+    return r;
+}
+
+/* ------------------------------------------------------------------ the kind */
+
+GPD_KIND_CORE(gp_spec3d, gp_spec3d_read, gp_spec3d_free, gp_specimen3d, gp_specimen3d_build,
+              gp_specimen3d_destroy)
+
+/* {steps, porosity, stability} */
+static json_t *progress_detail(const gp_progress *p)
+{
+    return json_pack("{s:I, s:o, s:o}", "steps", (json_int_t)p->steps, "porosity",
+                     gpd_jreal(p->porosity), "stability", gpd_jreal(p->stability));
+}
+
+/* ~0.5 s and more */
+static int large_result(const void *specimen)
+{
+    const gp_specimen3d *s = specimen;
+    return (s->spheres && s->count > 50000) || s->ncontacts > 100000;
+}
+
+/* the sphere list, when the spec asked for it */
+static int pack(const void *specimen, const void *spec, void **pack, size_t *len, gp_error *err)
+{
+    const gp_specimen3d *s = specimen;
+    if (!s->spheres) return 1;
+    return gp_export_pack_3d(s, ((const gp_spec3d *)spec)->material.density, pack, len, err) ? -1
+                                                                                            : 0;
+}
+
+/* an infeasible or unconverged packing says why it stopped */
+static void failure_note(const void *specimen, char *buf, size_t n)
+{
+    const gp_specimen3d *s = specimen;
+    if (s->stats.stop_reason) snprintf(buf, n, " (stop reason: %s)", s->stats.stop_reason);
+}
+
+/* a result without "kind": its spheres, its box or its sieve curves */
+static int owns_result(const json_t *r)
+{
+    return json_object_get(r, "spheres") || json_object_get(r, "box") ||
+           json_object_get(json_object_get(r, "stats"), "psd");
+}
+
+/* the api.md example */
+static const char example[] =
+    "{\"kind\": \"" KIND_NAME "\", \"seed\": 7, \"box\": [0.5, 0.5, 0.5],"
+    " \"sieve\": [[10, 0], [20, 2], [50, 50], [80, 95], [100, 100]], \"sieve_units\": \"mm\","
+    " \"porosity\": 0.38,"
+    " \"material\": {\"density\": 2600, \"young\": 15e6, \"poisson\": 0.5, \"friction_deg\": 18,"
+    " \"damping\": 0.2},"
+    " \"tiling\": [4, 4, 4], \"outputs\": [\"spheres\", \"contacts\", \"fabric\", \"stress\"]}";
+
+static const gpd_view views[] = {
+    {"section", "z", svg_view_section},
+    {"psd", "", svg_view_psd},
+    {NULL, NULL, NULL},
+};
+
+const gpd_kind gpd_kind_spheres3d = {
+    .name = KIND_NAME, .example = example, .views = views, .owns_result = owns_result,
+    .bounds = gp_spec_check_result, GPD_KIND_CORE_OPS(gp_spec3d),
+    .progress_detail = progress_detail, .large_result = large_result, .result = result,
+    .pack = pack, .failure_note = failure_note, .export_dim = 3, .pack_what = "sphere list",
+    .pack_output = "spheres"};
