@@ -53,7 +53,7 @@ static const gp_vec2 HOLE[4] = {{0.3, 0.3}, {0.6, 0.3}, {0.6, 0.6}, {0.3, 0.6}};
 static void row(const shape *sh, size_t n, double cov, double aniso, int kind, long max_steps)
 {
     gp_imc_params p;
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     p.cov = cov;
     p.anisotropy = aniso;
     p.error_kind = kind;
@@ -96,7 +96,7 @@ static void row(const shape *sh, size_t n, double cov, double aniso, int kind, l
 static void speed(size_t n, long steps)
 {
     gp_imc_params p;
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     p.cov = 0.8;
     p.threshold = 1e-12;
     p.max_steps = steps;

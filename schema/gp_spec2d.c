@@ -473,7 +473,7 @@ static int check_threshold_2d(const gp_spec2d *s, size_t n, gp_spec_problem *p)
 {
     if (s->imc_error == GP_IMC_AD) return 0;
     gp_imc_params q;
-    gp_imc_params_default(&q);
+    gp_imc_params_defaults(&q);
     q.error_kind = (int)s->imc_error;
     q.threshold = s->imc_threshold;
     q.classes_size = q.classes_orient = s->imc_classes;

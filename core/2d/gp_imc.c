@@ -32,7 +32,7 @@
  * cells (COV 0.1: excess 0.066 after 1e5 steps). */
 #define GP_IMC_AD_THRESHOLD 0.1
 
-void gp_imc_params_default(gp_imc_params *p)
+void gp_imc_params_defaults(gp_imc_params *p)
 {
     if (!p) return;
     memset(p, 0, sizeof *p);

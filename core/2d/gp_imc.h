@@ -89,7 +89,7 @@ typedef struct gp_imc_params {
 
 /* AD with its default threshold, 1e6 steps, uniform start, automatic classes, lognormal cov
  * 0.5, isotropic, seed 1. */
-void gp_imc_params_default(gp_imc_params *p);
+void gp_imc_params_defaults(gp_imc_params *p);
 
 /* The default threshold of an error kind: 0.002 for E1-E3 (the paper), and for AD the value
  * that bench_imc showed to put the KS distance well inside its 5 % critical value at every N. */

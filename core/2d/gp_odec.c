@@ -7,7 +7,7 @@
 
 #define GP_PI 3.14159265358979323846
 
-void gp_odec_params_default(gp_odec_params *p)
+void gp_odec_params_defaults(gp_odec_params *p)
 {
     if (!p)
         return;
@@ -153,7 +153,7 @@ static gp_status odec_setup(odec_run *R, const gp_vec2 *poly, size_t n, const gp
     if (params)
         R->P = *params;
     else
-        gp_odec_params_default(&R->P);
+        gp_odec_params_defaults(&R->P);
     if (!(R->P.r_min > 0 && R->P.r_min < 10) || !(R->P.spacing > 0 && R->P.spacing < 10))
         return gp_error_set(err, GP_ERR_INVALID,
                             "odec: r_min = %g and spacing = %g must be in (0, 10) (relative to "

@@ -45,7 +45,7 @@ typedef struct gp_odec_params {
 } gp_odec_params;
 
 /* The defaults above. */
-void gp_odec_params_default(gp_odec_params *p);
+void gp_odec_params_defaults(gp_odec_params *p);
 
 typedef struct gp_odec_disc {
     double x, y, r;

@@ -69,7 +69,7 @@ typedef struct gp_shape_curve {
 } gp_shape_curve;
 
 /* Descriptors of a simple polygon (n >= 3, either orientation): builds its ODEC with params
- * (NULL = gp_odec_params_default) and takes P, P_conv from the polygon itself. */
+ * (NULL = gp_odec_params_defaults) and takes P, P_conv from the polygon itself. */
 gp_status gp_shape_describe(const gp_vec2 *contour, size_t n, const gp_odec_params *params,
                             gp_shape_result *out, gp_error *err);
 

@@ -715,7 +715,7 @@ static gp_status run_imc(build_ctx *b, gp_error *err)
     const gp_spec2d *spec = b->spec;
     gp_specimen2d *out = b->out;
     gp_imc_params ip;
-    gp_imc_params_default(&ip);
+    gp_imc_params_defaults(&ip);
     ip.seed = spec->seed;
     ip.law = b->cell_law;
     ip.mean_deg = spec->mean_deg;

@@ -700,7 +700,7 @@ static void test_imc_threshold(void)
     if (g_verbose) fprintf(stderr, "%s\n", p.message);
     /* the floor itself, as the core computes it */
     gp_imc_params q;
-    gp_imc_params_default(&q);
+    gp_imc_params_defaults(&q);
     q.error_kind = 3;
     q.threshold = 0.002;
     double floor20 = gp_imc_reachable_threshold(&q, 20);

@@ -154,7 +154,7 @@ static void converge(int kind, size_t n, double cov, double aniso, double mean, 
                      const char *name)
 {
     gp_imc_params p;
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     p.error_kind = kind;
     p.threshold = gp_imc_default_threshold(kind);
     p.cov = cov;
@@ -233,7 +233,7 @@ int main(void)
     gp_imc_params p;
     /* --- a wrong specimen that a histogram error passes: 4 equal-probability classes at
      * COV 0.2 are matched exactly by cells whose COV is far from 0.2; the AD error is not --- */
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     p.error_kind = 3;
     p.threshold = 1e-9;
     p.cov = 0.2;
@@ -252,7 +252,7 @@ int main(void)
         gp_imc_report_free(&r);
     }
     /* --- N = 1: nothing can move; the run says so at once --- */
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     {
         gp_voronoi *v = NULL;
         gp_imc_report r;
@@ -263,7 +263,7 @@ int main(void)
         gp_imc_report_free(&r);
     }
     /* --- floor: 25 classes at N = 500 cannot reach 0.002 (NOTES.md: ~0.0029) --- */
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     p.error_kind = 3;
     p.threshold = 0.002;
     p.cov = 0.3;
@@ -296,7 +296,7 @@ int main(void)
         CHECK_NEAR(gp_imc_floor(t, 3, 100, 2), (2.0 / 3.0) / 100, 1e-12);
     }
     /* automatic classes keep the threshold reachable; AD has no floor */
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     CHECK(gp_imc_reachable_threshold(&p, 20) == 0.0);
     p.error_kind = 3;
     p.threshold = 0.002;
@@ -313,7 +313,7 @@ int main(void)
     }
 
     /* --- determinism: same seed, same tessellation bit for bit; another seed differs --- */
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     p.cov = 0.6;
     p.max_steps = 20000;
     {
@@ -341,7 +341,7 @@ int main(void)
     }
 
     /* --- cancellation: the flag, and the progress callback --- */
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     p.classes_size = 20; /* will not converge */
     p.classes_orient = 20;
     p.threshold = 1e-9;
@@ -369,16 +369,16 @@ int main(void)
     }
 
     /* --- bad input --- */
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     {
         gp_voronoi *v = (gp_voronoi *)1;
         gp_error e;
         p.anisotropy = 0;
         CHECK(gp_imc_run(SQ, 4, NULL, NULL, 0, 100, &p, NULL, NULL, NULL, &v, NULL, &e) == GP_ERR_INVALID && !v);
-        gp_imc_params_default(&p);
+        gp_imc_params_defaults(&p);
         p.cov = -1;
         CHECK(gp_imc_run(SQ, 4, NULL, NULL, 0, 100, &p, NULL, NULL, NULL, &v, NULL, &e) == GP_ERR_INVALID);
-        gp_imc_params_default(&p);
+        gp_imc_params_defaults(&p);
         /* duplicate initial seeds: a clear error */
         gp_vec2 s[3] = {{0.1, 0.1}, {0.5, 0.5}, {0.1, 0.1}};
         p.seeds = s;
@@ -388,7 +388,7 @@ int main(void)
 
     /* --- hard cases --- */
     const long HS = 30000;
-    gp_imc_params_default(&p);
+    gp_imc_params_defaults(&p);
     p.max_steps = HS;
     {
         /* collinear initial seeds (a diagonal), seeds on the boundary and at corners */
@@ -414,7 +414,7 @@ int main(void)
             b[k] = (gp_vec2){SQ[k].x * 1e6, SQ[k].y * 1e6};
         }
         gp_imc_params q;
-        gp_imc_params_default(&q);
+        gp_imc_params_defaults(&q);
         q.cov = 0.8;
         q.max_steps = 300000;
         gp_voronoi *v1 = NULL, *v2 = NULL, *v0 = NULL;

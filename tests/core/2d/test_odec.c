@@ -169,7 +169,7 @@ static void check_cluster(const char *name, const gp_vec2 *p, size_t n, const gp
                           double min_ratio)
 {
     gp_odec_params d;
-    gp_odec_params_default(&d);
+    gp_odec_params_defaults(&d);
     if (!pr)
         pr = &d;
     gp_odec_result r;
