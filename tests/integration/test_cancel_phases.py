@@ -82,6 +82,10 @@ def test_delete_in_every_phase(env):
             continue
         t0 = time.time()
         st, _, c = d.json("DELETE", "/v1/jobs/" + jid)
+        if st == 409 and phase == "tiling":  # the short tiling can also end before the DELETE
+            assert c["error"]["code"] == "already_finished", c
+            report.append("%s (%s): finished before the DELETE" % (phase, spec["kind"]))
+            continue
         assert st == 200 and c["status"] == "cancelled", (phase, st, c)
         assert c["progress"]["phase"] == phase, ("left the phase before the DELETE", phase, c)
         tiny = d.submit(TINY)
