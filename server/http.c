@@ -20,6 +20,8 @@
 #include "gp_export.h"
 #include "gp_spec.h"
 #include "kind.h"
+#include "maint.h"
+#include "metrics.h"
 #include "offload.h"
 #include "page.h"
 #include "store.h"
@@ -33,6 +35,7 @@
 static struct MHD_Daemon *daemon_ = NULL;
 static size_t max_body = 1 << 20;
 static double max_result_mb = 1024;
+static long max_queued = 10000;
 static double started_at = 0;
 
 /* ------------------------------------------------------------------ per-request state */
@@ -148,14 +151,15 @@ static enum MHD_Result send_json(struct MHD_Connection *c, req *r, unsigned stat
     return send_json_hdr(c, r, status, j, NULL, NULL);
 }
 
-static enum MHD_Result send_error_allow(struct MHD_Connection *c, req *r, unsigned status,
-                                        const char *code, const char *pointer,
-                                        const char *allow, const char *fmt, ...)
-    __attribute__((format(printf, 7, 8)));
+/* The error object with one extra header (hname NULL: none). */
+static enum MHD_Result send_error_hdr(struct MHD_Connection *c, req *r, unsigned status,
+                                      const char *code, const char *pointer, const char *hname,
+                                      const char *hval, const char *fmt, ...)
+    __attribute__((format(printf, 8, 9)));
 
-static enum MHD_Result send_error_allow(struct MHD_Connection *c, req *r, unsigned status,
-                                        const char *code, const char *pointer,
-                                        const char *allow, const char *fmt, ...)
+static enum MHD_Result send_error_hdr(struct MHD_Connection *c, req *r, unsigned status,
+                                      const char *code, const char *pointer, const char *hname,
+                                      const char *hval, const char *fmt, ...)
 {
     char msg[768];
     va_list ap;
@@ -176,12 +180,13 @@ static enum MHD_Result send_error_allow(struct MHD_Connection *c, req *r, unsign
         json_t *pj = json_string(pointer);
         json_object_set_new(e, "pointer", pj ? pj : json_string(""));
     }
-    return send_json_hdr(c, r, status, json_pack("{s:o}", "error", e),
-                         allow ? MHD_HTTP_HEADER_ALLOW : NULL, allow);
+    return send_json_hdr(c, r, status, json_pack("{s:o}", "error", e), hname, hval);
 }
 
 #define send_error(c, r, status, code, pointer, ...) \
-    send_error_allow(c, r, status, code, pointer, NULL, __VA_ARGS__)
+    send_error_hdr(c, r, status, code, pointer, NULL, NULL, __VA_ARGS__)
+#define send_error_allow(c, r, status, code, pointer, allow, ...) \
+    send_error_hdr(c, r, status, code, pointer, MHD_HTTP_HEADER_ALLOW, allow, __VA_ARGS__)
 
 static enum MHD_Result send_store_error(struct MHD_Connection *c, req *r)
 {
@@ -250,6 +255,16 @@ static enum MHD_Result h_schema(struct MHD_Connection *c, req *r)
     }
     return send_buf(c, r, 200, "application/schema+json", (char *)doc, strlen(doc),
                     MHD_RESPMEM_PERSISTENT, NULL);
+}
+
+/* GET /metrics: the Prometheus text exposition (metrics.h) */
+static enum MHD_Result h_metrics(struct MHD_Connection *c, req *r)
+{
+    size_t len = 0;
+    char *text = metrics_render(&len);
+    if (!text) return send_error(c, r, 500, "internal", NULL, "out of memory");
+    return send_buf(c, r, 200, "text/plain; version=0.0.4; charset=utf-8", text, len,
+                    MHD_RESPMEM_MUST_FREE, NULL);
 }
 
 static enum MHD_Result h_dashboard(struct MHD_Connection *c, req *r)
@@ -327,9 +342,18 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
     if (!eff) return ret;
     char *text = json_dumps(eff, JSON_COMPACT);
     char id[33];
-    store_rc rc = text ? store_insert(k->name, text, id) : STORE_ERROR;
+    store_rc rc = text ? store_insert(k->name, text, max_queued, id) : STORE_ERROR;
     free(text);
     json_decref(eff);
+    if (rc == STORE_FULL) {
+        char retry[16];
+        snprintf(retry, sizeof retry, "%d", metrics_retry_after(workers_total()));
+        return send_error_hdr(c, r, 503, "queue_full", NULL, "Retry-After", retry,
+                              "the queue is full: %ld jobs are waiting, the most this daemon "
+                              "queues (--max-queued %ld); submit again after Retry-After "
+                              "seconds",
+                              max_queued, max_queued);
+    }
     if (rc != STORE_OK) return send_store_error(c, r);
     workers_notify();
     gpd_log(GPD_LOG_INFO, "job %s queued", id);
@@ -389,8 +413,35 @@ static enum MHD_Result h_job(struct MHD_Connection *c, req *r, const char *id)
     return send_json(c, r, 200, j);
 }
 
+/* DELETE /v1/jobs/{id}?purge=1: a finished job removed with everything it has (204), its space
+ * given back in the background (maint.h) */
+static enum MHD_Result h_purge(struct MHD_Connection *c, req *r, const char *id)
+{
+    char st[16];
+    store_rc rc = store_purge(id, st);
+    if (rc == STORE_NOT_FOUND) return not_found(c, r, id);
+    if (rc == STORE_CONFLICT)
+        return send_error(c, r, 409, "not_finished", NULL,
+                          "job %s is %s; only a finished job can be purged: cancel it first "
+                          "with DELETE /v1/jobs/%s, then purge it",
+                          id, st, id);
+    if (rc != STORE_OK) return send_store_error(c, r);
+    gpd_log(GPD_LOG_INFO, "job %s purged (was %s)", id, st);
+    maint_kick();
+    struct MHD_Response *resp =
+        MHD_create_response_from_buffer(0, (void *)"", MHD_RESPMEM_PERSISTENT);
+    if (!resp) return MHD_NO;
+    std_headers(resp, r, "application/json");
+    return queue_response(c, r, 204, resp);
+}
+
 static enum MHD_Result h_cancel(struct MHD_Connection *c, req *r, const char *id)
 {
+    const char *purge = qarg(c, "purge");
+    if (purge && (!strcmp(purge, "1") || !strcmp(purge, "true"))) return h_purge(c, r, id);
+    if (purge && *purge && strcmp(purge, "0") && strcmp(purge, "false"))
+        return send_error(c, r, 400, "invalid_parameter", NULL,
+                          "purge: expected 1 or 0 (true or false); got \"%.32s\"", purge);
     char st[16];
     store_rc rc = workers_cancel(id, st);
     if (rc == STORE_NOT_FOUND) return not_found(c, r, id);
@@ -759,6 +810,10 @@ static enum MHD_Result route(struct MHD_Connection *c, req *r, const char *url,
         if (!is_get(method)) return method_not_allowed(c, r, method, path, "GET, HEAD");
         return h_dashboard(c, r);
     }
+    if (!strcmp(path, "/metrics")) {
+        if (!is_get(method)) return method_not_allowed(c, r, method, path, "GET, HEAD");
+        return h_metrics(c, r);
+    }
     if (!strcmp(path, "/v1/health")) {
         if (!is_get(method)) return method_not_allowed(c, r, method, path, "GET, HEAD");
         return h_health(c, r);
@@ -915,6 +970,8 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
                 1e3 * (gpd_monotonic_s() - r->t0),
                 toe == MHD_REQUEST_TERMINATED_COMPLETED_OK ? "" : " (aborted)");
     }
+    /* by route pattern; a path cut to the buffer is not one of them */
+    metrics_http_request(strlen(r->url) < sizeof r->url - 1 ? r->url : "", r->status);
     if (r->resp) MHD_destroy_response(r->resp);
     free(r->body);
     free(r);
@@ -1015,6 +1072,7 @@ int gpd_http_start(const gpd_http_config *cfg)
 {
     max_body = cfg->max_body;
     if (cfg->max_result_mb > 0) max_result_mb = cfg->max_result_mb;
+    max_queued = cfg->max_queued;
     started_at = gpd_monotonic_s();
     origin_setup(cfg->listen, cfg->host, cfg->port);
     if (gpd_page_init() != 0) {

@@ -5,9 +5,13 @@
  *   GET  /v1/health                liveness, queue depth, workers
  *   GET  /v1/schema[?kind=K]       the JSON Schema (+ ?kind= one kind's schema)
  *   POST /v1/jobs                  201 job object (+ full job object, not only id/status), Location
+ *                                  (503 queue_full with Retry-After past --max-queued)
  *   GET  /v1/jobs?status=&limit=&after=   newest first, keyset cursor "next"
  *   GET  /v1/jobs/{id}             job object
  *   DELETE /v1/jobs/{id}           cancel (200 job object; 409 already_finished)
+ *   DELETE /v1/jobs/{id}?purge=1   remove a finished job, result, pack and summary (204;
+ *                                  409 not_finished while queued or running)
+ *   GET  /metrics                  Prometheus text format 0.0.4 (metrics.h)
  *   GET  /v1/jobs/{id}/result      result JSON (409 not_ready)
  *   GET  /v1/jobs/{id}/svg?view=V  image/svg+xml (409 not_ready)
  *   GET  /v1/jobs/{id}/export?format=F   an export file of the job (api.md formats)
@@ -46,6 +50,8 @@ typedef struct gpd_http_config {
     unsigned timeout_s;          /* idle timeout per connection */
     size_t max_body;             /* request body limit in bytes (413 above) */
     double max_result_mb;        /* specs whose estimated result is larger get 422 too_large */
+    long max_queued;             /* a submit while this many jobs are queued gets 503 queue_full
+                                    (with Retry-After); 0 = no cap */
     const char *listen;          /* the --listen value as given (its host is an accepted Host) */
     const char *host;            /* the bound host as gpd_listen_socket wrote it */
     int port;                    /* the bound port */

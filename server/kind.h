@@ -78,6 +78,9 @@ typedef struct gpd_kind {
     /* a job without a pack: "job ... has no <pack_what> to export ... with <pack_output> in
      * outputs" */
     const char *pack_what, *pack_output;
+    /* the phases of its result's "timings" (seconds), "total" among them, ending with NULL: the
+     * job duration histograms of GET /metrics (metrics.h), observed once a job succeeds */
+    const char *const *phases;
 } gpd_kind;
 
 /* The glue between a kind and its core pipeline, the same for every kind but for the names: a
@@ -110,6 +113,10 @@ const gpd_kind *gpd_kind_find(const char *name);
 /* The kind of a result without a "kind" member: the first that owns it, else the first of the
  * table. */
 const gpd_kind *gpd_kind_guess(const json_t *result);
+/* The i-th kind of the table (0-based), NULL past its end. */
+const gpd_kind *gpd_kind_at(size_t i);
+/* Its index in the table, -1 when it is not there. */
+int gpd_kind_index(const gpd_kind *k);
 /* k's view of that name, or NULL. */
 const gpd_view *gpd_kind_view(const gpd_kind *k, const char *name);
 

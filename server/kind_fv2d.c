@@ -368,8 +368,13 @@ static const char example[] =
     " \"init\": \"uniform\"},"
     " \"contour_points\": 128, \"outputs\": [\"grains\", \"odec\", \"descriptors\", \"cells\"]}";
 
+/* the phases of its "timings" (gpd_result_2d) */
+static const char *const phases[] = {"tessellation", "imc", "fill", "odec", "descriptors",
+                                     "total", NULL};
+
 const gpd_kind gpd_kind_fv2d = {
     .name = KIND_NAME, .example = example, .bounds = gp_spec_check_result,
     GPD_KIND_CORE_OPS(gp_spec2d), .progress_detail = progress_detail,
     .large_result = large_result, .result = result, .pack = pack, .done_detail = done_detail,
-    .views = views, .export_dim = 2, .pack_what = "ODEC discs", .pack_output = "odec"};
+    .views = views, .export_dim = 2, .pack_what = "ODEC discs", .pack_output = "odec",
+    .phases = phases};

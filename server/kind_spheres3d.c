@@ -184,9 +184,13 @@ static const gpd_view views[] = {
     {NULL, NULL, NULL},
 };
 
+/* the phases of its "timings" (result) */
+static const char *const phases[] = {"deposition", "compaction", "relaxation", "tiling", "total",
+                                     NULL};
+
 const gpd_kind gpd_kind_spheres3d = {
     .name = KIND_NAME, .example = example, .views = views, .owns_result = owns_result,
     .bounds = gp_spec_check_result, GPD_KIND_CORE_OPS(gp_spec3d),
     .progress_detail = progress_detail, .large_result = large_result, .result = result,
     .pack = pack, .failure_note = failure_note, .export_dim = 3, .pack_what = "sphere list",
-    .pack_output = "spheres"};
+    .pack_output = "spheres", .phases = phases};

@@ -24,6 +24,20 @@ const gpd_kind *gpd_kind_find(const char *name)
     return NULL;
 }
 
+const gpd_kind *gpd_kind_at(size_t i)
+{
+    for (size_t j = 0; table[j]; j++)
+        if (j == i) return table[j];
+    return NULL;
+}
+
+int gpd_kind_index(const gpd_kind *k)
+{
+    for (size_t i = 0; k && table[i]; i++)
+        if (table[i] == k) return (int)i;
+    return -1;
+}
+
 const gpd_kind *gpd_kind_guess(const json_t *result)
 {
     for (size_t i = 0; table[i]; i++)

@@ -9,6 +9,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
+#include <math.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
@@ -17,6 +18,7 @@
 #include <unistd.h>
 
 #include "http.h"
+#include "maint.h"
 #include "store.h"
 #include "util.h"
 #include "workers.h"
@@ -53,6 +55,12 @@ static void usage(FILE *f)
             "  --job-timeout S        a job whose run lasts longer fails with error code\n"
             "                         'timeout' (per run attempt; 0 = no limit)\n"
             "                         [GRAINPACK_JOB_TIMEOUT] (default 3600)\n"
+            "  --retain-days N        purge finished jobs (their results and exports) N days\n"
+            "                         after they finished; a real number (0.5 = 12 hours);\n"
+            "                         checked at start-up and every minute\n"
+            "                         [GRAINPACK_RETAIN_DAYS] (default 0 = keep every job)\n"
+            "  --max-queued N         a submit while N jobs are queued gets 503 queue_full\n"
+            "                         with Retry-After [GRAINPACK_MAX_QUEUED] (default 10000)\n"
             "  --allow-origin ORIGIN  also serve pages at ORIGIN (scheme://host[:port], e.g. a\n"
             "                         lab dashboard served elsewhere); repeatable or comma-\n"
             "                         separated [GRAINPACK_ALLOW_ORIGIN]. Any other Origin, and\n"
@@ -62,7 +70,8 @@ static void usage(FILE *f)
             "\n"
             "Restart rule: jobs found 'running' at start-up (the daemon crashed) are queued again,\n"
             "up to %d attempts; a job interrupted %d times fails with error code 'interrupted'.\n"
-            "SIGTERM/SIGINT requeue running jobs without counting an attempt.\n",
+            "SIGTERM/SIGINT requeue running jobs without counting an attempt.\n"
+            "DELETE /v1/jobs/ID?purge=1 removes a finished job; GET /metrics is for Prometheus.\n",
             STORE_MAX_ATTEMPTS, STORE_MAX_ATTEMPTS);
 }
 
@@ -80,6 +89,21 @@ static int parse_long(const char *name, const char *s, long lo, long hi, long *o
     return 0;
 }
 
+static int parse_days(const char *name, const char *s, double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || !end || *end || end == s || !isfinite(v) || v < 0 || v > 36500) {
+        fprintf(stderr, "grainpackd: %s expects a number of days in [0, 36500] (0 = keep "
+                        "forever; 0.5 = 12 hours), got \"%s\"\n",
+                name, s);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
 static const char *env_or(const char *name, const char *dflt)
 {
     const char *v = getenv(name);
@@ -89,7 +113,7 @@ static const char *env_or(const char *name, const char *dflt)
 /* the settings as given: the command line, else the environment, else the defaults */
 typedef struct settings {
     const char *listen, *db, *workers, *level, *threads, *maxconn, *timeout, *maxbody, *maxres,
-        *jobto;
+        *jobto, *retain, *maxq;
 } settings;
 
 /* Reads the command line over st (the environment's values); -1 to go on, else the exit
@@ -105,6 +129,8 @@ static int read_args(int argc, char **argv, settings *st)
         {"timeout", required_argument, 0, 'T'},      {"max-body", required_argument, 0, 'b'},
         {"max-result-mb", required_argument, 0, 'R'},
         {"job-timeout", required_argument, 0, 'J'},
+        {"retain-days", required_argument, 0, 1002},
+        {"max-queued", required_argument, 0, 1003},
         {"allow-origin", required_argument, 0, 1001},
         {"help", no_argument, 0, 'h'},               {"version", no_argument, 0, 'V'},
         {0, 0, 0, 0}};
@@ -121,6 +147,8 @@ static int read_args(int argc, char **argv, settings *st)
         case 'b': st->maxbody = optarg; break;
         case 'R': st->maxres = optarg; break;
         case 'J': st->jobto = optarg; break;
+        case 1002: st->retain = optarg; break;
+        case 1003: st->maxq = optarg; break;
         case 1001:
             if (gpd_allow_origins(optarg)) return 2;
             origins_flag = 1;
@@ -169,9 +197,9 @@ static int open_store(const char *db)
     return 0;
 }
 
-/* Starts the workers and the HTTP server on the open store; 0, or -1 with everything that
- * was started stopped and the store closed. */
-static int start(gpd_http_config *cfg, long nworkers, long jobto)
+/* Starts the workers, the maintenance thread (maint.h) and the HTTP server on the open store;
+ * 0, or -1 with everything that was started stopped and the store closed. */
+static int start(gpd_http_config *cfg, long nworkers, long jobto, double retain_days)
 {
     static char host[300];
     int port = 0;
@@ -186,11 +214,18 @@ static int start(gpd_http_config *cfg, long nworkers, long jobto)
         store_close();
         return -1;
     }
+    if (maint_start(retain_days) != 0) {
+        close(fd);
+        workers_stop();
+        store_close();
+        return -1;
+    }
     cfg->listen_fd = fd;
     cfg->host = host;
     cfg->port = port;
     if (gpd_http_start(cfg) != 0) {
         close(fd);
+        maint_stop();
         workers_stop();
         store_close();
         return -1;
@@ -213,17 +248,22 @@ int main(int argc, char **argv)
                    env_or("GRAINPACK_TIMEOUT", "30"),
                    env_or("GRAINPACK_MAX_BODY", "1048576"),
                    env_or("GRAINPACK_MAX_RESULT_MB", "1024"),
-                   env_or("GRAINPACK_JOB_TIMEOUT", "3600")};
+                   env_or("GRAINPACK_JOB_TIMEOUT", "3600"),
+                   env_or("GRAINPACK_RETAIN_DAYS", "0"),
+                   env_or("GRAINPACK_MAX_QUEUED", "10000")};
     int rc = read_args(argc, argv, &st);
     if (rc >= 0) return rc;
-    long nworkers, nthreads, maxconn, timeout, maxbody, maxres, jobto;
+    long nworkers, nthreads, maxconn, timeout, maxbody, maxres, jobto, maxq;
+    double retain_days;
     if (parse_long("--workers", st.workers, 1, 1024, &nworkers) ||
         parse_long("--http-threads", st.threads, 1, 256, &nthreads) ||
         parse_long("--max-connections", st.maxconn, 1, 1000000, &maxconn) ||
         parse_long("--timeout", st.timeout, 1, 86400, &timeout) ||
         parse_long("--max-body", st.maxbody, 1024, 1L << 30, &maxbody) ||
         parse_long("--max-result-mb", st.maxres, 1, 1L << 20, &maxres) ||
-        parse_long("--job-timeout", st.jobto, 0, 31622400, &jobto))
+        parse_long("--job-timeout", st.jobto, 0, 31622400, &jobto) ||
+        parse_long("--max-queued", st.maxq, 1, 1000000000, &maxq) ||
+        parse_days("--retain-days", st.retain, &retain_days))
         return 2;
     int level = gpd_log_parse_level(st.level);
     if (level < 0) {
@@ -247,18 +287,23 @@ int main(int argc, char **argv)
                            .timeout_s = (unsigned)timeout,
                            .max_body = (size_t)maxbody,
                            .max_result_mb = (double)maxres,
+                           .max_queued = maxq,
                            .listen = st.listen};
-    if (start(&cfg, nworkers, jobto)) return 1;
+    if (start(&cfg, nworkers, jobto, retain_days)) return 1;
     printf("listening on http://%s:%d\n", cfg.host, cfg.port);
     fflush(stdout);
     gpd_log(GPD_LOG_INFO, "grainpackd %s: http://%s:%d, db %s, %ld workers, %ld http threads",
             GPD_VERSION, cfg.host, cfg.port, st.db, nworkers, nthreads);
+    if (retain_days > 0)
+        gpd_log(GPD_LOG_INFO, "retention: finished jobs are purged %g days after they finished",
+                retain_days);
 
     int sig = 0;
     while (sigwait(&set, &sig) != 0) {
     }
     gpd_log(GPD_LOG_INFO, "signal %d: shutting down (running jobs are requeued)", sig);
     gpd_http_stop();
+    maint_stop();
     workers_stop();
     store_close();
     gpd_log(GPD_LOG_INFO, "stopped cleanly");

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -18,6 +19,19 @@
 #include "json_scan.h"
 
 /* ------------------------------------------------------------------ connections */
+
+static int auto_vacuum = 0; /* the database gives space back (set by store_open) */
+
+/* The one integer a query answers (its first column of its first row); -1 when it fails. */
+static long query_long(sqlite3 *db, const char *sql)
+{
+    sqlite3_stmt *st = NULL;
+    long v = -1;
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW)
+        v = (long)sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    return v;
+}
 
 static char *db_path = NULL;
 static pthread_key_t conn_key;
@@ -34,7 +48,7 @@ static long test_max_length = 0, test_max_pages = 0;
 
 /* A thread's connection and its prepared statements, cached by SQL text address (every SQL
  * string here is a literal), so that a status poll costs one sqlite3_step. */
-#define STMT_CACHE 24
+#define STMT_CACHE 40
 typedef struct conn_t {
     sqlite3 *db;
     int n;
@@ -51,6 +65,8 @@ static void conn_destroy(void *p)
     free(c);
 }
 
+#define STORE_JOURNAL_LIMIT "67108864" /* 64 MB */
+
 static const char *SCHEMA_SQL =
     "CREATE TABLE IF NOT EXISTS jobs("
     " seq INTEGER PRIMARY KEY AUTOINCREMENT,"
@@ -66,6 +82,11 @@ static const char *SCHEMA_SQL =
     " result TEXT,"
     " attempts INTEGER NOT NULL DEFAULT 0);"
     "CREATE INDEX IF NOT EXISTS jobs_status_seq ON jobs(status, seq);"
+    /* GET /metrics counts jobs by kind and status every scrape: a covering index; the
+     * retention sweep finds finished jobs by age (queued and running ones have none) */
+    "CREATE INDEX IF NOT EXISTS jobs_kind_status ON jobs(kind, status);"
+    "CREATE INDEX IF NOT EXISTS jobs_finished_at ON jobs(finished_at)"
+    " WHERE finished_at IS NOT NULL;"
     /* the export pack of a succeeded job (core/export/gp_export.h), keyed by the job's seq so that
      * it can be read with incremental blob I/O */
     "CREATE TABLE IF NOT EXISTS exports(seq INTEGER PRIMARY KEY, pack BLOB NOT NULL);"
@@ -99,8 +120,12 @@ static sqlite3 *conn_open(void)
     }
     sqlite3_busy_timeout(db, 5000);
     char *em = NULL;
-    if (sqlite3_exec(db, "PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON;", NULL, NULL, &em) !=
-        SQLITE_OK) {
+    /* journal_size_limit: a WAL that a big result grew to hundreds of MB is cut back to this
+     * once a checkpoint has reset it (store_reclaim truncates it to nothing) */
+    if (sqlite3_exec(db,
+                     "PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON; "
+                     "PRAGMA journal_size_limit=" STORE_JOURNAL_LIMIT ";",
+                     NULL, NULL, &em) != SQLITE_OK) {
         gpd_log(GPD_LOG_ERROR, "sqlite pragma: %s", em ? em : "?");
         sqlite3_free(em);
         sqlite3_close_v2(db);
@@ -216,13 +241,25 @@ int store_open(const char *path)
     sqlite3 *db = conn();
     if (!db) return -1;
     char *em = NULL;
-    /* WAL is persistent in the file; set it once here. */
-    if (sqlite3_exec(db, "PRAGMA journal_mode=WAL;", NULL, NULL, &em) != SQLITE_OK ||
+    /* A new database gives the space of purged jobs back (store_reclaim): auto_vacuum can only
+     * be chosen before the first table, and before WAL mode writes the file's first page.
+     * WAL is persistent in the file; set it once here. */
+    int fresh = query_long(db, "SELECT count(*) FROM sqlite_master") == 0;
+    if ((fresh && sqlite3_exec(db, "PRAGMA auto_vacuum=INCREMENTAL;", NULL, NULL, &em) !=
+                      SQLITE_OK) ||
+        sqlite3_exec(db, "PRAGMA journal_mode=WAL;", NULL, NULL, &em) != SQLITE_OK ||
         sqlite3_exec(db, SCHEMA_SQL, NULL, NULL, &em) != SQLITE_OK) {
         gpd_log(GPD_LOG_ERROR, "cannot initialise database %s: %s", path, em ? em : "?");
         sqlite3_free(em);
         return -1;
     }
+    auto_vacuum = query_long(db, "PRAGMA auto_vacuum") == 2;
+    if (!auto_vacuum)
+        gpd_log(GPD_LOG_WARN,
+                "database %s was made without auto_vacuum: the space of purged jobs is reused "
+                "but not given back to the file system until it is converted once, with the "
+                "daemon stopped: sqlite3 %s 'PRAGMA auto_vacuum=INCREMENTAL; VACUUM;' (see README)",
+                path, path);
     return 0;
 }
 
@@ -444,24 +481,29 @@ int store_recover(int *requeued, int *failed)
     return rc;
 }
 
-store_rc store_insert(const char *kind, const char *spec_json, char id_out[33])
+store_rc store_insert(const char *kind, const char *spec_json, long max_queued, char id_out[33])
 {
     sqlite3 *db = conn();
     if (!db) return STORE_ERROR;
     if (gpd_new_id(id_out) != 0) return STORE_ERROR;
     char now[40];
     gpd_now_rfc3339(now, sizeof now);
+    /* the queue's cap in the same statement: two submits cannot both take the last place (the
+     * count walks the status index: 10,000 queued jobs cost well under a millisecond) */
     sqlite3_stmt *st = prep(db, "INSERT INTO jobs(id, kind, spec, status, created_at) "
-                                "VALUES (?1, ?2, ?3, 'queued', ?4)");
+                                "SELECT ?1, ?2, ?3, 'queued', ?4 WHERE ?5 <= 0 OR "
+                                "(SELECT count(*) FROM jobs WHERE status='queued') < ?5");
     if (!st) return STORE_ERROR;
     int rc = -1;
     if (bind_text(st, 1, id_out) == SQLITE_OK && bind_text(st, 2, kind) == SQLITE_OK &&
-        bind_text(st, 3, spec_json) == SQLITE_OK && bind_text(st, 4, now) == SQLITE_OK)
+        bind_text(st, 3, spec_json) == SQLITE_OK && bind_text(st, 4, now) == SQLITE_OK &&
+        sqlite3_bind_int64(st, 5, max_queued) == SQLITE_OK)
         rc = step_done(db, st);
     else
         gpd_log(GPD_LOG_ERROR, "sqlite insert: %s", sqlite3_errmsg(db));
+    int inserted = rc == 0 && sqlite3_changes(db) > 0;
     done(st);
-    return rc == 0 ? STORE_OK : STORE_ERROR;
+    return rc != 0 ? STORE_ERROR : inserted ? STORE_OK : STORE_FULL;
 }
 
 json_t *store_get_job(const char *id, store_rc *rc)
@@ -1025,10 +1067,11 @@ store_rc store_requeue(const char *id)
                           id, NULL, NULL, NULL);
 }
 
-store_rc store_cancel(const char *id, int *was_running, char status_out[16])
+store_rc store_cancel(const char *id, int *was_running, char status_out[16], char kind_out[64])
 {
     *was_running = 0;
     status_out[0] = '\0';
+    if (kind_out) kind_out[0] = '\0';
     sqlite3 *db = conn();
     if (!db) return STORE_ERROR;
     char now[40];
@@ -1038,7 +1081,7 @@ store_rc store_cancel(const char *id, int *was_running, char status_out[16])
         return STORE_ERROR;
     }
     store_rc rc = STORE_ERROR;
-    sqlite3_stmt *q = prep(db, "SELECT status FROM jobs WHERE id=?1");
+    sqlite3_stmt *q = prep(db, "SELECT status, kind FROM jobs WHERE id=?1");
     sqlite3_stmt *u = prep(db, "UPDATE jobs SET status='cancelled', finished_at=?2, "
                                "error='{\"code\":\"cancelled\",\"message\":\"cancelled by a "
                                "DELETE request\"}' WHERE id=?1");
@@ -1049,6 +1092,8 @@ store_rc store_cancel(const char *id, int *was_running, char status_out[16])
             rc = STORE_NOT_FOUND;
         } else if (s == SQLITE_ROW) {
             snprintf(status_out, 16, "%s", (const char *)sqlite3_column_text(q, 0));
+            const unsigned char *k = sqlite3_column_text(q, 1);
+            if (kind_out) snprintf(kind_out, 64, "%s", k ? (const char *)k : "");
             if (!strcmp(status_out, "queued") || !strcmp(status_out, "running")) {
                 *was_running = !strcmp(status_out, "running");
                 bind_text(u, 1, id);
@@ -1070,4 +1115,165 @@ store_rc store_cancel(const char *id, int *was_running, char status_out[16])
         rc = STORE_ERROR;
     }
     return rc;
+}
+
+/* ------------------------------------------------------------------ operations */
+
+/* the statuses of a job that has finished: the ones a purge may remove */
+static int is_finished(const char *status)
+{
+    return !strcmp(status, "succeeded") || !strcmp(status, "failed") ||
+           !strcmp(status, "cancelled");
+}
+
+store_rc store_purge(const char *id, char status_out[16])
+{
+    status_out[0] = '\0';
+    sqlite3 *db = conn();
+    if (!db) return STORE_ERROR;
+    if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite purge begin: %s", sqlite3_errmsg(db));
+        return STORE_ERROR;
+    }
+    sqlite3_stmt *st;
+    store_rc rc = job_row(db, "SELECT status, seq FROM jobs WHERE id=?1", id, "purge", &st,
+                          status_out);
+    sqlite3_int64 seq = st ? sqlite3_column_int64(st, 1) : 0;
+    done(st);
+    if (rc == STORE_OK && !is_finished(status_out)) rc = STORE_CONFLICT;
+    /* the pack and the summary first (keyed by the job's seq), then the row with its result */
+    static const char *const del[] = {"DELETE FROM exports WHERE seq=?1",
+                                      "DELETE FROM summaries WHERE seq=?1",
+                                      "DELETE FROM jobs WHERE seq=?1"};
+    for (size_t i = 0; rc == STORE_OK && i < sizeof del / sizeof *del; i++) {
+        sqlite3_stmt *d = prep(db, del[i]);
+        if (!d) {
+            rc = STORE_ERROR;
+            break;
+        }
+        sqlite3_bind_int64(d, 1, seq);
+        if (step_done(db, d)) rc = STORE_ERROR;
+        done(d);
+    }
+    if (rc == STORE_OK && sqlite3_exec(db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite purge commit: %s", sqlite3_errmsg(db));
+        note_write_error("purging a job", sqlite3_errmsg(db));
+        rc = STORE_ERROR;
+    }
+    if (!sqlite3_get_autocommit(db) && sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK)
+        gpd_log(GPD_LOG_ERROR, "sqlite purge rollback: %s", sqlite3_errmsg(db));
+    return rc;
+}
+
+int store_purge_finished_before(const char *before, int max)
+{
+    sqlite3 *db = conn();
+    if (!db || max <= 0) return db ? 0 : -1;
+    /* the candidates first (the index on finished_at: queued and running jobs are not in it),
+     * then each purged in its own transaction, so that the sweep never holds the store long */
+    sqlite3_stmt *st = prep(db, "SELECT id FROM jobs WHERE finished_at < ?1 AND status IN "
+                                "('succeeded', 'failed', 'cancelled') "
+                                "ORDER BY finished_at LIMIT ?2");
+    if (!st) return -1;
+    char(*ids)[33] = calloc((size_t)max, sizeof *ids);
+    if (!ids) {
+        done(st);
+        return -1;
+    }
+    bind_text(st, 1, before);
+    sqlite3_bind_int(st, 2, max);
+    int n = 0, s = SQLITE_DONE;
+    while (n < max && (s = sqlite3_step(st)) == SQLITE_ROW) {
+        const unsigned char *t = sqlite3_column_text(st, 0);
+        if (t) snprintf(ids[n++], 33, "%s", (const char *)t);
+    }
+    if (n < max && s != SQLITE_DONE) {
+        gpd_log(GPD_LOG_ERROR, "sqlite retention: %s", sqlite3_errmsg(db));
+        done(st);
+        free(ids);
+        return -1;
+    }
+    done(st);
+    int purged = 0;
+    for (int i = 0; i < n; i++) {
+        char status[16];
+        /* a job may have gone meanwhile (a DELETE ?purge=1): not an error */
+        if (store_purge(ids[i], status) == STORE_OK) purged++;
+    }
+    free(ids);
+    return purged;
+}
+
+/* pages freed by one step of the incremental vacuum: 4 MB of 4 KB pages, a few milliseconds
+ * of the write lock */
+#define RECLAIM_STEP_SQL "PRAGMA incremental_vacuum(1024)"
+
+int store_reclaim(void)
+{
+    sqlite3 *db = conn();
+    if (!db) return -1;
+    if (auto_vacuum) {
+        /* each step is its own write transaction: workers and submits get the lock between */
+        for (int guard = 0; guard < 1000000; guard++) {
+            long free_pages = query_long(db, "PRAGMA freelist_count");
+            if (free_pages <= 0) break;
+            char *em = NULL;
+            if (sqlite3_exec(db, RECLAIM_STEP_SQL,
+                             NULL, NULL, &em) != SQLITE_OK) {
+                gpd_log(GPD_LOG_WARN, "sqlite incremental vacuum: %s (tried again later)",
+                        em ? em : "?");
+                sqlite3_free(em);
+                return 1;
+            }
+        }
+    }
+    /* TRUNCATE: the WAL goes back to nothing and the file to its pages in use; it needs every
+     * reader on the newest snapshot, so with no busy handler a download in progress makes it
+     * answer SQLITE_BUSY at once (after a passive checkpoint) instead of waiting for it */
+    sqlite3_busy_timeout(db, 0);
+    int rc = sqlite3_wal_checkpoint_v2(db, "main", SQLITE_CHECKPOINT_TRUNCATE, NULL, NULL);
+    sqlite3_busy_timeout(db, 5000);
+    if (rc == SQLITE_OK) return 0;
+    if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) return 1;
+    gpd_log(GPD_LOG_WARN, "sqlite checkpoint: %s", sqlite3_errmsg(db));
+    return -1;
+}
+
+int store_count_by_kind(void (*fn)(void *user, const char *kind, const char *status, long n),
+                        void *user)
+{
+    sqlite3 *db = conn();
+    if (!db) return -1;
+    sqlite3_stmt *st = prep(db, "SELECT kind, status, count(*) FROM jobs GROUP BY kind, status");
+    if (!st) return -1;
+    int s;
+    while ((s = sqlite3_step(st)) == SQLITE_ROW) {
+        const unsigned char *k = sqlite3_column_text(st, 0), *t = sqlite3_column_text(st, 1);
+        if (k && t) fn(user, (const char *)k, (const char *)t, (long)sqlite3_column_int64(st, 2));
+    }
+    if (s != SQLITE_DONE) gpd_log(GPD_LOG_ERROR, "sqlite count by kind: %s", sqlite3_errmsg(db));
+    done(st);
+    return s == SQLITE_DONE ? 0 : -1;
+}
+
+int store_size(long long *bytes)
+{
+    *bytes = 0;
+    sqlite3 *db = conn();
+    if (!db) return -1;
+    sqlite3_stmt *pc = prep(db, "PRAGMA page_count"), *ps = prep(db, "PRAGMA page_size");
+    long long pages = -1, size = -1;
+    if (pc && sqlite3_step(pc) == SQLITE_ROW) pages = sqlite3_column_int64(pc, 0);
+    if (ps && sqlite3_step(ps) == SQLITE_ROW) size = sqlite3_column_int64(ps, 0);
+    done(pc);
+    done(ps);
+    if (pages < 0 || size < 0) return -1;
+    *bytes = pages * size;
+    const char *file = sqlite3_db_filename(db, "main");
+    char wal[PATH_MAX + 8];
+    struct stat sb;
+    if (file && snprintf(wal, sizeof wal, "%s-wal", file) < (int)sizeof wal &&
+        stat(wal, &sb) == 0)
+        *bytes += (long long)sb.st_size;
+    return 0;
 }

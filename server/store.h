@@ -1,7 +1,8 @@
 /* store.h -- the SQLite job store of grainpackd.
  *
- * One table, jobs (WAL journal, busy_timeout 5 s, synchronous=NORMAL... FULL for the commit of
- * a result, see store.c):
+ * One table, jobs (WAL journal, busy_timeout 5 s, synchronous=FULL; a new database is made with
+ * auto_vacuum=INCREMENTAL so that purged jobs give their space back (store_reclaim), and every
+ * connection sets journal_size_limit=64 MB so that the WAL shrinks after a checkpoint):
  *   seq         INTEGER PRIMARY KEY AUTOINCREMENT  submission order (newest = largest)
  *   id          TEXT NOT NULL UNIQUE               32 hex digits, 128 random bits (/dev/urandom)
  *   kind        TEXT NOT NULL
@@ -43,12 +44,14 @@
 /* ---- the store ---- */
 #define STORE_MAX_ATTEMPTS 3
 
-/* STORE_TOOBIG: a value larger than the database can hold (SQLITE_TOOBIG); retrying is futile. */
+/* STORE_TOOBIG: a value larger than the database can hold (SQLITE_TOOBIG); retrying is futile.
+ * STORE_FULL: the queue already holds the most jobs it may (store_insert's max_queued). */
 typedef enum {
     STORE_OK = 0,
     STORE_NOT_FOUND = 1,
     STORE_CONFLICT = 2,
     STORE_TOOBIG = 3,
+    STORE_FULL = 4,
     STORE_ERROR = -1
 } store_rc;
 
@@ -69,8 +72,10 @@ void store_thread_done(void);
 /* Crash recovery at startup (rule above). Returns the number of jobs requeued and failed. */
 int store_recover(int *requeued, int *failed);
 
-/* Inserts a queued job; fills id. */
-store_rc store_insert(const char *kind, const char *spec_json, char id_out[33]);
+/* Inserts a queued job; fills id. With max_queued > 0 the job is inserted only while fewer than
+ * max_queued jobs are queued, checked in the same statement (atomic with respect to every
+ * other writer): STORE_FULL when the queue is full. */
+store_rc store_insert(const char *kind, const char *spec_json, long max_queued, char id_out[33]);
 
 /* The job object of api.md (a new reference), or NULL with *rc set. */
 json_t *store_get_job(const char *id, store_rc *rc);
@@ -119,8 +124,40 @@ store_rc store_requeue(const char *id);
 
 /* DELETE: a queued or running job becomes cancelled (finished_at now). STORE_CONFLICT (with
  * its status in status_out) when it has already finished, STORE_NOT_FOUND when unknown.
- * was_running tells whether a worker must be told. */
-store_rc store_cancel(const char *id, int *was_running, char status_out[16]);
+ * was_running tells whether a worker must be told; kind_out (may be NULL) gets the job's kind. */
+store_rc store_cancel(const char *id, int *was_running, char status_out[16], char kind_out[64]);
+
+/* ---- operations: purging finished jobs, giving the space back, sizes ---- */
+
+/* DELETE ?purge=1: removes a finished job (succeeded, failed or cancelled) -- its row with the
+ * result, its export pack and its summary -- in one transaction. STORE_CONFLICT (with the
+ * status in status_out) when the job is queued or running, STORE_NOT_FOUND when unknown.
+ * A download of its result or pack in progress keeps reading the value as it was: a stream
+ * (store_stream_open) holds a read transaction, whose snapshot a later write never changes.
+ * The space the job took is free for reuse at once; store_reclaim gives it back to the file
+ * system. */
+store_rc store_purge(const char *id, char status_out[16]);
+
+/* The retention sweep: purges (store_purge, each job its own short transaction) at most max
+ * finished jobs whose finished_at is before `before` (RFC 3339, as the store writes it),
+ * oldest first. Returns how many were purged, -1 when the candidates could not be read. */
+int store_purge_finished_before(const char *before, int max);
+
+/* Gives the space of purged jobs back: incremental vacuum (in steps of a few MB, each its own
+ * short write transaction) and a WAL checkpoint in TRUNCATE mode that does not wait: readers
+ * (a download in progress) block it, and the caller tries again later. 0 when done, 1 when the
+ * checkpoint was blocked, -1 on an error (logged). A database made without auto_vacuum (before
+ * it was set at creation) only checkpoints: its file keeps its size, its free pages are
+ * reused. */
+int store_reclaim(void);
+
+/* The jobs in the store by kind and status (one GROUP BY over an index): fn is called once
+ * per pair present. 0, or -1. */
+int store_count_by_kind(void (*fn)(void *user, const char *kind, const char *status, long n),
+                        void *user);
+
+/* The database's size on disk: page_count * page_size plus the WAL file. 0, or -1. */
+int store_size(long long *bytes);
 
 /* ---- reading large values (results, export packs) without holding them in memory ---- */
 typedef struct store_stream store_stream;

@@ -67,8 +67,20 @@ void gpd_log(gpd_log_level level, const char *fmt, ...)
 
 void gpd_now_rfc3339(char *buf, size_t len)
 {
+    gpd_past_rfc3339(0, buf, len);
+}
+
+void gpd_past_rfc3339(double ago_s, char *buf, size_t len)
+{
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
+    if (ago_s > 0) {
+        long long ms = (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000L -
+                       (long long)(ago_s * 1000.0 + 0.5);
+        if (ms < 0) ms = 0;
+        ts.tv_sec = (time_t)(ms / 1000);
+        ts.tv_nsec = (long)(ms % 1000) * 1000000L;
+    }
     struct tm tm;
     gmtime_r(&ts.tv_sec, &tm);
     size_t n = strftime(buf, len, "%Y-%m-%dT%H:%M:%S", &tm);
@@ -151,5 +163,22 @@ int gpd_buf_add(gpd_buf *b, const void *p, size_t n)
     memcpy(b->buf + b->len, p, n);
     b->len += n;
     b->buf[b->len] = '\0';
+    return 0;
+}
+
+int gpd_buf_printf(gpd_buf *b, const char *fmt, ...)
+{
+    char small[512];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(small, sizeof small, fmt, ap);
+    va_end(ap);
+    if (n < 0) return -1;
+    if ((size_t)n < sizeof small) return gpd_buf_add(b, small, (size_t)n);
+    if (gpd_buf_reserve(b, (size_t)n)) return -1;
+    va_start(ap, fmt);
+    vsnprintf(b->buf + b->len, (size_t)n + 1, fmt, ap);
+    va_end(ap);
+    b->len += (size_t)n;
     return 0;
 }

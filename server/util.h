@@ -44,6 +44,8 @@ void gpd_log(gpd_log_level level, const char *fmt, ...) __attribute__((format(pr
 
 /* RFC 3339 UTC with milliseconds, e.g. "2026-11-23T17:25:47.123Z" (buf >= 32). */
 void gpd_now_rfc3339(char *buf, size_t len);
+/* The same for the time ago_s seconds before now (the cut-off of the retention sweep). */
+void gpd_past_rfc3339(double ago_s, char *buf, size_t len);
 double gpd_monotonic_s(void);
 /* Sleeps s seconds, through signals. */
 void gpd_sleep_s(double s);
@@ -67,5 +69,7 @@ typedef struct gpd_buf {
 int gpd_buf_reserve(gpd_buf *b, size_t n);
 /* Appends n bytes; 0, or -1 (oom). */
 int gpd_buf_add(gpd_buf *b, const void *p, size_t n);
+/* Appends formatted text; 0, or -1 (oom). */
+int gpd_buf_printf(gpd_buf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 #endif /* GPD_UTIL_H */

@@ -12,6 +12,7 @@
 #include <jansson.h>
 
 #include "kind.h"
+#include "metrics.h"
 #include "result_json.h"
 
 #define PROGRESS_MIN_INTERVAL_S 0.25 /* <= 4 Hz per job */
@@ -96,15 +97,18 @@ void workers_notify(void)
 store_rc workers_cancel(const char *id, char status_out[16])
 {
     int was_running = 0;
+    char kind[64];
     pthread_mutex_lock(&reg_mu);
-    store_rc rc = store_cancel(id, &was_running, status_out);
+    store_rc rc = store_cancel(id, &was_running, status_out, kind);
     if (rc == STORE_OK && was_running) {
         for (int i = 0; i < nslots; i++)
             if (!strcmp(slots[i].id, id)) raise_cancel(&slots[i], REASON_DELETE);
     }
     pthread_mutex_unlock(&reg_mu);
-    if (rc == STORE_OK) gpd_log(GPD_LOG_INFO, "job %s cancelled (was %s)", id,
-                                was_running ? "running" : "queued");
+    if (rc == STORE_OK) {
+        gpd_log(GPD_LOG_INFO, "job %s cancelled (was %s)", id, was_running ? "running" : "queued");
+        metrics_job_finished(kind, "cancelled", -1);
+    }
     return rc;
 }
 
@@ -220,6 +224,7 @@ static void report_result_phase(run_ctx *c, double fraction)
 typedef struct pending {
     struct pending *next;
     char id[33];
+    char kind[64];
     char code[32];
     char *msg;
 } pending;
@@ -227,7 +232,7 @@ static pending *pend_head = NULL;
 static int pend_count = 0; /* atomic; guarded by pend_mu for writes */
 static pthread_mutex_t pend_mu = PTHREAD_MUTEX_INITIALIZER;
 
-static void pending_add(const char *id, const char *code, const char *msg)
+static void pending_add(const char *id, const char *kind, const char *code, const char *msg)
 {
     pending *p = calloc(1, sizeof *p);
     if (p) p->msg = strdup(msg ? msg : "");
@@ -238,6 +243,7 @@ static void pending_add(const char *id, const char *code, const char *msg)
         return;
     }
     snprintf(p->id, sizeof p->id, "%s", id);
+    snprintf(p->kind, sizeof p->kind, "%s", kind);
     snprintf(p->code, sizeof p->code, "%s", code);
     pthread_mutex_lock(&pend_mu);
     p->next = pend_head;
@@ -266,9 +272,11 @@ static void pending_drain(int last)
             gpd_log(GPD_LOG_ERROR, "job %s stays running in the database (it cannot be marked "
                                    "failed: %s: %s); it is requeued at the next start",
                     p->id, p->code, p->msg);
-        else if (rc == STORE_OK)
+        else if (rc == STORE_OK) {
             gpd_log(GPD_LOG_INFO, "job %s failed: %s: %s (written late)", p->id, p->code,
                     p->msg);
+            metrics_job_finished(p->kind, "failed", -1);
+        }
         *pp = p->next;
         free(p->msg);
         free(p);
@@ -277,9 +285,11 @@ static void pending_drain(int last)
     pthread_mutex_unlock(&pend_mu);
 }
 
-/* Marks a running job failed. A write the database refuses is tried again after a pause, then
- * left to pending_drain, and said in the log at level error: never silently running. */
-static void finish_failed(const char *id, const char *code, const char *msg)
+/* Marks a running job of kind (its name) failed; t0: when its run began (monotonic; 0 before
+ * it began). A write the database refuses is tried again after a pause, then left to
+ * pending_drain, and said in the log at level error: never silently running. */
+static void finish_failed(const char *id, const char *kind, double t0, const char *code,
+                          const char *msg)
 {
     store_rc rc = store_fail(id, code, msg);
     if (rc == STORE_ERROR) {
@@ -288,11 +298,12 @@ static void finish_failed(const char *id, const char *code, const char *msg)
     }
     if (rc == STORE_OK) {
         gpd_log(GPD_LOG_INFO, "job %s failed: %s: %s", id, code, msg);
+        metrics_job_finished(kind, "failed", t0 > 0 ? gpd_monotonic_s() - t0 : -1);
     } else if (rc == STORE_ERROR) {
         gpd_log(GPD_LOG_ERROR, "job %s: cannot mark it failed (%s: %s); it shows running until "
                                "a retry succeeds",
                 id, code, msg);
-        pending_add(id, code, msg);
+        pending_add(id, kind, code, msg);
     }
     /* STORE_CONFLICT: no longer running (cancelled meanwhile); nothing to write */
 }
@@ -305,7 +316,7 @@ static void finish_timeout(run_ctx *ctx, const char *phase)
              "stopped after running longer than the job time limit of %ld s (--job-timeout), "
              "in phase \"%s\"",
              job_timeout_s, phase);
-    finish_failed(ctx->id, "timeout", msg);
+    finish_failed(ctx->id, ctx->kind->name, ctx->t0, "timeout", msg);
 }
 
 /* A build that did not succeed: cancelled (by DELETE or shutdown) or failed; err may be NULL
@@ -328,13 +339,14 @@ static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err, const
     snprintf(msg, sizeof msg, "%s%s",
              err && err->message[0] ? err->message : gp_status_name(st),
              extra ? extra : "");
-    finish_failed(ctx->id, gp_status_name(st), msg);
+    finish_failed(ctx->id, ctx->kind->name, ctx->t0, gp_status_name(st), msg);
 }
 
 /* The result text, the "done" progress and the pack committed with status succeeded; a write
- * the database refuses is tried once more, and a result it can never take fails the job. */
+ * the database refuses is tried once more, and a result it can never take fails the job.
+ * timings: the result's "timings" (may be NULL), observed by the metrics once it is stored. */
 static void store_result(run_ctx *ctx, const char *text, const char *prog, const void *pack,
-                         size_t pack_len)
+                         size_t pack_len, const json_t *timings)
 {
     gpd_err why;
     store_rc rc = store_succeed(ctx->id, text, prog, pack, pack_len, &why);
@@ -346,14 +358,17 @@ static void store_result(run_ctx *ctx, const char *text, const char *prog, const
     }
     char msg[600];
     if (rc == STORE_OK) {
-        gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%zu bytes)", ctx->id,
-                gpd_monotonic_s() - ctx->t0, strlen(text));
+        double run_s = gpd_monotonic_s() - ctx->t0;
+        gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%zu bytes)", ctx->id, run_s,
+                strlen(text));
+        metrics_job_finished(ctx->kind->name, "succeeded", run_s);
+        metrics_job_timings(ctx->kind, timings);
     } else if (rc == STORE_TOOBIG) {
         snprintf(msg, sizeof msg, "the result cannot be stored: %s", why.msg);
-        finish_failed(ctx->id, "too_large", msg);
+        finish_failed(ctx->id, ctx->kind->name, ctx->t0, "too_large", msg);
     } else if (rc == STORE_ERROR) {
         snprintf(msg, sizeof msg, "the result could not be stored (tried twice): %s", why.msg);
-        finish_failed(ctx->id, "store_error", msg);
+        finish_failed(ctx->id, ctx->kind->name, ctx->t0, "store_error", msg);
     }
     /* STORE_CONFLICT: cancelled by a DELETE meanwhile */
 }
@@ -368,6 +383,8 @@ static void finish_succeeded(run_ctx *ctx, json_t *r, json_t *detail, void *pack
 {
     char *text = r ? gpd_dumps_c(r, JSON_COMPACT | JSON_REAL_PRECISION(17), &ctx->s->cancel)
                    : NULL;
+    /* the timings (a few numbers) outlive the tree, for the metrics */
+    json_t *timings = r ? json_deep_copy(json_object_get(r, "timings")) : NULL;
     reap_later(r);
     int reason = __atomic_load_n(&ctx->s->reason, __ATOMIC_RELAXED);
     int stopped = __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED) &&
@@ -385,10 +402,12 @@ static void finish_succeeded(run_ctx *ctx, json_t *r, json_t *detail, void *pack
          * requeued */
         finish_not_ok(ctx, GP_ERR_CANCELLED, NULL, NULL);
     } else if (!text || !prog) {
-        finish_failed(ctx->id, "internal", "out of memory while serialising the result");
+        finish_failed(ctx->id, ctx->kind->name, ctx->t0, "internal",
+                      "out of memory while serialising the result");
     } else {
-        store_result(ctx, text, prog, pack, pack_len);
+        store_result(ctx, text, prog, pack, pack_len, timings);
     }
+    json_decref(timings);
     json_decref(detail);
     free(text);
     free(prog);
@@ -401,14 +420,15 @@ static void result_not_built(run_ctx *ctx)
     if (__atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED))
         finish_not_ok(ctx, GP_ERR_CANCELLED, NULL, NULL);
     else
-        finish_failed(ctx->id, "internal", "out of memory while building the result");
+        finish_failed(ctx->id, ctx->kind->name, ctx->t0, "internal",
+                      "out of memory while building the result");
 }
 
 static void unavailable(const char *id, const char *kind)
 {
     char msg[200];
     snprintf(msg, sizeof msg, "kind %s is not available in this build of grainpackd", kind);
-    finish_failed(id, "not_implemented", msg);
+    finish_failed(id, kind, 0, "not_implemented", msg);
 }
 
 /* A built specimen (taken) becomes the result, the export pack and the final "done" detail of
@@ -442,13 +462,13 @@ static void run_kind(slot *s, const char *id, const gpd_kind *k, const json_t *s
     memset(&prob, 0, sizeof prob);
     void *spec = calloc(1, k->spec_size);
     if (!spec) {
-        finish_failed(id, "internal", "out of memory while reading the spec");
+        finish_failed(id, k->name, 0, "internal", "out of memory while reading the spec");
         return;
     }
     if (k->read_spec(spec_json, spec, &prob)) {
         k->free_spec(spec);
         free(spec);
-        finish_failed(id, "invalid_spec", prob.message);
+        finish_failed(id, k->name, 0, "invalid_spec", prob.message);
         return;
     }
     run_ctx ctx = {.s = s, .id = id, .kind = k, .t0 = gpd_monotonic_s(), .last_write = 0,
@@ -474,7 +494,7 @@ static void run_job(slot *s, const char *id, const char *kind, const char *spec_
     json_error_t je;
     json_t *spec = json_loads(spec_text, 0, &je);
     if (!spec) {
-        finish_failed(id, "internal", "stored spec is not valid JSON");
+        finish_failed(id, kind, 0, "internal", "stored spec is not valid JSON");
         return;
     }
     const gpd_kind *k = gpd_kind_find(kind);
