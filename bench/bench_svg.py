@@ -32,7 +32,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 # the daemon harness is bench_export.py's
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_export import call, download, job_args, proc_status, start, stop, submit  # noqa: E402
+from bench_export import call, download, job_args, proc_status, start, stop, submit
+from bench_export import wait as wait_job  # noqa: E402
 
 SPEC_3D = {"kind": "spheres-3d", "box": [0.5, 0.5, 0.5], "porosity": 0.38,
            "outputs": ["spheres"]}
@@ -43,15 +44,10 @@ CONCURRENCY = 4
 
 
 def wait(base, jid, what):
-    t0 = time.time()
-    while True:
-        st, j = call(base + "/v1/jobs/" + jid)
-        if j["status"] in ("succeeded", "failed", "cancelled"):
-            print("  %s: %s in %.1f s" % (what, j["status"], time.time() - t0), flush=True)
-            if j["status"] != "succeeded":
-                sys.exit("the job did not succeed: %s" % j["error"])
-            return j
-        time.sleep(0.5)
+    j = wait_job(base, jid, what)
+    if j["status"] != "succeeded":
+        sys.exit("the job did not succeed: %s" % j["error"])
+    return j
 
 
 def fetch(url):

@@ -22,7 +22,7 @@ import urllib.error
 import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_export import start, stop, submit  # noqa: E402
+from bench_export import start, stop, submit, wait  # noqa: E402
 
 OUT2 = ["grains", "odec", "descriptors", "cells"]
 SPECS = {
@@ -66,16 +66,6 @@ def get(url):
         return e.code, e.read()
 
 
-def wait(base, jid):
-    import time
-    while True:
-        st, b = get(base + "/v1/jobs/" + jid)
-        j = json.loads(b)
-        if j["status"] in ("succeeded", "failed", "cancelled"):
-            return j
-        time.sleep(0.2)
-
-
 def files_of(binary, workers):
     """{(job, file): bytes} for every spec, run on a fresh daemon with this many workers."""
     out = {}
@@ -84,7 +74,7 @@ def files_of(binary, workers):
         try:
             ids = {name: submit(base, spec) for name, spec in SPECS.items()}
             for name, jid in ids.items():
-                j = wait(base, jid)
+                j = wait(base, jid, name)
                 kind = SPECS[name]["kind"]
                 out[(name, "status")] = json.dumps([j["status"], j["error"]]).encode()
                 st, b = get(base + "/v1/jobs/%s/result" % jid)
