@@ -1,0 +1,209 @@
+/* gen_shapemap_table.c -- writes core/2d/gp_shapemap_table.h, the calibrated map of
+ * gp_shapemap.h: on a grid over (D2, D3, D8) (alpha = beta = -2), the mean and sd of the four
+ * descriptors over a fixed set of random-phase grains and the star-shaped fraction of the
+ * draws, measured by gp_shapemap_sampler (the same code the refinement and the tests use).
+ *
+ * Build and run (not part of the default build; about 8.5 min of CPU, 2925 nodes x 400 grains):
+ *     cmake --build B --target gen_shapemap_table
+ *     B/core/2d/gen_shapemap_table -t 2 -o core/2d/gp_shapemap_table.h
+ * Options: -t threads (default 1; the output does not depend on it), -n grains per node
+ * (default 400, the committed table), -o file (default stdout). Same options, same bytes.
+ *
+ * The grid: D2 up to 0.9 (elongation down to ~0.4; r = 1 + D2 cos 2 theta is star-shaped for
+ * D2 < 1), D3 up to 0.25 and D8 up to 0.06 (beyond the paper's 0.2 / 0.1 / 0.03 of Fig. 13,
+ * for angular and rough grains). Steps are finer where descriptors change fast: roundness
+ * falls from 1 to 0.6 and regularity from 5 to 3 between D8 = 0.002 and 0.006.
+ */
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gp_shapemap.h"
+
+#define NP 128
+#define SEED 2012u
+#define NG_DEFAULT 400
+
+static const double AX2[] = {0, 0.025, 0.05, 0.075, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4,
+                             0.5, 0.6, 0.75, 0.9};
+static const double AX3[] = {0, 0.005, 0.01, 0.02, 0.03, 0.045, 0.06, 0.08, 0.1, 0.125,
+                             0.15, 0.2, 0.25};
+static const double AX8[] = {0, 0.001, 0.002, 0.003, 0.004, 0.005, 0.0065, 0.008, 0.01,
+                             0.0125, 0.015, 0.02, 0.03, 0.045, 0.06};
+#define N2 (sizeof AX2 / sizeof AX2[0])
+#define N3 (sizeof AX3 / sizeof AX3[0])
+#define N8 (sizeof AX8 / sizeof AX8[0])
+#define NNODES (N2 * N3 * N8)
+
+typedef struct node_out {
+    gp_shapemap_stats st;
+    int ok;
+} node_out;
+
+typedef struct worker {
+    pthread_t tid;
+    int index, nthreads;
+    size_t ngrains;
+    node_out *out;
+    gp_error err;
+    int failed;
+} worker;
+
+/* Nodes index, index + nthreads, ...: each with the same phases (one sampler per thread, all
+ * seeded alike), so the result does not depend on the thread count. */
+static void *work(void *arg)
+{
+    worker *w = arg;
+    gp_shapemap_sampler *s = gp_shapemap_sampler_create(NP, w->ngrains, SEED, &w->err);
+    if (!s) {
+        w->failed = 1;
+        return NULL;
+    }
+    for (size_t n = (size_t)w->index; n < NNODES; n += (size_t)w->nthreads) {
+        size_t i = n / (N3 * N8), j = (n / N8) % N3, k = n % N8;
+        gp_error e;
+        gp_status st = gp_shapemap_sampler_measure(s, AX2[i], AX3[j], AX8[k], GP_SHAPEMAP_ALPHA,
+                                                   GP_SHAPEMAP_BETA, &w->out[n].st, &e);
+        if (st != GP_OK && st != GP_ERR_NOT_STAR) {
+            w->err = e;
+            w->failed = 1;
+            break;
+        }
+        w->out[n].ok = st == GP_OK;
+        if (w->index == 0 && n % (50 * (size_t)w->nthreads) == 0)
+            fprintf(stderr, "node %zu / %zu\n", n, (size_t)NNODES);
+    }
+    gp_shapemap_sampler_destroy(s);
+    return NULL;
+}
+
+static double star_fraction(const node_out *o, size_t ngrains)
+{
+    return (double)(ngrains - o->st.not_star) / (double)ngrains;
+}
+
+static void print_axis(FILE *f, const char *name, const double *a, size_t n)
+{
+    fprintf(f, "static const double gp_shapemap_table_%s[%zu] = {", name, n);
+    for (size_t i = 0; i < n; i++)
+        fprintf(f, "%s%.6g", i ? ", " : "", a[i]);
+    fprintf(f, "};\n");
+}
+
+/* Largest and median standard error sd / sqrt(n) of each descriptor over usable nodes. */
+static void print_errors(FILE *f, const node_out *o, size_t ngrains)
+{
+    static const char *names[] = {"elongation", "roundness", "circularity", "regularity"};
+    double *se = malloc(NNODES * sizeof *se);
+    for (int d = 0; d < GP_SHAPEMAP_NDESC && se; d++) {
+        size_t m = 0;
+        for (size_t n = 0; n < NNODES; n++)
+            if (o[n].ok && star_fraction(&o[n], ngrains) >= GP_SHAPEMAP_STAR_MIN)
+                se[m++] = o[n].st.sd[d] / sqrt((double)o[n].st.ngrains);
+        for (size_t a = 1; a < m; a++) /* insertion sort: m is a few thousand, run once */
+            for (size_t b = a; b > 0 && se[b - 1] > se[b]; b--) {
+                double t = se[b];
+                se[b] = se[b - 1];
+                se[b - 1] = t;
+            }
+        fprintf(f, " *   %-11s standard error: median %.4f, max %.4f\n", names[d],
+                m ? se[m / 2] : 0.0, m ? se[m - 1] : 0.0);
+    }
+    free(se);
+}
+
+static void print_header(FILE *f, const node_out *o, size_t ngrains)
+{
+    size_t usable = 0;
+    for (size_t n = 0; n < NNODES; n++)
+        usable += o[n].ok && star_fraction(&o[n], ngrains) >= GP_SHAPEMAP_STAR_MIN;
+    fprintf(f, "/* gp_shapemap_table.h -- GENERATED by tools/gen_shapemap_table.c: do not edit.\n"
+               " *\n"
+               " * The calibrated map of gp_shapemap.h: %zu x %zu x %zu nodes over (D2, D3, D8),\n"
+               " * alpha = beta = -2, Np = %d (Np / 2 modes); per node %zu random-phase grains\n"
+               " * (gp_rng streams (%u, g), g < %zu, the same at every node), described by\n"
+               " * gp_shape_describe_fourier with default ODEC parameters. %zu nodes usable\n"
+               " * (star-shaped fraction >= %.2f). Standard errors of the node means:\n",
+            (size_t)N2, (size_t)N3, (size_t)N8, NP, ngrains, SEED, ngrains, usable,
+            GP_SHAPEMAP_STAR_MIN);
+    print_errors(f, o, ngrains);
+    fprintf(f, " * Row of node (i, j, k) = (D2[i], D3[j], D8[k]) at index (i * N3 + j) * N8 + k:\n"
+               " * mean elongation, roundness, circularity, regularity; their sds; star fraction.\n"
+               " * Means of the star-shaped draws only (0 where fewer than 2 were).\n */\n"
+               "#ifndef GP_SHAPEMAP_TABLE_H\n#define GP_SHAPEMAP_TABLE_H\n\n");
+    fprintf(f, "#define GP_SHAPEMAP_TABLE_NP %d\n#define GP_SHAPEMAP_TABLE_NGRAINS %zu\n"
+               "#define GP_SHAPEMAP_TABLE_SEED %uu\n#define GP_SHAPEMAP_TABLE_N2 %zu\n"
+               "#define GP_SHAPEMAP_TABLE_N3 %zu\n#define GP_SHAPEMAP_TABLE_N8 %zu\n\n",
+            NP, ngrains, SEED, (size_t)N2, (size_t)N3, (size_t)N8);
+    print_axis(f, "d2", AX2, N2);
+    print_axis(f, "d3", AX3, N3);
+    print_axis(f, "d8", AX8, N8);
+}
+
+static void print_rows(FILE *f, const node_out *o, size_t ngrains)
+{
+    fprintf(f, "\nstatic const float gp_shapemap_table_rows[%zu][9] = {\n", (size_t)NNODES);
+    for (size_t n = 0; n < NNODES; n++) {
+        const gp_shapemap_stats *s = &o[n].st;
+        int ok = o[n].ok;
+        fprintf(f, "{%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.4f},\n",
+                ok ? s->mean[0] : 0.0, ok ? s->mean[1] : 0.0, ok ? s->mean[2] : 0.0,
+                ok ? s->mean[3] : 0.0, ok ? s->sd[0] : 0.0, ok ? s->sd[1] : 0.0,
+                ok ? s->sd[2] : 0.0, ok ? s->sd[3] : 0.0, star_fraction(&o[n], ngrains));
+    }
+    fprintf(f, "};\n\n#endif /* GP_SHAPEMAP_TABLE_H */\n");
+}
+
+static int parse(int argc, char **argv, int *threads, size_t *ngrains, const char **path)
+{
+    for (int a = 1; a < argc; a++) {
+        if (!strcmp(argv[a], "-t") && a + 1 < argc)
+            *threads = atoi(argv[++a]);
+        else if (!strcmp(argv[a], "-n") && a + 1 < argc)
+            *ngrains = (size_t)atol(argv[++a]);
+        else if (!strcmp(argv[a], "-o") && a + 1 < argc)
+            *path = argv[++a];
+        else
+            return 0;
+    }
+    return *threads >= 1 && *threads <= 64 && *ngrains >= 2;
+}
+
+int main(int argc, char **argv)
+{
+    int nthreads = 1;
+    size_t ngrains = NG_DEFAULT;
+    const char *path = NULL;
+    if (!parse(argc, argv, &nthreads, &ngrains, &path)) {
+        fprintf(stderr, "usage: gen_shapemap_table [-t threads] [-n grains] [-o file]\n");
+        return 2;
+    }
+    node_out *out = calloc(NNODES, sizeof *out);
+    worker *w = calloc((size_t)nthreads, sizeof *w);
+    if (!out || !w)
+        return 1;
+    for (int t = 0; t < nthreads; t++) {
+        w[t] = (worker){.index = t, .nthreads = nthreads, .ngrains = ngrains, .out = out};
+        pthread_create(&w[t].tid, NULL, work, &w[t]);
+    }
+    int failed = 0;
+    for (int t = 0; t < nthreads; t++) {
+        pthread_join(w[t].tid, NULL);
+        if (w[t].failed) {
+            fprintf(stderr, "thread %d: %s\n", t, w[t].err.message);
+            failed = 1;
+        }
+    }
+    FILE *f = path ? fopen(path, "w") : stdout;
+    if (failed || !f)
+        return 1;
+    print_header(f, out, ngrains);
+    print_rows(f, out, ngrains);
+    if (path)
+        fclose(f);
+    free(out);
+    free(w);
+    return 0;
+}
