@@ -55,6 +55,8 @@ void gp_svg_close(gp_svg *g)
     free(g->out.buf);
     free(g->mid.buf);
     free(g->tail.buf);
+    free(g->inset.kxy);
+    free(g->inset.kept);
     free(g);
 }
 

@@ -33,13 +33,34 @@
  *   where there is no target; "counts" is accepted in place of "achieved".)
  *   Missing (absent or null) stats histograms are recomputed from grains[] / cells[] where
  *   possible (descriptors from grains[].descriptors).
- *   The size view draws the CDFs of stats.fit (target law dashed, achieved solid, x in log
- *   scale when it spans more than a decade, one KS line per series, then the warnings); a
- *   result without them (stored before stats.fit) gets the histograms.
+ *   What each view draws (svg_stats2d.c, svg_views2d.c):
+ *   - size: the CDFs of stats.fit (target law dashed, achieved solid, cells and grains) on a
+ *     log-area axis in a unit whose labels read as whole numbers (mm² for most packings), KS
+ *     and its 5 % critical value in the legend, N, W1 and COV in a line under it, then the
+ *     warnings; for a sieve law also the grains' percent passing by mass (stats.fit.passing).
+ *     A result without stats.fit (stored before it) gets the histograms.
+ *   - orientation: a rose of the grains' directions (else the cells'), read from the items: as
+ *     many classes as N supports (36 of 5 degrees from N = 900, 18 of 10 from 450, ... 6 of
+ *     30: 25 directions a class), the target cosine law of stats.fit.<grain|cell>_orientation
+ *     and the achieved both as closed step outlines, in % per degree on labelled rings, KS in
+ *     the legend; without items, stats.orientation_histogram.
+ *   - descriptors: one histogram per descriptor from the grains, zoomed to the data, round
+ *     Freedman-Diaconis bins (8 to 40), the mean (dashed) and stats.descriptors.<name>.target
+ *     (red, when a number) marked, mean and sd in the panel's title.
+ *   - packing, cells: maps coloured by area (or orientation); more than 2,000 items add a
+ *     detail inset (default width then 1200 px): a square window of about 150 items where the
+ *     packing is full, drawn enlarged beside the map, its frame on the map.
+ *   Colour bars and axes have round ticks (1-2-5 x 10^k steps; 1, 2, 3, 5 x 10^k on a log
+ *   axis) whose labels keep apart; no two texts of a picture overlap.
  *
  * 3D result
  *   "spheres": [[x,y,z,r],...] (m)                                        (api.md)
  *   "box": [bx,by,bz] (m, the box of the (tiled) packing; optional: else the spheres' bounds)
+ *   "tiling": [nx,ny,nz] (optional; the mirror planes of the flip are every bz / nz)
+ *   The section cuts at ?z= (a 400 naming the valid range when outside the packing), by
+ *   default at mid-height of the middle base cell, the farthest a cut can be from the mirror
+ *   planes (svg_views3d.c: default_z); its title has z and the spheres cut, a subtitle the
+ *   porosity (stats and of the cut itself), D50, Cu and the PSD's largest error.
  *   "stats": {"porosity", "coordination_number", "fabric", "particles",   (api.md)
  *     "psd": {"diameters": [n] (m, the sieve diameters),
  *             "target_weight": [n], "achieved_weight": [n],
@@ -53,10 +74,10 @@
  * and contacts, see store_get_summary) -- and its geometry one item at a time from an item
  * source: the export pack (gp_svg_items_pack: 2D grains, 3D spheres), or an array of the
  * result text walked element by element (gp_svg_items_scan, server/json_scan.h), or an array in
- * memory (gp_svg_items_json). The statistics views (size, orientation, descriptors, psd) need
- * only the summary (they fall back to the grains or cells when a histogram is missing); the
- * geometry views (packing, cells, section) read their items in two or three passes (bounds and
- * colour range, then drawing). The SVG is handed out as a pull stream (gp_svg_open /
+ * memory (gp_svg_items_json). The size and psd views need only the summary; orientation and
+ * descriptors read the grains' numbers in one and three light passes (no contours: O(1)
+ * memory); the geometry views (packing, cells, section) read their items in two to four
+ * passes (bounds and colour range, then drawing, the cells' seeds, the inset). The SVG is handed out as a pull stream (gp_svg_open /
  * gp_svg_read), one item at a time, so memory is O(1) in the number of items: the summary, one
  * item, the sources' caches and a staging buffer of about 16 KiB.
  */

@@ -131,7 +131,9 @@ static int json_rewind(gp_svg_items *it)
 static int json_next(gp_svg_items *it)
 {
     if (it->idx >= json_array_size(it->arr)) return 0;
-    return svg_item_from_json(it->part, &it->cur, json_array_get(it->arr, it->idx++)) ? -1 : 1;
+    if (svg_item_from_json(it->part, &it->cur, json_array_get(it->arr, it->idx++))) return -1;
+    if (it->light) it->cur.npts = it->cur.nrings = 0; /* as the other sources give it */
+    return 1;
 }
 
 gp_svg_items *gp_svg_items_json(const json_t *array, gp_svg_part part)
@@ -328,7 +330,8 @@ static int pp_polygons(pp *q, svg_item *c)
     return r;
 }
 
-int svg_item_parse(gp_svg_part part, svg_item *c, const char *text, size_t len)
+/* the element's members into c; light: its points skipped */
+static int item_parse(gp_svg_part part, svg_item *c, const char *text, size_t len, int light)
 {
     item_clear(c);
     pp q = {text, text + len};
@@ -343,18 +346,28 @@ int svg_item_parse(gp_svg_part part, svg_item *c, const char *text, size_t len)
         else if (key_is(k, kl, "orientation_deg")) rc = pp_num(&q, &c->orientation_deg);
         else if (part == GP_SVG_GRAINS && key_is(k, kl, "contour")) {
             c->npts = 0;
-            rc = pp_ring(&q, c);
+            rc = light ? pp_skip(&q) : pp_ring(&q, c);
         } else if (part == GP_SVG_GRAINS && key_is(k, kl, "descriptors"))
             rc = pp_descriptors(&q, c);
         else if (part == GP_SVG_CELLS && key_is(k, kl, "seed"))
             rc = pp_nums(&q, c->seed, 2);
         else if (part == GP_SVG_CELLS && key_is(k, kl, "polygons"))
-            rc = pp_polygons(&q, c);
+            rc = light ? pp_skip(&q) : pp_polygons(&q, c);
         else
             rc = pp_skip(&q);
         if (rc) return -1;
     }
     return r;
+}
+
+int svg_item_parse(gp_svg_part part, svg_item *c, const char *text, size_t len)
+{
+    return item_parse(part, c, text, len, 0);
+}
+
+int svg_item_parse_light(gp_svg_part part, svg_item *c, const char *text, size_t len)
+{
+    return item_parse(part, c, text, len, 1);
 }
 
 /* ------------------------------------------------------------------ an array of a JSON text */
@@ -372,7 +385,7 @@ static int scan_next(gp_svg_items *it)
     if (r <= 0) return r;
     const char *t = js_span(it->js, a, b);
     if (!t) return -1;
-    return svg_item_parse(it->part, &it->cur, t, (size_t)(b - a)) ? -1 : 1;
+    return item_parse(it->part, &it->cur, t, (size_t)(b - a), it->light) ? -1 : 1;
 }
 
 gp_svg_items *gp_svg_items_scan(const js_source *text, uint64_t off, gp_svg_part part)
@@ -411,10 +424,13 @@ static int pack_next(gp_svg_items *it)
         return 1;
     }
     gp_xgrain g;
-    if (gp_xr_grain(e, k, &g) || pts_room(c, (size_t)g.point_count)) return -1;
-    for (uint64_t i = 0; i < g.point_count; i++)
-        if (gp_xr_point(it->ep, g.point_first + i, c->xy + 2 * i)) return -1;
-    c->npts = (size_t)g.point_count;
+    if (gp_xr_grain(e, k, &g)) return -1;
+    if (!it->light) {
+        if (pts_room(c, (size_t)g.point_count)) return -1;
+        for (uint64_t i = 0; i < g.point_count; i++)
+            if (gp_xr_point(it->ep, g.point_first + i, c->xy + 2 * i)) return -1;
+        c->npts = (size_t)g.point_count;
+    }
     c->area = g.area;
     c->orientation_deg = g.orientation_deg;
     c->desc[0] = g.elongation;
@@ -461,11 +477,25 @@ gp_svg_items *svg_open_items(const gp_svg_input *in, gp_svg_part part, int *fail
     return it;
 }
 
+gp_svg_items *svg_open_light(const gp_svg_input *in, gp_svg_part part, int *failed)
+{
+    gp_svg_items *it = svg_open_items(in, part, failed);
+    if (it) it->light = 1;
+    return it;
+}
+
+int svg_items_fold(gp_svg_items *it, void (*fn)(void *user, const svg_item *c), void *user)
+{
+    int r = it->rewind(it) ? -1 : 1;
+    while (r > 0 && (r = it->next(it)) > 0) fn(user, &it->cur);
+    return r < 0 ? -1 : 0;
+}
+
 double *svg_collect_items(const gp_svg_input *in, gp_svg_part part, int field, size_t *n,
                           int *failed)
 {
     *n = 0;
-    gp_svg_items *it = svg_open_items(in, part, failed);
+    gp_svg_items *it = svg_open_light(in, part, failed);
     if (!it) return NULL;
     size_t cap = 0;
     double *v = NULL;

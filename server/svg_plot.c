@@ -113,6 +113,145 @@ void fmt_label(char *buf, size_t n, double v)
     snprintf(buf, n, "%.4g", v);
 }
 
+/* "m×10ᵏ" (m left out when 1), the exponent in superscript digits */
+static void fmt_pow10(char *buf, size_t n, double v)
+{
+    static const char *const sup[10] = {"⁰", "¹", "²", "³", "⁴",
+                                        "⁵", "⁶", "⁷", "⁸", "⁹"};
+    int e = (int)floor(log10(fabs(v)) + 1e-9);
+    double m = v / pow(10, e);
+    char digits[16], out[96];
+    int k = 0;
+    if (fabs(fabs(m) - 1) > 1e-9) k = snprintf(out, sizeof out, "%.3g×", m);
+    else if (m < 0) out[k++] = '-', out[k] = 0;
+    k += snprintf(out + k, sizeof out - (size_t)k, "10%s", e < 0 ? "⁻" : "");
+    snprintf(digits, sizeof digits, "%d", abs(e));
+    for (const char *d = digits; *d && (size_t)k + 4 < sizeof out; d++)
+        k += snprintf(out + k, sizeof out - (size_t)k, "%s", sup[*d - '0']);
+    snprintf(buf, n, "%s", out);
+}
+
+void fmt_tick(char *buf, size_t n, double v, double step)
+{
+    step = fabs(step) > 0 ? fabs(step) : fabs(v);
+    if (fabs(v) < step * 1e-9 || v == 0) {
+        snprintf(buf, n, "0");
+        return;
+    }
+    if (fabs(v) < 1e-4 || fabs(v) >= 1e6) {
+        fmt_pow10(buf, n, v);
+        return;
+    }
+    /* decimals of the step: 0.002 -> 3, 0.5 -> 1, 20 -> 0 (1-2-5 steps need no more) */
+    int dec = (int)ceil(-log10(step) - 1e-9);
+    if (dec < 0) dec = 0;
+    if (dec > 12) dec = 12;
+    snprintf(buf, n, "%.*f", dec, v);
+}
+
+double text_w(const char *str)
+{
+    double w = 0;
+    for (const unsigned char *p = (const unsigned char *)str; *p; p++)
+        if ((*p & 0xC0) != 0x80) w += 7; /* one per character, not per UTF-8 byte */
+    return w;
+}
+
+/* ------------------------------------------------------------------ ticks */
+
+/* 1 when the labels of t, at positions pos[] px along the axis, keep apart */
+static int ticks_fit(const ticks *t, const double *pos, int horiz)
+{
+    double wprev = 0;
+    for (int i = 0; i < t->n; i++) {
+        char lab[64];
+        fmt_tick(lab, sizeof lab, t->v[i], t->step);
+        double w = text_w(lab);
+        if (i > 0) {
+            double need = horiz ? (w + wprev) / 2 + 6 : 16;
+            if (fabs(pos[i] - pos[i - 1]) < need) return 0;
+        }
+        wprev = w;
+    }
+    return 1;
+}
+
+void lin_ticks(double lo, double hi, double px, int horiz, int nmax, ticks *t)
+{
+    t->n = 0;
+    t->step = 0;
+    if (!isfinite(lo) || !isfinite(hi)) return;
+    if (!(hi > lo) || fabs(lo) / (hi - lo) > 1e12) { /* one value, or beyond doubles' steps */
+        t->v[t->n++] = lo;
+        if (hi > lo) t->v[t->n++] = hi;
+        return;
+    }
+    if (nmax < 1) nmax = 1;
+    double span = hi - lo, pos[TICKS_MAX];
+    int e0 = (int)floor(log10(span / (nmax + 1)));
+    static const double mant[3] = {1, 2, 5};
+    for (int e = e0; e <= e0 + 3; e++)
+        for (int i = 0; i < 3; i++) {
+            double st = mant[i] * pow(10, e);
+            double a = ceil(lo / st - 1e-9), b = floor(hi / st + 1e-9);
+            if (b - a + 1 > nmax + 1 || b - a + 1 > TICKS_MAX || b < a) continue;
+            t->n = 0;
+            t->step = st;
+            for (double k = a; k <= b; k++) {
+                t->v[t->n] = k * st;
+                pos[t->n] = (k * st - lo) / span * px;
+                t->n++;
+            }
+            if (ticks_fit(t, pos, horiz) || t->n <= 1) return;
+        }
+}
+
+void log_ticks(double lo, double hi, double px, int horiz, ticks *t)
+{
+    static const int sets[4][10] = {
+        {1, 2, 3, 4, 5, 6, 7, 8, 9, 0}, {1, 2, 3, 5, 0}, {1, 2, 5, 0}, {1, 0}};
+    static const int stride[9] = {1, 1, 1, 1, 2, 3, 5, 10, 20};
+    t->n = 0;
+    t->step = 0;
+    if (!(lo > 0) || !(hi > lo) || !isfinite(hi)) {
+        lin_ticks(lo, hi, px, horiz, 5, t);
+        return;
+    }
+    int d0 = (int)floor(log10(lo) + 1e-9), d1 = (int)ceil(log10(hi) - 1e-9);
+    double L = log10(hi / lo), pos[TICKS_MAX];
+    for (int c = 0; c < 9; c++) {
+        const int *m = sets[c < 3 ? c : 3];
+        t->n = 0;
+        for (int d = d0; d <= d1 && t->n < TICKS_MAX; d++) {
+            if (((d % stride[c]) + stride[c]) % stride[c]) continue;
+            for (int i = 0; m[i] && t->n < TICKS_MAX; i++) {
+                double v = m[i] * pow(10, d);
+                if (v < lo * (1 - 1e-9) || v > hi * (1 + 1e-9)) continue;
+                pos[t->n] = log10(v / lo) / L * px;
+                t->v[t->n++] = v;
+            }
+        }
+        if (c == 0 && t->n < 2) break; /* less than two round values: linear ones */
+        if (t->n >= 2 && ticks_fit(t, pos, horiz)) return;
+        if (t->n < 2) break; /* sparser sets only lose more: linear ones */
+    }
+    lin_ticks(lo, hi, px, horiz, 4, t);
+}
+
+const char *area_unit(double hi, double *factor)
+{
+    if (!(hi < 0.1)) {
+        *factor = 1;
+        return "m²";
+    }
+    if (hi >= 1e-7) {
+        *factor = 1e6;
+        return "mm²";
+    }
+    *factor = 1e12;
+    return "µm²";
+}
+
 /* viridis-like colour ramp, t in [0, 1] */
 void ramp(double t, char *buf, size_t n)
 {
@@ -190,7 +329,68 @@ double fy(const frame *f, double y)
     return f->y0 + f->h - (y - f->ymin) / (f->ymax - f->ymin) * f->h;
 }
 
-/* axes with ticks and labels; grid lines when grid */
+/* a grid line across the frame at x (vertical) or y */
+static void grid_line(sb *s, const frame *f, double at, int vertical)
+{
+    if (vertical)
+        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n", at,
+                  f->y0, at, f->y0 + f->h);
+    else
+        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n",
+                  f->x0, at, f->x0 + f->w, at);
+}
+
+/* the x axis' ticks: round values labelled (ticks.h), on a log axis the other m x 10^k as
+ * short unlabelled ticks where a decade is wide enough to show them */
+static void x_ticks(sb *s, const frame *f, int grid)
+{
+    ticks t;
+    if (f->xlog) log_ticks(f->xmin, f->xmax, f->w, 1, &t);
+    else lin_ticks(f->xmin, f->xmax, f->w, 1, 7, &t);
+    double yb = f->y0 + f->h;
+    if (f->xlog && f->w / log10(f->xmax / f->xmin) >= 40) {
+        int d0 = (int)floor(log10(f->xmin)), d1 = (int)ceil(log10(f->xmax));
+        for (int d = d0; d <= d1; d++)
+            for (int m = 1; m <= 9; m++) {
+                double v = m * pow(10, d);
+                if (v < f->xmin * (1 - 1e-9) || v > f->xmax * (1 + 1e-9)) continue;
+                double x = fx(f, v);
+                sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", x, yb,
+                          x, yb + 3);
+            }
+    }
+    for (int i = 0; i < t.n; i++) {
+        double x = fx(f, t.v[i]);
+        char lab[64];
+        if (grid) grid_line(s, f, x, 1);
+        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", x, yb, x,
+                  yb + 6);
+        fmt_tick(lab, sizeof lab, t.v[i], t.step);
+        text_at(s, x, yb + 19, "middle", "class=\"xtick\" stroke=\"none\"", lab);
+    }
+}
+
+/* the y axis' ticks; returns the width of the widest label */
+static double y_ticks(sb *s, const frame *f, int grid)
+{
+    ticks t;
+    lin_ticks(f->ymin, f->ymax, f->h, 0, 6, &t);
+    double wmax = 0;
+    for (int i = 0; i < t.n; i++) {
+        double y = fy(f, t.v[i]);
+        char lab[64];
+        if (grid) grid_line(s, f, y, 0);
+        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0 - 6, y,
+                  f->x0, y);
+        fmt_tick(lab, sizeof lab, t.v[i], t.step);
+        wmax = fmax(wmax, text_w(lab));
+        text_at(s, f->x0 - 9, y + 4, "end", "class=\"ytick\" stroke=\"none\"", lab);
+    }
+    return wmax;
+}
+
+/* axes with ticks and labels; grid lines when grid. The y label stands clear of the widest
+ * tick label. */
 void axes(sb *s, const frame *f, const char *xlabel, const char *ylabel, int grid)
 {
     sb_puts(s, "<g class=\"axes\" stroke=\"#000000\" stroke-width=\"1\">\n");
@@ -199,76 +399,57 @@ void axes(sb *s, const frame *f, const char *xlabel, const char *ylabel, int gri
     sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0, f->y0, f->x0,
               f->y0 + f->h);
     sb_puts(s, "</g>\n<g class=\"ticks\" stroke=\"#000000\">\n");
-    char lab[64];
-    /* x ticks */
-    if (f->xlog) {
-        int d0 = (int)floor(log10(f->xmin) + 1e-9), d1 = (int)ceil(log10(f->xmax) - 1e-9);
-        for (int d = d0; d <= d1; d++)
-            for (int m = 1; m <= 9; m++) {
-                double v = m * pow(10, d);
-                if (v < f->xmin * (1 - 1e-9) || v > f->xmax * (1 + 1e-9)) continue;
-                double x = fx(f, v);
-                int major = m == 1, labelled = m == 1 || m == 2 || m == 5;
-                if (grid && major)
-                    sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n",
-                              x, f->y0, x, f->y0 + f->h);
-                sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", x,
-                          f->y0 + f->h, x, f->y0 + f->h + (major ? 6 : 3));
-                if (labelled) {
-                    fmt_label(lab, sizeof lab, v);
-                    text_at(s, x, f->y0 + f->h + 19, "middle", "stroke=\"none\"", lab);
-                }
-            }
-    } else {
-        double st = nice_step(f->xmin, f->xmax, 6);
-        for (double v = ceil(f->xmin / st - 1e-9) * st; v <= f->xmax + st * 1e-9; v += st) {
-            double x = fx(f, v);
-            if (grid)
-                sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n",
-                          x, f->y0, x, f->y0 + f->h);
-            sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", x,
-                      f->y0 + f->h, x, f->y0 + f->h + 6);
-            fmt_label(lab, sizeof lab, v);
-            text_at(s, x, f->y0 + f->h + 19, "middle", "stroke=\"none\"", lab);
-        }
-    }
-    /* y ticks */
-    double st = nice_step(f->ymin, f->ymax, 5);
-    for (double v = ceil(f->ymin / st - 1e-9) * st; v <= f->ymax + st * 1e-9; v += st) {
-        double y = fy(f, v);
-        if (grid)
-            sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n",
-                      f->x0, y, f->x0 + f->w, y);
-        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0 - 6, y,
-                  f->x0, y);
-        fmt_label(lab, sizeof lab, v);
-        text_at(s, f->x0 - 9, y + 4, "end", "stroke=\"none\"", lab);
-    }
+    x_ticks(s, f, grid);
+    double wy = y_ticks(s, f, grid);
     sb_puts(s, "</g>\n");
     text_at(s, f->x0 + f->w / 2, f->y0 + f->h + 38, "middle", NULL, xlabel);
-    text_up(s, f->x0 - 52, f->y0 + f->h / 2, ylabel);
+    text_up(s, f->x0 - 9 - wy - 10, f->y0 + f->h / 2, ylabel);
+}
+
+/* a legend item's symbol, 22 px wide from x, for a label on baseline yy */
+static void legend_symbol(sb *s, double x, double yy, const legend_item *it)
+{
+    if (!strcmp(it->style, "bar"))
+        sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"22\" height=\"10\" fill=\"%s\" "
+                     "fill-opacity=\"0.7\" stroke=\"%s\"/>\n",
+                  x, yy - 9, it->color, it->color);
+    else
+        sb_printf(s, "<path d=\"M%.1f %.1fh22\" stroke=\"%s\" stroke-width=\"2\"%s/>\n", x, yy - 4,
+                  it->color, !strcmp(it->style, "dash") ? " stroke-dasharray=\"5 3\"" : "");
+    if (!strcmp(it->style, "marker"))
+        sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"6\" height=\"6\" fill=\"%s\"/>\n", x + 8,
+                  yy - 7, it->color);
+}
+
+double legend_row(sb *s, double x, double y, const legend_item *it, int n)
+{
+    double x0 = x;
+    sb_puts(s, "<g class=\"legend\">\n");
+    for (int i = 0; i < n; i++) {
+        legend_symbol(s, x, y, &it[i]);
+        text_at(s, x + 28, y, "start", NULL, it[i].label);
+        x += 28 + text_w(it[i].label) + 20;
+    }
+    sb_puts(s, "</g>\n");
+    return x - x0 - 20;
+}
+
+double legend_w(const legend_item *it, int n)
+{
+    double w = 0;
+    for (int i = 0; i < n; i++) w = fmax(w, text_w(it[i].label));
+    return w + 46;
 }
 
 void legend(sb *s, double x, double y, const legend_item *it, int n)
 {
-    double w = 0;
-    for (int i = 0; i < n; i++) w = fmax(w, 7.0 * strlen(it[i].label));
+    double w = legend_w(it, n) - 46;
     sb_printf(s, "<g class=\"legend\">\n<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" "
                  "fill=\"#ffffff\" fill-opacity=\"0.85\" stroke=\"#999999\"/>\n",
               x, y, w + 46, 8 + 18 * n);
     for (int i = 0; i < n; i++) {
         double yy = y + 16 + 18 * i;
-        if (!strcmp(it[i].style, "bar"))
-            sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"22\" height=\"10\" fill=\"%s\" "
-                         "fill-opacity=\"0.7\" stroke=\"%s\"/>\n",
-                      x + 8, yy - 9, it[i].color, it[i].color);
-        else
-            sb_printf(s, "<path d=\"M%.1f %.1fh22\" stroke=\"%s\" stroke-width=\"2\"%s/>\n", x + 8,
-                      yy - 4, it[i].color,
-                      !strcmp(it[i].style, "dash") ? " stroke-dasharray=\"5 3\"" : "");
-        if (!strcmp(it[i].style, "marker"))
-            sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"6\" height=\"6\" fill=\"%s\"/>\n",
-                      x + 16, yy - 7, it[i].color);
+        legend_symbol(s, x + 8, yy, &it[i]);
         text_at(s, x + 38, yy, "start", NULL, it[i].label);
     }
     sb_puts(s, "</g>\n");
@@ -280,7 +461,20 @@ void marker(sb *s, double x, double y, const char *color)
     sb_printf(s, "<path d=\"M%.1f %.1fh6v6h-6z\" fill=\"%s\"/>\n", x - 3, y - 3, color);
 }
 
-/* vertical colour bar with a gradient; cyc = orientation colours */
+/* the colour bar's ticks: every 45 degrees for orientations, else round values */
+static void colorbar_ticks(double lo, double hi, double h, int cyc, int logscale, ticks *t)
+{
+    if (cyc) {
+        t->n = 5;
+        t->step = 45;
+        for (int k = 0; k < 5; k++) t->v[k] = -90 + 45 * k;
+    } else if (logscale && lo > 0) {
+        log_ticks(lo, hi, h, 0, t);
+    } else {
+        lin_ticks(lo, hi, h, 0, 6, t);
+    }
+}
+
 void colorbar(sb *s, double x, double y, double h, double lo, double hi, int cyc,
                      int logscale, const char *label)
 {
@@ -294,17 +488,22 @@ void colorbar(sb *s, double x, double y, double h, double lo, double hi, int cyc
     sb_puts(s, "</linearGradient></defs>\n");
     sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"16\" height=\"%.1f\" fill=\"url(#cbar)\" stroke=\"#000000\"/>\n",
               x, y, h);
-    for (int k = 0; k <= 4; k++) {
-        double t = k / 4.0;
-        double v = logscale ? lo * pow(hi / lo, t) : lo + t * (hi - lo);
+    if (cyc) lo = -90, hi = 90;
+    ticks t;
+    colorbar_ticks(lo, hi, h, cyc, logscale, &t);
+    int lg = logscale && !cyc && lo > 0;
+    double wmax = 0;
+    for (int k = 0; k < t.n; k++) {
+        double u = !(hi > lo) ? 0.5 : lg ? log(t.v[k] / lo) / log(hi / lo) : (t.v[k] - lo) / (hi - lo);
+        double yy = y + h - u * h;
         char lab[64];
-        fmt_label(lab, sizeof lab, v);
-        double yy = y + h - t * h;
-        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#000000\"/>\n",
-                  x + 16, yy, x + 20, yy);
-        text_at(s, x + 23, yy + 4, "start", NULL, lab);
+        fmt_tick(lab, sizeof lab, t.v[k], t.step);
+        sb_printf(s, "<line class=\"cbar-tick\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#000000\"/>\n",
+                  x + 16, yy, x + 21, yy);
+        text_at(s, x + 25, yy + 4, "start", "class=\"cbar-label\"", lab);
+        wmax = fmax(wmax, text_w(lab));
     }
-    text_up(s, x + 82, y + h / 2, label);
+    text_up(s, x + 25 + wmax + 14, y + h / 2, label);
 }
 
 /* ------------------------------------------------------------------ maps */
@@ -315,18 +514,29 @@ void bounds_init(bounds *b)
     b->xmax = b->ymax = -INFINITY;
 }
 
+/* (comparisons, not fmin/fmax: these see every point of every pass, and the finite test
+ * already keeps NaN out) */
 void bounds_add(bounds *b, double x, double y)
 {
     if (!isfinite(x) || !isfinite(y)) return;
-    b->xmin = fmin(b->xmin, x);
-    b->xmax = fmax(b->xmax, x);
-    b->ymin = fmin(b->ymin, y);
-    b->ymax = fmax(b->ymax, y);
+    if (x < b->xmin) b->xmin = x;
+    if (x > b->xmax) b->xmax = x;
+    if (y < b->ymin) b->ymin = y;
+    if (y > b->ymax) b->ymax = y;
 }
 
 void bounds_xy(bounds *b, const double *xy, size_t n)
 {
-    for (size_t i = 0; i < n; i++) bounds_add(b, xy[2 * i], xy[2 * i + 1]);
+    bounds r = *b;
+    for (size_t i = 0; i < n; i++) {
+        double x = xy[2 * i], y = xy[2 * i + 1];
+        if (!isfinite(x) || !isfinite(y)) continue;
+        if (x < r.xmin) r.xmin = x;
+        if (x > r.xmax) r.xmax = x;
+        if (y < r.ymin) r.ymin = y;
+        if (y > r.ymax) r.ymax = y;
+    }
+    *b = r;
 }
 
 int bounds_ok(const bounds *b) { return b->xmax >= b->xmin && b->ymax >= b->ymin; }
@@ -362,6 +572,17 @@ frame map_frame(bounds b, int width, int *height)
     f.ymax = cy + f.h / sc / 2;
     f.xlog = 0;
     *height = (int)ceil(f.y0 + f.h + 60);
+    return f;
+}
+
+frame map_frame_in(bounds b, double x0, double y0, double w, double hmax)
+{
+    double dx = b.xmax - b.xmin, dy = b.ymax - b.ymin;
+    if (!(dx > 0)) dx = dy > 0 ? dy : 1;
+    if (!(dy > 0)) dy = dx;
+    double sc = fmin(w / dx, hmax / dy);
+    double cx = (b.xmin + b.xmax) / 2, cy = (b.ymin + b.ymax) / 2;
+    frame f = {x0, y0, dx * sc, dy * sc, cx - dx / 2, cx + dx / 2, cy - dy / 2, cy + dy / 2, 0};
     return f;
 }
 

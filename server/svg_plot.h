@@ -4,7 +4,7 @@
  * Conventions: pixel coordinates printed with one or two decimals (bounded output), y axis of
  * data flipped so that up is up, legends and colour bars drawn with <rect>/<line>/<path> only
  * so that the <polygon> / <circle> elements of a picture are exactly its grains, cells, seeds
- * or sphere sections. Everything writes into an sb (util.h's gpd_buf): a failed allocation is
+ * or sphere sections (a detail inset redraws some of them as <path>s). Everything writes into an sb (util.h's gpd_buf): a failed allocation is
  * seen once, at the end, in its oom flag. */
 #ifndef GPD_SVG_PLOT_H
 #define GPD_SVG_PLOT_H
@@ -38,6 +38,33 @@ void doc_end(sb *s);
 int fmt_f1(char *buf, double v);
 /* "%.4g", with a tiny value printed as 0 */
 void fmt_label(char *buf, size_t n, double v);
+/* a tick value as a reader wants it: fixed decimals enough for step (the spacing of the ticks;
+ * 0 = v's own), "2×10⁻⁵" outside 1e-4..1e6 */
+void fmt_tick(char *buf, size_t n, double v, double step);
+/* the width in px of a text at 12 px (7 px a character: Helvetica's digits are 6.7) */
+double text_w(const char *str);
+
+/* ---- ticks: round values whose labels do not collide ---- */
+
+#define TICKS_MAX 64
+typedef struct ticks {
+    int n;
+    double v[TICKS_MAX];
+    double step; /* linear ticks: their spacing; log ticks: 0 */
+} ticks;
+
+/* Round ticks over [lo, hi] drawn along px pixels: multiples of a 1-2-5 x 10^k step, at most
+ * nmax + 1 of them, the smallest step whose labels keep apart (horiz: their widths plus 6 px;
+ * vertical: 16 px, the 12 px font and a gap). */
+void lin_ticks(double lo, double hi, double px, int horiz, int nmax, ticks *t);
+/* Ticks of a log axis over [lo, hi] (lo > 0): m x 10^k for the densest of the mantissa sets
+ * {1..9}, {1, 2, 3, 5}, {1, 2, 5}, {1} (then every 2nd, 3rd, 5th, 10th decade) whose labels keep apart as
+ * lin_ticks'; a range too short for two of them gets lin_ticks. */
+void log_ticks(double lo, double hi, double px, int horiz, ticks *t);
+
+/* The unit of an area axis whose largest value is hi m²: the factor from m² and its name, so
+ * that the labels read 1 to 10,000 rather than 0.0001 (m², cm², mm², µm²). */
+const char *area_unit(double hi, double *factor);
 
 /* ---- colours ---- */
 
@@ -75,9 +102,15 @@ typedef struct legend_item {
 } legend_item;
 
 void legend(sb *s, double x, double y, const legend_item *it, int n);
+/* the same in one row from x (no box), centred on baseline y; returns its width */
+double legend_row(sb *s, double x, double y, const legend_item *it, int n);
+/* the width of legend()'s box for these items */
+double legend_w(const legend_item *it, int n);
 /* a marker as a small square path (not a <circle>, see the conventions above) */
 void marker(sb *s, double x, double y, const char *color);
-/* vertical colour bar with a gradient; cyc = orientation colours */
+/* vertical colour bar with a gradient at (x, y), h px tall, of the values lo..hi (cyc: the
+ * orientation colours, -90..90 degrees, ticks every 45); round ticks (lin_ticks, log_ticks)
+ * labelled to their right ("cbar-tick", "cbar-label"), the label turned beside them */
 void colorbar(sb *s, double x, double y, double h, double lo, double hi, int cyc, int logscale,
               const char *label);
 
@@ -95,6 +128,8 @@ int bounds_ok(const bounds *b);
 /* a map frame with equal scales on both axes, fitting width px (room for a colour bar on the
  * right); the picture's height in *height */
 frame map_frame(bounds b, int width, int *height);
+/* a frame at (x0, y0) of b with equal scales, as large as fits in w by hmax px */
+frame map_frame_in(bounds b, double x0, double y0, double w, double hmax);
 /* "x,y x,y ..." of a ring of n points (xy: x0 y0 x1 y1 ...), decimated to min_px (a point
  * within min_px of the last one written, in both directions, is dropped, but a ring keeps at
  * least 3 points); returns points written */
@@ -129,7 +164,7 @@ typedef struct cdf_series {
     const char *law;
     double *x, *target, *achieved; /* n points, x increasing */
     size_t n;
-    double ks, ks_critical, w1, cov, target_cov;
+    double ks, ks_critical, w1, cov, target_cov, count;
 } cdf_series;
 
 void cdf_free(cdf_series *c);

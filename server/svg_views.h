@@ -5,7 +5,7 @@
 
 #include "svg.h"
 
-/* the 2D kind (svg_views2d.c) */
+/* the 2D kind (maps: svg_views2d.c; statistics: svg_stats2d.c) */
 int svg_view_packing(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                      gpd_err *err);
 int svg_view_cells(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,

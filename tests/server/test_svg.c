@@ -1,6 +1,14 @@
 /* test_svg.c -- the SVG views of a hand-made 2D and 3D result: well-formed XML, one
- * <polygon>/<circle> per grain, cell part, seed or cut sphere, axes and labels, errors for
- * unknown views and missing parts, and a 10,000-grain packing drawn compactly.
+ * <polygon>/<circle> per grain, cell part, seed or cut sphere, axes and labels, no two texts
+ * overlapping (every picture drawn here), errors for unknown views and missing parts, and a
+ * 10,000-grain packing drawn compactly.
+ * Geometry against the tests' own truth: the rose's classes (18 at Mollon & Zhao's 500 grains)
+ * and its achieved and target radii recomputed from the test's directions and a numerical
+ * integral of the cosine law; colour-bar ticks round (1-2-5 steps) and 12 px apart; the
+ * section's default z half a base cell from every mirror plane of a tiled result, its title's
+ * cut count, porosity of the cut and D50/Cu; the detail inset's window (central on a uniform
+ * packing, where the grains are on a half-empty one) and the grains drawn in it; the
+ * descriptor histograms' Freedman-Diaconis bins, bar heights, mean and target.
  * The size view from stats.fit (CDF curves, KS lines, warnings), and stats.fit / warnings as
  * server/result_json.c writes them from a specimen, drawn by the size view.
  * Compact reading (what GET /svg does): server/json_scan.c (member spans, array walks, the
@@ -138,6 +146,94 @@ static char *render(const json_t *r, const char *kind, const char *view, const g
     return s;
 }
 
+/* ---- reading a picture back: attributes, <text> boxes ---- */
+
+/* the number of attribute attr (e.g. "x") of the element that starts at el; NAN without it */
+static double attr_num(const char *el, const char *attr)
+{
+    const char *end = strchr(el, '>');
+    char key[48];
+    snprintf(key, sizeof key, " %s=\"", attr);
+    const char *p = strstr(el, key);
+    if (!p || (end && p > end)) return NAN;
+    return strtod(p + strlen(key), NULL);
+}
+
+/* the content of the <text> element that starts at el, entities and tags kept, into buf */
+static void text_of(const char *el, char *buf, size_t n)
+{
+    const char *a = strchr(el, '>'), *b = a ? strstr(a, "</text>") : NULL;
+    size_t k = a && b ? (size_t)(b - a - 1) : 0;
+    if (k >= n) k = n - 1;
+    memcpy(buf, a ? a + 1 : "", k);
+    buf[k] = 0;
+}
+
+/* characters of a text as drawn: UTF-8 characters, an entity as one */
+static double text_chars(const char *t)
+{
+    double n = 0;
+    for (const unsigned char *p = (const unsigned char *)t; *p; p++) {
+        if (*p == '&') {
+            while (p[1] && *p != ';') p++;
+        } else if ((*p & 0xC0) == 0x80) {
+            continue;
+        }
+        n++;
+    }
+    return n;
+}
+
+typedef struct tbox {
+    double x0, y0, x1, y1;
+    char s[128];
+} tbox;
+
+/* the box of every <text>: 0.55 em a character (Helvetica's average; digits 0.56), from 0.75
+ * em above the baseline to 0.2 em below; anchors and a -90 rotation taken into account */
+static size_t text_boxes(const char *svg, tbox *b, size_t max)
+{
+    size_t n = 0;
+    for (const char *p = strstr(svg, "<text "); p && n < max; p = strstr(p + 1, "<text ")) {
+        double x = attr_num(p, "x"), y = attr_num(p, "y"), fs = attr_num(p, "font-size");
+        if (isnan(fs)) fs = 12;
+        text_of(p, b[n].s, sizeof b[n].s);
+        double w = 0.55 * fs * text_chars(b[n].s), lo = x;
+        const char *end = strchr(p, '>');
+        const char *anc = strstr(p, "text-anchor=\"");
+        if (anc && anc < end && !strncmp(anc + 13, "middle", 6)) lo = x - w / 2;
+        else if (anc && anc < end && !strncmp(anc + 13, "end", 3)) lo = x - w;
+        const char *rot = strstr(p, "rotate(-90");
+        if (rot && rot < end) /* along -y from the anchor, glyphs towards -x */
+            b[n] = (tbox){x - 0.75 * fs, y - (lo - x) - w, x + 0.2 * fs, y - (lo - x), ""},
+            text_of(p, b[n].s, sizeof b[n].s);
+        else
+            b[n].x0 = lo, b[n].x1 = lo + w, b[n].y0 = y - 0.75 * fs, b[n].y1 = y + 0.2 * fs;
+        n++;
+    }
+    return n;
+}
+
+/* no two texts of the picture overlap (by more than half a pixel each way) */
+static int texts_apart(const char *svg)
+{
+    enum { MAXT = 4000 };
+    tbox *b = malloc(MAXT * sizeof *b);
+    size_t n = text_boxes(svg, b, MAXT);
+    int ok = 1;
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = i + 1; j < n; j++) {
+            double ox = fmin(b[i].x1, b[j].x1) - fmax(b[i].x0, b[j].x0);
+            double oy = fmin(b[i].y1, b[j].y1) - fmax(b[i].y0, b[j].y0);
+            if (ox > 0.5 && oy > 0.5) {
+                fprintf(stderr, "texts overlap: \"%s\" and \"%s\"\n", b[i].s, b[j].s);
+                ok = 0;
+            }
+        }
+    free(b);
+    return ok;
+}
+
 static void check_common(const char *svg, size_t len)
 {
     CHECK(svg != NULL);
@@ -150,6 +246,7 @@ static void check_common(const char *svg, size_t len)
     CHECK(count(svg, "<text") >= 3);
     CHECK(well_formed(svg, len));
     CHECK(strstr(svg, "nan") == NULL && strstr(svg, "inf") == NULL);
+    CHECK(texts_apart(svg));
 }
 
 /* a result from its text (NULL, counted as a failed check, when it is not JSON) */
@@ -407,12 +504,15 @@ static void test_size_fit(void)
     CHECK(count(s, "stroke-dasharray=\"6 4\"") == 2);
     /* the legend and the KS lines, the grains' one marked as over its critical value */
     CHECK(strstr(s, "cells: target (lognormal)") && strstr(s, "grains: achieved"));
-    CHECK(strstr(s, "cells: KS 0.021 (5 % critical 0.061)") != NULL);
-    CHECK(strstr(s, "grains: KS 0.09 (5 % critical 0.061)") != NULL);
+    CHECK(strstr(s, "cells: achieved, KS 0.021 (5 % critical 0.061)") != NULL);
+    CHECK(strstr(s, "grains: achieved, KS 0.09 (5 % critical 0.061)") != NULL);
     CHECK(count(s, "ks-over") == 1);
+    CHECK(strstr(s, "KS 0.09 is above its 5 % critical value 0.061") != NULL);
+    CHECK(strstr(s, "cells: N 500, W1 0.012, COV 0.79 (target 0.8)") != NULL);
     CHECK(strstr(s, "COV 0.79 (target 0.8)") != NULL);
     /* log axis: the areas span more than a decade */
-    CHECK(strstr(s, "area (m², log scale)") != NULL);
+    CHECK(strstr(s, "area (mm², log scale)") != NULL); /* 0.5 to 20,000 mm², not 5e-4 m² */
+    CHECK(strstr(s, ">1000<") && strstr(s, ">10000<") && !strstr(s, "e-0"));
     /* the warnings, the long one wrapped */
     CHECK(strstr(s, "IMC stopped at max_steps: error 0.31 &gt; threshold 0.05") != NULL);
     CHECK(count(s, "class=\"warning\"") >= 3);
@@ -427,9 +527,10 @@ static void test_size_fit(void)
     json_object_set_new(json_object_get(st, "fit"), "cell_area", fit_block(1e-3, 4e-3, 30, 0.021, 0.061, 1));
     s = render(r, NULL, "size", NULL, &len, &status, err);
     check_common(s, len);
-    CHECK(s && !strstr(s, "class=\"warning\"") && !strstr(s, "log scale"));
+    CHECK(s && !strstr(s, "class=\"warning\"") && strstr(s, "log scale")); /* less than a decade */
+    CHECK(s && strstr(s, ">1000<") && strstr(s, ">2000<") && strstr(s, ">3000<"));
     CHECK(s && strstr(s, "class=\"cdf-achieved cells\"") && !strstr(s, "grains"));
-    CHECK(s && strstr(s, "cells: KS 0.021 (5 % critical 0.061)") && !strstr(s, "ks-over"));
+    CHECK(s && strstr(s, "cells: achieved, KS 0.021 (5 % critical 0.061)") && !strstr(s, "ks-over"));
     free(s);
 
     /* a fit without its curves (or none at all, an old result): the histograms */
@@ -518,7 +619,7 @@ static void test_result_fit(void)
     char *svg = render(r, NULL, "size", NULL, &len, &status, err);
     check_common(svg, len);
     CHECK(svg && strstr(svg, "class=\"cdf-target cells\"") && strstr(svg, "class=\"cdf-achieved cells\""));
-    CHECK(svg && strstr(svg, "cells: KS 0.021 (5 % critical 0.061)") && !strstr(svg, "grains"));
+    CHECK(svg && strstr(svg, "cells: achieved, KS 0.021 (5 % critical 0.061)") && !strstr(svg, "grains"));
     CHECK(svg && strstr(svg, "error 0.31 &gt; threshold 0.05"));
     free(svg);
     json_decref(r);
@@ -538,6 +639,511 @@ static void test_result_fit(void)
     CHECK(json_is_array(json_object_get(r, "warnings")) && json_array_size(json_object_get(r, "warnings")) == 0);
     json_decref(r);
     json_decref(sj);
+}
+
+/* ---------------------------------------------------------------- the orientation rose */
+
+/* a fixed generator for the tests' data: uniform in [0, 1) */
+static double lcg(unsigned *x)
+{
+    *x = *x * 1103515245u + 12345u;
+    return ((*x >> 8) & 0xFFFFFF) / 16777216.0;
+}
+
+/* the cosine law of api.md (any scale) */
+static double cos_law(double t, double mean, double a)
+{
+    return (1 + a) / 2 + (1 - a) / 2 * cos(2 * (t - mean) * M_PI / 180);
+}
+
+/* its probability between t0 and t1 degrees, by Simpson's rule (not the view's closed form) */
+static double cos_prob(double t0, double t1, double mean, double a)
+{
+    double in[2] = {0, 0}, lim[2][2] = {{t0, t1}, {-90, 90}};
+    for (int k = 0; k < 2; k++) {
+        int m = 400;
+        double h = (lim[k][1] - lim[k][0]) / m;
+        for (int i = 0; i <= m; i++)
+            in[k] += (i == 0 || i == m ? 1 : i % 2 ? 4 : 2) * cos_law(lim[k][0] + i * h, mean, a);
+        in[k] *= h / 3;
+    }
+    return in[0] / in[1];
+}
+
+/* n grains whose directions follow the law (rejection sampling), with their fit block */
+static json_t *rose_result(int n, double mean, double a)
+{
+    json_t *grains = json_array();
+    unsigned x = 11;
+    for (int i = 0; i < n; i++) {
+        double t;
+        do t = lcg(&x) * 180 - 90;
+        while (lcg(&x) > cos_law(t, mean, a));
+        json_array_append_new(grains, json_pack("{s:f, s:f}", "orientation_deg", t, "area", 1.0));
+    }
+    json_t *fit = json_pack("{s:{s:{s:f, s:f}, s:f, s:f, s:i}}", "grain_orientation", "target",
+                            "mean_deg", mean, "anisotropy", a, "ks", 0.03, "ks_critical",
+                            1.36 / sqrt(n), "n", n);
+    return json_pack("{s:s, s:o, s:{s:o}}", "kind", KIND_2D, "grains", grains, "stats", "fit", fit);
+}
+
+/* the radii of the arcs of the path of class cls; their count */
+static int arc_radii(const char *svg, const char *cls, double *r, int max)
+{
+    const char *d = path_d(svg, cls);
+    if (!d) return 0;
+    const char *end = strchr(d + 4, '"');
+    int n = 0;
+    for (const char *q = strchr(d + 4, 'A'); q && q < end && n < max; q = strchr(q + 1, 'A'))
+        r[n++] = strtod(q + 1, NULL);
+    return n;
+}
+
+/* px per unit of density: each ring's radius over its label's value, the same for all */
+static double ring_scale(const char *svg, int *rings)
+{
+    double scale = NAN;
+    *rings = 0;
+    const char *p = strstr(svg, "class=\"ring\""), *l = strstr(svg, "class=\"ring-label\"");
+    for (; p && l; p = strstr(p + 1, "class=\"ring\""), l = strstr(l + 1, "class=\"ring-label\"")) {
+        double cx, cy, pr;
+        char lab[32];
+        CHECK(sscanf(strstr(p, " d=\"") + 4, "M%lf %lfa%lf", &cx, &cy, &pr) == 3);
+        text_of(l, lab, sizeof lab);
+        double v = strtod(lab, NULL), sc = pr / v;
+        if (*rings) CHECK_NEAR(sc, scale, 0.02 * (1 + scale) / v);
+        else scale = sc;
+        (*rings)++;
+    }
+    return scale;
+}
+
+static void check_rose(int n, double mean, double a, int classes)
+{
+    json_t *r = rose_result(n, mean, a);
+    size_t len;
+    int status;
+    char err[256];
+    char *s = render(r, NULL, "orientation", NULL, &len, &status, err);
+    check_common(s, len);
+    if (!s) return;
+    double ra[80], rt[80], w = 180.0 / classes;
+    int rings;
+    double scale = ring_scale(s, &rings);
+    CHECK(rings >= 3 && isfinite(scale));
+    /* classes x 2 arcs (axial: each class and its mirror), the same drawing for both curves */
+    CHECK(arc_radii(s, "achieved", ra, 80) == 2 * classes);
+    CHECK(arc_radii(s, "target", rt, 80) == 2 * classes);
+    /* the achieved radii are the test's own counts of its directions (% per degree) */
+    double cnt[40] = {0};
+    const json_t *g;
+    size_t i;
+    json_array_foreach(json_object_get(r, "grains"), i, g) {
+        int c = (int)floor((json_number_value(json_object_get(g, "orientation_deg")) + 90) / w);
+        cnt[c >= classes ? 0 : c]++;
+    }
+    for (int c = 0; c < classes; c++) {
+        CHECK_NEAR(ra[c], scale * 100 * cnt[c] / n / w, 0.02 + 0.002 * ra[c]);
+        CHECK_NEAR(ra[c + classes], ra[c], 0);
+        double t0 = -90 + w * c;
+        CHECK_NEAR(rt[c], scale * 100 * cos_prob(t0, t0 + w, mean, a) / w, 0.02 + 0.002 * rt[c]);
+    }
+    char want[160];
+    snprintf(want, sizeof want, "(N = %d, %d classes of %g°): KS 0.03 (5 %% critical %.3g)", n,
+             classes, w, 1.36 / sqrt(n));
+    CHECK(strstr(s, want) != NULL);
+    snprintf(want, sizeof want, "target: cosine law, mean %g°, anisotropy %g", mean, a);
+    CHECK(strstr(s, want) != NULL);
+    CHECK(strstr(s, "% per degree") != NULL);
+    free(s);
+    json_decref(r);
+}
+
+static void test_rose(void)
+{
+    check_rose(500, 0, 0.1, 18); /* Mollon & Zhao's Example 2: 10-degree classes, not 4 */
+    check_rose(500, 30, 0.5, 18);
+    check_rose(1000, -60, 0.3, 36);
+    check_rose(300, 0, 1, 12);
+    check_rose(100, 45, 0.2, 6);
+}
+
+/* ---------------------------------------------------------------- colour bars */
+
+/* n square grains, 4 a row, their areas from amin to amax (m²) */
+static json_t *squares_result(int n, double amin, double amax)
+{
+    json_t *grains = json_array();
+    for (int i = 0; i < n; i++) {
+        double a = amin + (amax - amin) * i / (n - 1), h = sqrt(a) / 2, cx = 0.4 * (i % 4);
+        double cy = 0.4 * (i / 4);
+        json_array_append_new(grains, json_pack("{s:[[f,f],[f,f],[f,f],[f,f]], s:f, s:f}", "contour",
+                                                cx - h, cy - h, cx + h, cy - h, cx + h, cy + h, cx - h, cy + h,
+                                                "area", a, "orientation_deg", 0.0));
+    }
+    return json_pack("{s:s, s:o}", "kind", KIND_2D, "grains", grains);
+}
+
+/* the colour bar's ticks and labels: labels keep 12 px (the font) apart and right of their
+ * ticks, round values (linear: multiples of a 1-2-5 x 10^k step; log: m x 10^k, m whole),
+ * within lo..hi (the bar's unit); their count */
+static int check_colorbar(const char *svg, int logscale, double lo, double hi)
+{
+    double v[64], y[64];
+    int n = 0;
+    const char *t = strstr(svg, "class=\"cbar-tick\"");
+    for (const char *l = strstr(svg, "class=\"cbar-label\""); l && n < 64;
+         l = strstr(l + 1, "class=\"cbar-label\""), n++) {
+        const char *el = l;
+        while (el > svg && strncmp(el, "<text", 5)) el--;
+        char lab[32];
+        text_of(el, lab, sizeof lab);
+        v[n] = strtod(lab, NULL);
+        y[n] = attr_num(el, "y");
+        CHECK(t != NULL);
+        if (!t) break;
+        const char *tl = t;
+        while (tl > svg && strncmp(tl, "<line", 5)) tl--;
+        CHECK(attr_num(el, "x") > attr_num(tl, "x2")); /* the label starts right of its tick */
+        CHECK_NEAR(attr_num(tl, "y1") + 4, y[n], 0.11);  /* and is centred on it */
+        t = strstr(t + 1, "class=\"cbar-tick\"");
+        CHECK(v[n] >= lo * (1 - 1e-9) && v[n] <= hi * (1 + 1e-9));
+        if (logscale) {
+            double m = v[n] / pow(10, floor(log10(v[n]) + 1e-9));
+            CHECK_NEAR(m, round(m), 1e-9);
+        }
+    }
+    for (int i = 1; i < n; i++) CHECK(fabs(y[i] - y[i - 1]) >= 12);
+    if (!logscale && n >= 2) {
+        double st = v[1] - v[0], m = st / pow(10, floor(log10(st) + 1e-9));
+        CHECK(fabs(m - 1) < 1e-6 || fabs(m - 2) < 1e-6 || fabs(m - 5) < 1e-6);
+        for (int i = 0; i < n; i++) CHECK_NEAR(v[i] / st, round(v[i] / st), 1e-6);
+        for (int i = 1; i < n; i++) CHECK_NEAR(v[i] - v[i - 1], st, st * 1e-6);
+    }
+    return n;
+}
+
+static void test_colorbar(void)
+{
+    size_t len;
+    int status;
+    char err[256];
+    /* linear (areas within a factor 10): mm², 1-2-5 steps -- not 0.001798 m² */
+    json_t *r = squares_result(12, 0.0011, 0.0034);
+    char *s = render(r, NULL, "packing", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && strstr(s, "grain area (mm²)") && check_colorbar(s, 0, 1100, 3400) >= 3);
+    free(s);
+    json_decref(r);
+    /* log (a factor 150) */
+    r = squares_result(12, 2e-5, 3e-3);
+    s = render(r, NULL, "packing", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && check_colorbar(s, 1, 20, 3000) >= 3);
+    free(s);
+    json_decref(r);
+    /* small values keep their digits: 1-2-5 steps of 10^-5 m² would read 0.00001 */
+    r = squares_result(12, 0.101, 0.1013);
+    s = render(r, NULL, "packing", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && strstr(s, "grain area (m²)") && check_colorbar(s, 0, 0.101, 0.1013) >= 2);
+    free(s);
+    json_decref(r);
+    /* the fixed-decimals label of a tick, and powers of ten beyond */
+    char b[64];
+    fmt_tick(b, sizeof b, 0.3000000000000001, 0.1);
+    CHECK(!strcmp(b, "0.3"));
+    fmt_tick(b, sizeof b, 2e-5, 0);
+    CHECK(!strcmp(b, "2×10⁻⁵"));
+    fmt_tick(b, sizeof b, 1e7, 0);
+    CHECK(!strcmp(b, "10⁷"));
+    fmt_tick(b, sizeof b, -1e-17, 0.5);
+    CHECK(!strcmp(b, "0"));
+}
+
+/* ---------------------------------------------------------------- the 3D section */
+
+static void test_section_z(void)
+{
+    json_t *r = load(RESULT_3D);
+    /* tiled 2 x 2 x 4: a box 2 m high, mirror planes every 0.5 m */
+    json_object_set_new(r, "box", json_pack("[f, f, f]", 1.0, 1.0, 2.0));
+    json_object_set_new(r, "tiling", json_pack("[i, i, i]", 2, 2, 4));
+    json_object_set_new(json_object_get(r, "stats"), "porosity",
+                        json_pack("{s:f, s:f}", "target", 0.38, "achieved", 0.377));
+    json_t *sp = json_object_get(r, "spheres");
+    for (int i = 0; i < 40; i++) /* spheres about every height */
+        json_array_append_new(sp, json_pack("[f, f, f, f]", 0.1 + 0.02 * i, 0.5, 0.05 * i, 0.04));
+    size_t len;
+    int status;
+    char err[256];
+    char *s = render(r, NULL, "section", NULL, &len, &status, err);
+    check_common(s, len);
+    double z = NAN;
+    CHECK(s && sscanf(strstr(s, "Section at z = ") + 15, "%lf", &z) == 1);
+    double base = 2.0 / 4, off = fabs(z / base - round(z / base)) * base;
+    CHECK(off > 0.01 * base);    /* not on a mirror plane */
+    CHECK_NEAR(off, base / 2, 1e-9); /* as far from them as a cut can be */
+    /* the spheres it cuts and their area, counted here */
+    int cut = 0;
+    double area = 0;
+    const json_t *q;
+    size_t i;
+    json_array_foreach(sp, i, q) {
+        double zz = json_number_value(json_array_get(q, 2)), rr = json_number_value(json_array_get(q, 3));
+        if (fabs(zz - z) < rr) cut++, area += M_PI * (rr * rr - (zz - z) * (zz - z));
+    }
+    char want[200];
+    snprintf(want, sizeof want, ": %d of %zu spheres cut", cut, json_array_size(sp));
+    CHECK(s && strstr(s, want));
+    snprintf(want, sizeof want, "porosity 0.377 (target 0.38), of this section %.3f", 1 - area / 1.0);
+    CHECK(s && strstr(s, want));
+    /* the PSD summary, from the achieved curve by weight (log-linear between sieves) */
+    double d50 = 0.02 * pow(2.5, (50 - 2.7) / (52 - 2.7)), d10 = 0.02 * pow(2.5, (10 - 2.7) / (52 - 2.7));
+    double d60 = 0.05 * pow(1.6, (60 - 52) / (94.5 - 52));
+    snprintf(want, sizeof want, "D50 %.3g mm, Cu = D60/D10 %.3g, max error 2.00 pp", d50 * 1e3, d60 / d10);
+    CHECK(s && strstr(s, want));
+    CHECK(s && strstr(s, "mirror planes every 0.5 m, the nearest 0.25 m from the cut"));
+    free(s);
+    /* z asked for: outside the packing, a 400 naming z and the range */
+    gp_svg_options o = {.has_z = 1, .z = 2.5};
+    CHECK(render_st(r, NULL, "section", &o, &len, &status, err, sizeof err) == NULL);
+    CHECK(status == 400 && strstr(err, "z = 2.5") && strstr(err, "valid z from 0 to 2 m"));
+    o.z = 1.0; /* on a mirror plane, when asked */
+    s = render(r, NULL, "section", &o, &len, &status, err);
+    CHECK(s && strstr(s, "Section at z = 1 m") && strstr(s, "the nearest 0 m from the cut"));
+    free(s);
+    /* a curve that starts above 10 %: no D10, so no Cu (and no "nan") */
+    json_t *aw = json_object_get(json_object_get(json_object_get(r, "stats"), "psd"), "achieved_weight");
+    json_array_set_new(aw, 0, json_real(15));
+    json_array_set_new(aw, 1, json_real(20));
+    s = render(r, NULL, "section", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && strstr(s, "PSD by weight: D50 ") && !strstr(s, "Cu =") && strstr(s, "max error 18.00 pp"));
+    free(s);
+    /* an odd tiling: the middle cell's middle, which is the box's */
+    json_object_set_new(r, "box", json_pack("[f, f, f]", 1.0, 1.0, 1.5));
+    json_object_set_new(r, "tiling", json_pack("[i, i, i]", 1, 1, 3));
+    s = render(r, NULL, "section", NULL, &len, &status, err);
+    CHECK(s && strstr(s, "Section at z = 0.75 m"));
+    free(s);
+    json_decref(r);
+}
+
+/* ---------------------------------------------------------------- the detail inset */
+
+/* n x m grains (polygons of np points, radius rad) on a grid over [x0, x1] x [0, 1], in a
+ * container [0, cw] x [0, 1] */
+static json_t *grid_result_np(int n, int m, double x0, double x1, double rad, double cw, int np)
+{
+    json_t *grains = json_array();
+    for (int j = 0; j < m; j++)
+        for (int i = 0; i < n; i++) {
+            double cx = x0 + (x1 - x0) * (i + 0.5) / n, cy = (j + 0.5) / m;
+            json_t *c = json_array();
+            for (int k = 0; k < np; k++)
+                json_array_append_new(c, json_pack("[f, f]", cx + rad * cos(k * 2 * M_PI / np),
+                                                   cy + rad * sin(k * 2 * M_PI / np)));
+            json_array_append_new(grains, json_pack("{s:o, s:f, s:f}", "contour", c, "area",
+                                                    2.83 * rad * rad * (1 + (i % 5) * 0.1),
+                                                    "orientation_deg", 0.0));
+        }
+    return json_pack("{s:s, s:o, s:{s:[[i,i],[f,i],[f,i],[i,i]]}}", "kind", KIND_2D, "grains",
+                     grains, "container", "polygon", 0, 0, cw, 0, cw, 1, 0, 1);
+}
+
+static json_t *grid_result(int n, int m, double x0, double x1, double rad, double cw)
+{
+    return grid_result_np(n, m, x0, x1, rad, cw, 8);
+}
+
+/* the inset of a packing: its window (desc), the paths drawn in it, the test's own count of
+ * the grains whose bounding box meets the window; returns that count */
+static int check_inset(const char *s, const json_t *r, double win[4])
+{
+    const char *d = strstr(s, "<desc>detail window: x from ");
+    CHECK(d && sscanf(d + 28, "%lf to %lf m, y from %lf to %lf", &win[0], &win[1], &win[2], &win[3]) == 4);
+    if (!d) return -1;
+    CHECK_NEAR(win[1] - win[0], win[3] - win[2], 1e-8); /* square */
+    const char *a = strstr(d, "<g clip-path"), *b = strstr(a, "</g>");
+    int drawn = 0, own = 0;
+    for (const char *p = strstr(a, "<path"); p && p < b; p = strstr(p + 1, "<path")) drawn++;
+    const json_t *g;
+    size_t i;
+    json_array_foreach(json_object_get(r, "grains"), i, g) {
+        double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+        const json_t *pt;
+        size_t k;
+        json_array_foreach(json_object_get(g, "contour"), k, pt) for (int c = 0; c < 2; c++) {
+            lo[c] = fmin(lo[c], json_number_value(json_array_get(pt, (size_t)c)));
+            hi[c] = fmax(hi[c], json_number_value(json_array_get(pt, (size_t)c)));
+        }
+        own += hi[0] >= win[0] && lo[0] <= win[1] && hi[1] >= win[2] && lo[1] <= win[3];
+    }
+    CHECK(drawn == own);
+    char cap[96];
+    snprintf(cap, sizeof cap, "): %d grains in the red square", own);
+    CHECK(strstr(s, cap) != NULL);
+    CHECK(count(s, "<polygon") == json_array_size(json_object_get(r, "grains"))); /* each once */
+    return own;
+}
+
+static void test_inset(void)
+{
+    size_t len;
+    int status;
+    char err[256];
+    double w[4];
+    /* 55 x 55 grains, uniform: a central window of about INSET_TARGET grains */
+    json_t *r = grid_result(55, 55, 0, 1, 0.006, 1);
+    char *s = render(r, NULL, "packing", NULL, &len, &status, err);
+    check_common(s, len);
+    int in = s ? check_inset(s, r, w) : -1;
+    CHECK(in >= 100 && in <= 300);
+    CHECK_NEAR((w[0] + w[1]) / 2, 0.5, 1e-9);
+    CHECK_NEAR((w[2] + w[3]) / 2, 0.5, 1e-9);
+    CHECK(s && strstr(s, "width=\"1200\"") && count(s, "class=\"inset-window\"") == 1);
+    free(s);
+    gp_svg_options o = {.width = 900};
+    s = render(r, NULL, "packing", &o, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && strstr(s, "width=\"900\"") && check_inset(s, r, w) == in);
+    free(s);
+    json_decref(r);
+    /* grains in the right half of a 2 x 1 container only: the window is where they are */
+    r = grid_result(50, 50, 1, 2, 0.004, 2);
+    s = render(r, NULL, "packing", NULL, &len, &status, err);
+    check_common(s, len);
+    in = s ? check_inset(s, r, w) : -1;
+    CHECK(in >= 100 && w[0] >= 1 - 0.1 * (w[1] - w[0]) && w[1] <= 2 + 1e-9);
+    free(s);
+    json_decref(r);
+    /* grains of 600 points: the window's (some 100,000 points) are not kept from the map's
+     * pass, the inset reads them again -- the same picture */
+    r = grid_result_np(46, 46, 0, 1, 0.007, 1, 600);
+    s = render(r, NULL, "packing", NULL, &len, &status, err);
+    check_common(s, len);
+    in = s ? check_inset(s, r, w) : -1;
+    CHECK(in >= 100 && in <= 300 && in * 600 > INSET_KEEP);
+    free(s);
+    json_decref(r);
+    /* 2,000 grains or fewer: no inset */
+    r = grid_result(40, 50, 0, 1, 0.004, 1);
+    s = render(r, NULL, "packing", NULL, &len, &status, err);
+    check_common(s, len);
+    CHECK(s && !strstr(s, "class=\"inset") && strstr(s, "width=\"800\""));
+    free(s);
+    json_decref(r);
+}
+
+/* ---------------------------------------------------------------- descriptor histograms */
+
+/* px = a + b v from the labelled x ticks between p and end */
+static int xmap(const char *p, const char *end, double *a, double *b)
+{
+    double px[64], v[64];
+    int n = 0;
+    for (const char *t = strstr(p, "class=\"xtick\""); t && t < end && n < 64; t = strstr(t + 1, "class=\"xtick\"")) {
+        const char *el = t;
+        while (strncmp(el, "<text", 5)) el--;
+        char lab[32];
+        text_of(el, lab, sizeof lab);
+        px[n] = attr_num(el, "x");
+        v[n++] = strtod(lab, NULL);
+    }
+    if (n < 2) return -1;
+    *b = (px[n - 1] - px[0]) / (v[n - 1] - v[0]);
+    *a = px[0] - *b * v[0];
+    for (int i = 0; i < n; i++) CHECK_NEAR(px[i], *a + *b * v[i], 0.11);
+    return 0;
+}
+
+/* the elongation panel of the descriptors view against the test's own values */
+static void check_desc_panel(const char *s, const double *v, int n, double target)
+{
+    const char *p = strstr(s, "class=\"panel-title\""), *end = strstr(p + 1, "class=\"panel-title\"");
+    double a = NAN, b = NAN, mean = 0, sd = 0, lo = INFINITY, hi = -INFINITY;
+    CHECK(xmap(p, end, &a, &b) == 0);
+    for (int i = 0; i < n; i++) mean += v[i] / n, lo = fmin(lo, v[i]), hi = fmax(hi, v[i]);
+    for (int i = 0; i < n; i++) sd += (v[i] - mean) * (v[i] - mean) / (n - 1);
+    sd = sqrt(sd);
+    char t[128];
+    snprintf(t, sizeof t, "elongation: mean %.3g, sd %.2g", mean, sd);
+    CHECK(strstr(s, t) != NULL);
+    /* the bars: edges on a 1-2-5 step, 8..40 of them covering the data and no more */
+    double e[48], frac[48], y0 = NAN, ymap;
+    int k = 0;
+    const char *bars = strstr(p, "<g class=\"bars\"");
+    for (const char *r = strstr(bars, "<rect"); r && r < strstr(bars, "</g>") && k < 47; r = strstr(r + 1, "<rect")) {
+        e[k] = (attr_num(r, "x") - 0.5 - a) / b;
+        e[k + 1] = (attr_num(r, "x") + attr_num(r, "width") + 0.5 - a) / b;
+        frac[k++] = attr_num(r, "height");
+        y0 = attr_num(r, "y") + attr_num(r, "height");
+    }
+    CHECK(k >= 8 && k <= 40);
+    double st = (e[k] - e[0]) / k, p10 = pow(10, floor(log10(st) + 1e-3)), m = st / p10;
+    CHECK(fabs(m - 1) < 0.01 || fabs(m - 2) < 0.02 || fabs(m - 5) < 0.05);
+    if (!(fabs(m - 1) < 0.01 || fabs(m - 2) < 0.02 || fabs(m - 5) < 0.05))
+        fprintf(stderr, "descriptor bins: %d from %g to %g\n", k, e[0], e[k]);
+    /* the exact edges: the round step from multiples of it (the pixels are rounded) */
+    st = round(m) * p10;
+    e[0] = round(e[0] / st) * st;
+    for (int i = 1; i <= k; i++) e[i] = e[0] + st * i;
+    CHECK(e[0] <= lo && e[0] > lo - st && e[k] >= hi && e[k] < hi + st);
+    /* Freedman-Diaconis: the step is the round one at or just above 2 IQR / n^(1/3) */
+    double *sv = malloc((size_t)n * sizeof *sv);
+    memcpy(sv, v, (size_t)n * sizeof *sv);
+    for (int i = 1; i < n; i++) /* insertion sort: n is small */
+        for (int j = i; j > 0 && sv[j - 1] > sv[j]; j--) { double x = sv[j]; sv[j] = sv[j - 1]; sv[j - 1] = x; }
+    double fd = 2 * (sv[3 * n / 4] - sv[n / 4]) / cbrt(n);
+    free(sv);
+    CHECK(st >= fd * 0.97 && st <= fd * 2.6);
+    /* heights: the test's own fractions, on the y axis' scale (the y ticks) */
+    const char *yt = strstr(p, "class=\"ytick\""), *yt2 = strstr(yt + 1, "class=\"ytick\"");
+    const char *e1 = yt, *e2 = yt2;
+    while (strncmp(e1, "<text", 5)) e1--;
+    while (strncmp(e2, "<text", 5)) e2--;
+    char l1[32], l2[32];
+    text_of(e1, l1, sizeof l1);
+    text_of(e2, l2, sizeof l2);
+    ymap = (attr_num(e1, "y") - attr_num(e2, "y")) / (strtod(l2, NULL) - strtod(l1, NULL));
+    CHECK_NEAR(attr_num(e1, "y") - 4, y0, 0.11); /* the first y tick is 0, at the bars' base */
+    for (int i = 0; i < k; i++) {
+        int c = 0;
+        for (int j = 0; j < n; j++) c += v[j] >= e[i] - st * 1e-6 && (v[j] < e[i + 1] - st * 1e-6 || (i == k - 1 && v[j] <= e[k]));
+        CHECK_NEAR(frac[i] / ymap, (double)c / n, 0.2 / ymap + 0.002 * c / n); /* 0.1 px */
+    }
+    /* the mean and the target, where they are */
+    CHECK_NEAR(attr_num(strstr(p, "class=\"mean\"") - 6, "x1"), a + b * mean, 0.11);
+    CHECK_NEAR(attr_num(strstr(p, "class=\"target\"") - 6, "x1"), a + b * target, 0.11);
+}
+
+static void test_descriptors_zoom(void)
+{
+    enum { N = 500 };
+    json_t *grains = json_array();
+    double el[N];
+    unsigned x = 3;
+    for (int i = 0; i < N; i++) {
+        el[i] = 0.62 + 0.1 * (lcg(&x) + lcg(&x) + lcg(&x)) / 3;
+        double ro = 0.4 + 0.01 * lcg(&x), ci = 0.85 + 0.003 * lcg(&x), re = 1.2 + 0.2 * lcg(&x);
+        json_array_append_new(grains, json_pack("{s:{s:f, s:f, s:f, s:f}, s:f}", "descriptors",
+                                                "elongation", el[i], "roundness", ro, "circularity",
+                                                ci, "regularity", re, "area", 1.0));
+    }
+    json_t *r = json_pack("{s:s, s:o, s:{s:{s:{s:f}, s:{s:f}}}}", "kind", KIND_2D, "grains", grains,
+                          "stats", "descriptors", "elongation", "target", 0.66, "roundness",
+                          "target", 0.3);
+    size_t len;
+    int status;
+    char err[256];
+    char *s = render(r, NULL, "descriptors", NULL, &len, &status, err);
+    check_common(s, len);
+    if (s) check_desc_panel(s, el, N, 0.66);
+    /* a target outside the data widens the axis to show it: roundness 0.3, data 0.40-0.41 */
+    CHECK(s && count(s, "class=\"target\"") == 2);
+    free(s);
+    json_decref(r);
 }
 
 /* 10,000 grains of 128 points: fast and bounded */
@@ -1011,6 +1617,11 @@ int main(void)
     test_size_fit();
     test_result_fit();
     test_3d();
+    test_rose();
+    test_colorbar();
+    test_section_z();
+    test_inset();
+    test_descriptors_zoom();
     test_large();
     test_json_scan();
     test_item_parse();
