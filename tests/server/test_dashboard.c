@@ -1,9 +1,13 @@
-/* test_dashboard.c -- the dashboard page: self-contained HTML that polls the job list, submits,
- * cancels and shows SVG views and exports; a finished job's warnings (amber) and fit table;
- * the kinds, their examples, views and export formats filled in from the daemon's kind table
- * (server/page.c), none of them written in the page itself; and dashboard.c is in sync with
- * dashboard.html. With node installed, the page's script also runs against a stand-in DOM
- * (tests/server/dashboard_check.js) to check how a finished job is drawn. */
+/* test_dashboard.c -- the dashboard page: self-contained HTML that polls the job list (paged,
+ * rows updated in place), submits (with quick fields), cancels, shows a finished job's result
+ * summary (targets next to achieved values, from GET .../summary, never .../result), timings,
+ * warnings (amber), SVG views (a download link each, the section's z slider) and exports; the
+ * DOM contract the browser test relies on (ids and data- attributes); a URL per job
+ * (#/jobs/{id}); the kinds, their examples, views and export formats filled in from the
+ * daemon's kind table (server/page.c), none of them written in the page itself; and
+ * dashboard.c is in sync with dashboard.html. With node installed, the page's script also runs
+ * against a stand-in DOM and service (tests/server/dashboard_check.js) to check how it
+ * behaves. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -77,14 +81,28 @@ int main(void)
         "<!DOCTYPE html>", "</html>", "<meta charset=\"utf-8\">",
         /* polling, every second */
         "setInterval(refresh, POLL_MS)", "POLL_MS = 1000",
-        /* the endpoints it uses */
-        "\"/v1/jobs?limit=50\"", "api(\"POST\", \"/v1/jobs\"", "api(\"DELETE\", \"/v1/jobs/\"",
-        "/svg?view=", "/export?format=", "/v1/health", ".fraction",
-        /* a finished job: warnings from its progress detail in amber, the fit report */
+        /* the endpoints it uses: the list by pages, the summary of a result (not the result) */
+        "\"/v1/jobs?limit=\" + PAGE_SIZE", "\"&after=\"", "api(\"POST\", \"/v1/jobs\"",
+        "api(\"DELETE\", jobPath(id))", "\"/summary\"", "\"/svg\"", "?view=", "&z=",
+        "&color=orientation", "/export?format=", "/v1/health", ".fraction", ".eta_s",
+        /* a finished job: warnings in amber, the fit report as rows of the summary */
         "jobDetail(job).warnings", "--amber: #bf8700", ".bar.done.warn > div { background: var(--amber)",
         "\"warnmark\"", "s-warn", "cell_area", "grain_area", "cell_orientation",
-        "grain_orientation", "passing", "ks_critical", "max_error_pp", "w1", "fitTable(fit)",
-        "b.ks > b.ks_critical",
+        "grain_orientation", "passing", "ks_critical", "max_error_pp", "w1",
+        "within(b.ks, b.ks_critical)", "coordination_number", "fabric", "porosity",
+        "cells_target_met", "stop_reason", "timings",
+        /* a cancelled job grey, not a running bar */
+        ".bar.cancelled > div { background: var(--grey)",
+        /* the DOM contract of the browser test (tests/integration/browser) */
+        "id=\"kind\"", "id=\"spec\"", "id=\"q-particles\"", "id=\"q-seed\"",
+        "id=\"q-solid-fraction\"", "id=\"q-porosity\"", "id=\"submit\"", "id=\"submit-msg\"",
+        "id=\"jobs\"", "id=\"page-prev\"", "id=\"page-next\"", "id=\"detail\"",
+        "id=\"cancel\"", "id=\"summary\"", "id=\"timings\"", "id=\"views\"",
+        "id=\"picture\"", "id=\"svg-download\"", "id=\"z\"", "id=\"exports\"",
+        "\"data-job-id\"", "\"data-status\"", "\"data-quantity\"", "\"data-view\"",
+        "\"data-state\"", "\"data-format\"", "\"class\": \"job\"", "\"target\"", "\"achieved\"",
+        /* a URL per job */
+        "\"#/jobs/\"", "\"hashchange\"",
         /* filled in from the kind table: every kind, view and export format of api.md, and the
          * api.md example specs */
         "\"fourier-voronoi-2d\":{\"example\":", "\"spheres-3d\":{\"example\":", "\"packing\"",
@@ -96,6 +114,10 @@ int main(void)
     /* the page itself names no kind: it takes them from the daemon */
     CHECK(strstr(tpl, "fourier-voronoi-2d") == NULL && strstr(tpl, "spheres-3d") == NULL);
     CHECK(strstr(tpl, "var KINDS = /*@KINDS@*/{};") != NULL);
+    /* the whole result (up to ~100 MB) is only ever a download link, never fetched */
+    const char *res = strstr(tpl, "\"/result\"");
+    CHECK(res != NULL && strstr(res + 1, "\"/result\"") == NULL);
+    CHECK(strstr(tpl, "download: job.id + \"-result.json\"") != NULL);
     run_in_node(h);
     /* self-contained: nothing fetched from elsewhere, nothing that would close the script */
     CHECK(strstr(h, "http://") == NULL && strstr(h, "https://") == NULL);
