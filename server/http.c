@@ -341,9 +341,14 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
     json_t *eff = effective_spec(c, r, &k, &ret);
     if (!eff) return ret;
     char *text = json_dumps(eff, JSON_COMPACT);
+    /* the brief from the spec, through the kind (kind.h): a few dozen bytes in the row */
+    json_t *brief = k->brief(eff, NULL);
+    char *btext = brief ? json_dumps(brief, JSON_COMPACT) : NULL;
+    json_decref(brief);
     char id[33];
-    store_rc rc = text ? store_insert(k->name, text, max_queued, id) : STORE_ERROR;
+    store_rc rc = text && btext ? store_insert(k->name, text, btext, max_queued, id) : STORE_ERROR;
     free(text);
+    free(btext);
     json_decref(eff);
     if (rc == STORE_FULL) {
         char retry[16];
@@ -516,6 +521,22 @@ static enum MHD_Result h_result(struct MHD_Connection *c, req *r, const char *id
         return send_buf(c, r, 200, "application/json", text, len, MHD_RESPMEM_MUST_FREE, NULL);
     return send_stream(c, r, "application/json", store_stream_size(s), read_result_stream, s,
                        free_result_stream, NULL);
+}
+
+/* GET /v1/jobs/{id}/summary: the result without its per-item arrays (store_get_summary: the
+ * few KB stored with the result, whatever the result's size), for pictures and result panels */
+static enum MHD_Result h_summary(struct MHD_Connection *c, req *r, const char *id)
+{
+    char *text = NULL, st[16];
+    size_t len = 0;
+    store_rc rc = store_get_summary(id, &text, &len, NULL, st);
+    if (rc == STORE_NOT_FOUND) return not_found(c, r, id);
+    if (rc != STORE_OK) return send_store_error(c, r);
+    if (strcmp(st, "succeeded") || !text) {
+        free(text);
+        return not_ready(c, r, id, st);
+    }
+    return send_buf(c, r, 200, "application/json", text, len, MHD_RESPMEM_MUST_FREE, NULL);
 }
 
 static enum MHD_Result h_spec(struct MHD_Connection *c, req *r, const char *id)
@@ -854,6 +875,7 @@ static enum MHD_Result route(struct MHD_Connection *c, req *r, const char *url,
         else if (!strcmp(sub, "svg")) hk = h_svg;
         else if (!strcmp(sub, "export")) hk = h_export;
         else if (!strcmp(sub, "spec")) h = h_spec;
+        else if (!strcmp(sub, "summary")) h = h_summary;
         if (!h && !hk)
             return send_error(c, r, 404, "not_found", NULL, "no such resource: %.128s", path);
         if (!is_get(method)) return method_not_allowed(c, r, method, path, "GET, HEAD");

@@ -20,6 +20,7 @@
 #include "gp_error.h"
 #include "gp_progress.h"
 #include "gp_spec.h"
+#include "progress.h"
 #include "svg.h"
 
 /* A view of the SVG renderer: ?view=name draws it. */
@@ -38,6 +39,13 @@ typedef struct gpd_kind {
     /* Its estimated result against max_bytes: 0, or -1 with *p (422 too_large, or from the
      * estimate itself); both kinds use schema's gp_spec_check_result */
     int (*bounds)(const json_t *spec, double max_bytes, gp_spec_problem *p);
+    /* The job object's "brief" (README, "Extensions to api.md"): a new object
+     *   {"particles": N or null, "seed": S,
+     *    "headline": {"name": "<the spec's headline target>", "target": x, "achieved": y|null}}
+     * of a valid effective spec; stats is the result's "stats" once the job has succeeded, NULL
+     * before (achieved null, and particles null where only the run tells it). NULL on out of
+     * memory. A few dozen bytes: every row of GET /v1/jobs carries it. */
+    json_t *(*brief)(const json_t *spec, const json_t *stats);
 
     /* ---- running a job (workers.c), in this order ---- */
     /* GPD_KIND_CORE_OPS: the glue to the kind's core pipeline (GPD_KIND_CORE below) */
@@ -53,8 +61,13 @@ typedef struct gpd_kind {
     void (*destroy)(void *specimen);
     /* The "detail" of a progress report (a new object) */
     json_t *(*progress_detail)(const gp_progress *p);
-    /* 1 when writing the result takes long enough (~0.5 s and more) to show as a phase */
-    int (*large_result)(const void *specimen);
+    /* The phases a job of this spec goes through, in order, each with its expected seconds on
+     * one core (progress.h: the daemon's fraction and ETA weigh the phases by them), the last
+     * "result" (building, packing and storing the result): how many, at most max. spec is the
+     * core's parsed spec, spec_json the effective spec. */
+    int (*plan)(const void *spec, const json_t *spec_json, gpd_phase *out, int max);
+    /* The expected seconds of the "result" phase for this specimen (its size now known) */
+    double (*result_cost)(const void *specimen);
     /* The result JSON (result_json.h), stopping early when *cancel comes up (the tree returned
      * is then partial); NULL on out of memory */
     json_t *(*result)(const void *specimen, const void *spec, const json_t *spec_json,
@@ -125,6 +138,16 @@ void gpd_kind_view_list(const gpd_kind *k, char *buf, size_t n);
 /* The names of the kinds, each between quote and quote, sep between two, into buf (e.g. quote
  * "\"", sep ", ": "\"a\", \"b\""). */
 void gpd_kind_names(char *buf, size_t n, const char *quote, const char *sep);
+
+/* A brief (see gpd_kind.brief) with the seed and the headline's target read from spec: its
+ * member `headline` (a number); particles and achieved are taken (NULL: null). */
+json_t *gpd_brief_new(const json_t *spec, const char *headline, json_t *particles,
+                      json_t *achieved);
+/* The brief of a stored job as text (malloc'ed; NULL when its kind is unknown here or its texts
+ * do not parse): kind, its effective spec and, once it has succeeded, its result summary
+ * (store_get_summary; NULL before). The store fills in the briefs of jobs stored by an older
+ * daemon with it (store_fill_briefs). */
+char *gpd_brief_text(const char *kind, const char *spec, const char *summary);
 
 /* What the dashboard knows of the kinds (a new object, NULL on out of memory):
  * {"<name>": {"example": <spec>, "views": [{"name", "options": [...]}, ...],

@@ -310,13 +310,93 @@ static json_t *progress_detail(const gp_progress *p)
     return json_pack("{s:I, s:o}", "steps", (json_int_t)p->steps, "error", gpd_jreal(p->error));
 }
 
-/* the result's size in points, roughly: ~0.5 s a million */
-static int large_result(const void *specimen)
+/* The brief: the grains (the spec's count, or the one its sieve law derives, as the run will;
+ * once succeeded the cells the run made, one grain each) and the solid fraction. */
+static json_t *brief(const json_t *spec, const json_t *stats)
+{
+    json_t *particles = NULL, *achieved = NULL;
+    if (stats) {
+        const json_t *n = json_object_get(json_object_get(stats, "particles"), "achieved");
+        particles = json_deep_copy(n);
+        achieved =
+            json_deep_copy(json_object_get(json_object_get(stats, "solid_fraction"), "achieved"));
+    } else {
+        gp_spec_bounds_t b;
+        gp_spec_problem p;
+        if (gp_spec_bounds(spec, &b, &p) == 0 && b.cells >= 1)
+            particles = json_integer((json_int_t)b.cells);
+    }
+    return gpd_brief_new(spec, "solid_fraction", particles, achieved);
+}
+
+/* ---- the progress plan (progress.h): seconds on one core, measured with
+ * bench/bench_progress.py (10,000 grains of 128 points; the 3D kind's figures are of the same
+ * run: together they give the machine's speed) ---- */
+#define COST_TESS_S 20e-6   /* the first tessellation, a cell */
+#define COST_IMC_S 25e-6    /* an IMC move at 1,000 cells ... */
+#define COST_IMC_DECADE 0.6 /* ... and this much more per tenfold more cells */
+#define IMC_MOVES_GUESS 4   /* moves a cell until the default threshold (a guess: the IMC runs
+                               until it converges; its own rate takes over as it runs) */
+#define COST_FILL_S 0.85e-3 /* filling a grain of 128 points ... */
+#define REFILL_SHARE 0.4    /* ... and the refill pass (law on the cells), a guess: it refills
+                               the cells that reached the fraction (measured 0.16 to 0.47) */
+#define COST_ODEC_S 0.3e-3  /* its ODEC discs (0.2 to 0.46 of its filling, measured) */
+#define COST_DESC_S 0.3e-3  /* its descriptors */
+#define DISCS_GUESS 20      /* ODEC discs of a grain, for the plan */
+#define CORNERS_GUESS 7     /* corners of a cell, for the plan */
+/* bytes of the result's text (at 17 digits): a grain's own members, a contour point, a disc,
+ * a cell's own members and a corner of its polygons */
+#define BYTES_GRAIN 250
+#define BYTES_POINT 40
+#define BYTES_DISC 60
+#define BYTES_CELL 120
+
+static int plan(const void *spec_, const json_t *spec_json, gpd_phase *out, int max)
+{
+    const gp_spec2d *spec = spec_;
+    double np = (double)spec->contour_points, scale = np / 128;
+    gp_spec_bounds_t b;
+    gp_spec_problem p;
+    if (gp_spec_bounds(spec_json, &b, &p) || max < 6) return 0;
+    double n = b.cells, moves = fmin((double)spec->imc_max_steps, IMC_MOVES_GUESS * n);
+    unsigned o = spec->outputs;
+    int grains = (o & (GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS)) != 0;
+    int finish = (o & (GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS)) ||
+                 spec->size_of_grains || spec->size_law == GP_LAW_SIEVE;
+    int k = 0;
+    out[k++] = (gpd_phase){"tessellation", COST_TESS_S * n, 1};
+    out[k++] = (gpd_phase){"imc", moves * COST_IMC_S *
+                                      (1 + COST_IMC_DECADE * log10(fmax(n, 1000) / 1000)), 0};
+    if (grains) out[k++] = (gpd_phase){"fill", COST_FILL_S * n * scale, 1};
+    if (grains && !spec->size_of_grains && spec->size_law != GP_LAW_SIEVE)
+        out[k++] = (gpd_phase){"fill", REFILL_SHARE * COST_FILL_S * n * scale, 0};
+    if (grains && finish)
+        out[k++] = (gpd_phase){"odec", n * scale * (((o & GP_OUT2_ODEC) ? COST_ODEC_S : 0) +
+                                                    ((o & GP_OUT2_DESCRIPTORS) ? COST_DESC_S : 0)),
+                               1};
+    double bytes = ((o & GP_OUT2_CELLS) ? n * (BYTES_CELL + BYTES_POINT * CORNERS_GUESS) : 0) +
+                   (grains ? n * (BYTES_GRAIN + BYTES_POINT * np +
+                                  ((o & GP_OUT2_ODEC) ? BYTES_DISC * DISCS_GUESS : 0))
+                           : 0);
+    out[k++] = (gpd_phase){"result", GPD_RESULT_S_PER_BYTE * bytes, 1};
+    return k;
+}
+
+/* the result's bytes: its grains with their contours and discs, its cells with their
+ * polygons */
+static double result_cost(const void *specimen)
 {
     const gp_specimen2d *s = specimen;
-    size_t np = s->ncells * 12;
-    for (size_t i = 0; i < s->ngrains; i++) np += s->grains[i].ncontour + s->grains[i].ndiscs;
-    return np > 1000000;
+    double bytes = 0;
+    for (size_t i = 0; i < s->ngrains; i++)
+        bytes += BYTES_GRAIN + BYTES_POINT * (double)s->grains[i].ncontour +
+                 BYTES_DISC * (double)s->grains[i].ndiscs;
+    for (size_t i = 0; s->cells && i < s->ncells; i++) {
+        bytes += BYTES_CELL;
+        for (size_t k = 0; k < s->cells[i].npolygons; k++)
+            bytes += BYTES_POINT * (double)s->cells[i].polygons[k].n;
+    }
+    return GPD_RESULT_S_PER_BYTE * bytes;
 }
 
 static json_t *result(const void *specimen, const void *spec, const json_t *spec_json,
@@ -373,8 +453,8 @@ static const char *const phases[] = {"tessellation", "imc", "fill", "odec", "des
                                      "total", NULL};
 
 const gpd_kind gpd_kind_fv2d = {
-    .name = KIND_NAME, .example = example, .bounds = gp_spec_check_result,
+    .name = KIND_NAME, .example = example, .bounds = gp_spec_check_result, .brief = brief,
     GPD_KIND_CORE_OPS(gp_spec2d), .progress_detail = progress_detail,
-    .large_result = large_result, .result = result, .pack = pack, .done_detail = done_detail,
-    .views = views, .export_dim = 2, .pack_what = "ODEC discs", .pack_output = "odec",
-    .phases = phases};
+    .plan = plan, .result_cost = result_cost, .result = result, .pack = pack,
+    .done_detail = done_detail, .views = views, .export_dim = 2, .pack_what = "ODEC discs",
+    .pack_output = "odec", .phases = phases};

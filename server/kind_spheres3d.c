@@ -139,11 +139,57 @@ static json_t *progress_detail(const gp_progress *p)
                      gpd_jreal(p->porosity), "stability", gpd_jreal(p->stability));
 }
 
-/* ~0.5 s and more */
-static int large_result(const void *specimen)
+/* The brief: the spheres of the final (tiled) packing, known once it has succeeded (the
+ * sieve's count is only drawn by the run), and the porosity. */
+static json_t *brief(const json_t *spec, const json_t *stats)
+{
+    json_t *particles = NULL, *achieved = NULL;
+    if (stats) {
+        particles = json_deep_copy(json_object_get(stats, "particles"));
+        achieved = json_deep_copy(json_object_get(json_object_get(stats, "porosity"), "achieved"));
+    }
+    return gpd_brief_new(spec, "porosity", particles, achieved);
+}
+
+/* ---- the progress plan (progress.h): seconds on one core, measured with
+ * bench/bench_progress.py (the paper's example, in the run that measured the 2D kind's) ---- */
+#define SPHERE_STEPS_S 3.5e6 /* DEM sphere-steps a second */
+/* the phases' seconds, as shares of the protocol's DEM that gp_spec_bounds counts (50 time
+ * units of sqrt(d50 / g)): deposition is GROW_T + SETTLE_T = 2.95 of them at most (core/3d);
+ * compaction and relaxation run until they converge (the paper's example, seven runs: 2.7 to
+ * 6 and 0.9 to 2 times the deposition's seconds; their steps cost more, with more contacts) */
+#define DEPOSITION_SHARE 0.059
+#define COMPACTION_SHARE 0.32
+#define RELAXATION_SHARE 0.11
+#define COST_TILE_S 0.4e-6    /* the flip and the measures, a sphere of the tiled packing */
+#define BYTES_SPHERE 90       /* the result's text: a sphere [x, y, z, r] at 17 digits */
+#define COST_CONTACT_S 23e-6  /* a contact of the result: an object of 210 bytes, 0.11 us each */
+#define CONTACTS_GUESS 2.3    /* contacts a sphere of the tiled packing, for the plan */
+
+static int plan(const void *spec_, const json_t *spec_json, gpd_phase *out, int max)
+{
+    gp_spec_bounds_t b;
+    gp_spec_problem p;
+    if (gp_spec_bounds(spec_json, &b, &p) || max < 5) return 0;
+    double dem = b.cells * b.steps / SPHERE_STEPS_S; /* the whole protocol's */
+    out[0] = (gpd_phase){"deposition", DEPOSITION_SHARE * dem, 1};
+    out[1] = (gpd_phase){"compaction", COMPACTION_SHARE * dem, 0};
+    out[2] = (gpd_phase){"relaxation", RELAXATION_SHARE * dem, 0};
+    /* (the measures report as "tiling" without a tiling too) */
+    out[3] = (gpd_phase){"tiling", COST_TILE_S * b.items, 1};
+    unsigned o = ((const gp_spec3d *)spec_)->outputs;
+    double per = ((o & GP_OUT3_SPHERES) ? GPD_RESULT_S_PER_BYTE * BYTES_SPHERE : 0) +
+                 ((o & GP_OUT3_CONTACTS) ? CONTACTS_GUESS * COST_CONTACT_S : 0);
+    out[4] = (gpd_phase){"result", per * b.items, 1};
+    return 5;
+}
+
+/* the result's spheres and contacts */
+static double result_cost(const void *specimen)
 {
     const gp_specimen3d *s = specimen;
-    return (s->spheres && s->count > 50000) || s->ncontacts > 100000;
+    return (s->spheres ? GPD_RESULT_S_PER_BYTE * BYTES_SPHERE * (double)s->count : 0) +
+           (s->contacts ? COST_CONTACT_S * (double)s->ncontacts : 0);
 }
 
 /* the sphere list, when the spec asked for it */
@@ -190,7 +236,7 @@ static const char *const phases[] = {"deposition", "compaction", "relaxation", "
 
 const gpd_kind gpd_kind_spheres3d = {
     .name = KIND_NAME, .example = example, .views = views, .owns_result = owns_result,
-    .bounds = gp_spec_check_result, GPD_KIND_CORE_OPS(gp_spec3d),
-    .progress_detail = progress_detail, .large_result = large_result, .result = result,
-    .pack = pack, .failure_note = failure_note, .export_dim = 3, .pack_what = "sphere list",
+    .bounds = gp_spec_check_result, .brief = brief, GPD_KIND_CORE_OPS(gp_spec3d),
+    .progress_detail = progress_detail, .plan = plan, .result_cost = result_cost,
+    .result = result, .pack = pack, .failure_note = failure_note, .export_dim = 3, .pack_what = "sphere list",
     .pack_output = "spheres", .phases = phases};

@@ -72,6 +72,30 @@ void gpd_kind_names(char *buf, size_t n, const char *quote, const char *sep)
     for (size_t i = 0; table[i]; i++) join(buf, n, i == 0, sep, quote, table[i]->name);
 }
 
+json_t *gpd_brief_new(const json_t *spec, const char *headline, json_t *particles,
+                      json_t *achieved)
+{
+    json_t *target = json_object_get(spec, headline);
+    return json_pack("{s:o, s:O, s:{s:s, s:O, s:o}}", "particles",
+                     particles ? particles : json_null(), "seed",
+                     json_object_get(spec, "seed") ? json_object_get(spec, "seed") : json_null(),
+                     "headline", "name", headline, "target", target ? target : json_null(),
+                     "achieved", achieved ? achieved : json_null());
+}
+
+char *gpd_brief_text(const char *kind, const char *spec, const char *summary)
+{
+    const gpd_kind *k = gpd_kind_find(kind);
+    json_t *sj = k && spec ? json_loads(spec, 0, NULL) : NULL;
+    json_t *rj = sj && summary ? json_loads(summary, 0, NULL) : NULL;
+    json_t *b = sj ? k->brief(sj, rj ? json_object_get(rj, "stats") : NULL) : NULL;
+    char *text = b ? json_dumps(b, JSON_COMPACT) : NULL;
+    json_decref(b);
+    json_decref(rj);
+    json_decref(sj);
+    return text;
+}
+
 /* "a, b, c" as ["a", "b", "c"] */
 static json_t *words(const char *list)
 {

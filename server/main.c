@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "http.h"
+#include "kind.h"
 #include "maint.h"
 #include "store.h"
 #include "util.h"
@@ -194,6 +195,9 @@ static int open_store(const char *db)
                 "recovered after an unclean stop: %d running job(s) requeued, %d failed after %d "
                 "attempts",
                 requeued, failed, STORE_MAX_ATTEMPTS);
+    /* jobs stored by a daemon from before briefs get theirs once (not fatal: they show null) */
+    int briefs = store_fill_briefs(gpd_brief_text);
+    if (briefs > 0) gpd_log(GPD_LOG_INFO, "filled in the brief of %d older job(s)", briefs);
     return 0;
 }
 

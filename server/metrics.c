@@ -28,6 +28,7 @@ static const char *const routes[] = {"/",
                                      "/v1/jobs/:id/svg",
                                      "/v1/jobs/:id/export",
                                      "/v1/jobs/:id/spec",
+                                     "/v1/jobs/:id/summary",
                                      "other"};
 #define NROUTES (sizeof routes / sizeof *routes)
 #define ROUTE_JOB 5   /* "/v1/jobs/:id", the subresources follow it */
@@ -51,8 +52,8 @@ static size_t route_of(const char *path)
     if (slash == id) return ROUTE_OTHER;
     const char *sub = slash + 1;
     size_t sl = (size_t)(end - sub);
-    static const char *const subs[] = {"result", "svg", "export", "spec"};
-    for (size_t i = 0; i < 4; i++)
+    static const char *const subs[] = {"result", "svg", "export", "spec", "summary"};
+    for (size_t i = 0; i < sizeof subs / sizeof *subs; i++)
         if (strlen(subs[i]) == sl && !strncmp(subs[i], sub, sl)) return ROUTE_JOB + 1 + i;
     return ROUTE_OTHER;
 }

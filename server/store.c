@@ -95,6 +95,20 @@ static const char *SCHEMA_SQL =
     "CREATE TABLE IF NOT EXISTS summaries(seq INTEGER PRIMARY KEY, summary TEXT NOT NULL,"
     " arrays TEXT);";
 
+/* The jobs' brief (kind.h), a column added after the table: a database made before it gets it
+ * here, and its jobs their briefs from store_fill_briefs. 0, or -1 (logged). */
+static int add_brief_column(sqlite3 *db)
+{
+    if (query_long(db, "SELECT count(*) FROM pragma_table_info('jobs') WHERE name='brief'") > 0)
+        return 0;
+    char *em = NULL;
+    if (sqlite3_exec(db, "ALTER TABLE jobs ADD COLUMN brief TEXT", NULL, NULL, &em) == SQLITE_OK)
+        return 0;
+    gpd_log(GPD_LOG_ERROR, "cannot add the brief column to the jobs table: %s", em ? em : "?");
+    sqlite3_free(em);
+    return -1;
+}
+
 /* a copy of the database's path; NULL once the store is closed (or out of memory) */
 static char *path_copy(void)
 {
@@ -253,6 +267,7 @@ int store_open(const char *path)
         sqlite3_free(em);
         return -1;
     }
+    if (add_brief_column(db)) return -1;
     auto_vacuum = query_long(db, "PRAGMA auto_vacuum") == 2;
     if (!auto_vacuum)
         gpd_log(GPD_LOG_WARN,
@@ -394,8 +409,14 @@ static json_t *text_col(sqlite3_stmt *st, int i)
     return t ? json_string((const char *)t) : json_null();
 }
 
+/* The progress of a job that has ended without success (failed, cancelled): its last phase
+ * and fraction, eta_s null (SQL NULL becomes JSON null) -- no time is left to wait for. */
+#define PROGRESS_ENDED                                                                         \
+    "progress=CASE WHEN json_valid(progress) THEN json_set(progress, '$.eta_s', NULL) "          \
+    "ELSE progress END"
+
 /* job object columns */
-#define JOB_COLS "id, kind, status, created_at, started_at, finished_at, progress, error"
+#define JOB_COLS "id, kind, status, created_at, started_at, finished_at, progress, error, brief"
 
 static json_t *job_from_row(sqlite3_stmt *st)
 {
@@ -414,6 +435,7 @@ static json_t *job_from_row(sqlite3_stmt *st)
     }
     json_object_set_new(j, "progress", p);
     json_object_set_new(j, "error", json_col(st, 7));
+    json_object_set_new(j, "brief", json_col(st, 8));
     return j;
 }
 
@@ -449,8 +471,8 @@ int store_recover(int *requeued, int *failed)
     gpd_now_rfc3339(now, sizeof now);
     int rc = -1;
     if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) return -1;
-    sqlite3_stmt *a = prep(db, "UPDATE jobs SET status='failed', finished_at=?1, error=?2 "
-                               "WHERE status='running' AND attempts >= ?3");
+    sqlite3_stmt *a = prep(db, "UPDATE jobs SET status='failed', finished_at=?1, error=?2, "
+                               PROGRESS_ENDED " WHERE status='running' AND attempts >= ?3");
     sqlite3_stmt *b = prep(db, "UPDATE jobs SET status='queued', started_at=NULL, progress=NULL "
                                "WHERE status='running'");
     if (a && b) {
@@ -481,7 +503,8 @@ int store_recover(int *requeued, int *failed)
     return rc;
 }
 
-store_rc store_insert(const char *kind, const char *spec_json, long max_queued, char id_out[33])
+store_rc store_insert(const char *kind, const char *spec_json, const char *brief_json,
+                      long max_queued, char id_out[33])
 {
     sqlite3 *db = conn();
     if (!db) return STORE_ERROR;
@@ -490,14 +513,15 @@ store_rc store_insert(const char *kind, const char *spec_json, long max_queued, 
     gpd_now_rfc3339(now, sizeof now);
     /* the queue's cap in the same statement: two submits cannot both take the last place (the
      * count walks the status index: 10,000 queued jobs cost well under a millisecond) */
-    sqlite3_stmt *st = prep(db, "INSERT INTO jobs(id, kind, spec, status, created_at) "
-                                "SELECT ?1, ?2, ?3, 'queued', ?4 WHERE ?5 <= 0 OR "
+    sqlite3_stmt *st = prep(db, "INSERT INTO jobs(id, kind, spec, status, created_at, brief) "
+                                "SELECT ?1, ?2, ?3, 'queued', ?4, ?6 WHERE ?5 <= 0 OR "
                                 "(SELECT count(*) FROM jobs WHERE status='queued') < ?5");
     if (!st) return STORE_ERROR;
     int rc = -1;
     if (bind_text(st, 1, id_out) == SQLITE_OK && bind_text(st, 2, kind) == SQLITE_OK &&
         bind_text(st, 3, spec_json) == SQLITE_OK && bind_text(st, 4, now) == SQLITE_OK &&
-        sqlite3_bind_int64(st, 5, max_queued) == SQLITE_OK)
+        sqlite3_bind_int64(st, 5, max_queued) == SQLITE_OK &&
+        bind_text(st, 6, brief_json) == SQLITE_OK)
         rc = step_done(db, st);
     else
         gpd_log(GPD_LOG_ERROR, "sqlite insert: %s", sqlite3_errmsg(db));
@@ -807,7 +831,7 @@ static store_rc succeed_end(sqlite3 *db, const char *id, store_rc rc, int src, g
 }
 
 store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
-                       const void *pack, size_t pack_len, gpd_err *why)
+                       const char *brief_json, const void *pack, size_t pack_len, gpd_err *why)
 {
     gpd_err dummy;
     if (!why) why = &dummy;
@@ -849,6 +873,11 @@ store_rc store_succeed(const char *id, const char *result_json, const char *prog
                               "finished_at=?4, error=NULL WHERE id=?1 AND status='running'",
                           id, result_json, rlen, 1, progress_json, now, &changes);
         if (src == SQLITE_OK) rc = changes > 0 ? STORE_OK : STORE_CONFLICT;
+    }
+    if (rc == STORE_OK && brief_json) {
+        src = write_value(db, "UPDATE jobs SET brief=?2 WHERE id=?1", id, brief_json,
+                          strlen(brief_json), 1, NULL, NULL, &changes);
+        rc = src == SQLITE_OK && changes == 1 ? STORE_OK : STORE_ERROR;
     }
     if (rc == STORE_OK && pack) {
         src = write_value(db, "INSERT OR REPLACE INTO exports(seq, pack) "
@@ -1043,6 +1072,88 @@ store_rc store_get_summary(const char *id, char **text, size_t *len,
     return summary_by_scan(id, text, len, spans);
 }
 
+/* ---- briefs of jobs stored before briefs ---- */
+
+#define BRIEF_BATCH 64 /* jobs a pass of store_fill_briefs reads, then writes in one transaction
+                        * (the LIMIT below) */
+
+typedef struct brief_row {
+    char id[33];
+    char *kind, *spec, *brief;
+    int succeeded;
+} brief_row;
+
+/* Up to BRIEF_BATCH jobs without a brief (their id, kind, spec and whether they succeeded):
+ * how many, or -1. */
+static int brief_rows(sqlite3 *db, brief_row *rows)
+{
+    sqlite3_stmt *st = prep(db, "SELECT id, kind, spec, status FROM jobs WHERE brief IS NULL "
+                                "ORDER BY seq LIMIT 64");
+    if (!st) return -1;
+    int n = 0, s = SQLITE_DONE;
+    while (n < BRIEF_BATCH && (s = sqlite3_step(st)) == SQLITE_ROW) {
+        brief_row *r = &rows[n++];
+        snprintf(r->id, sizeof r->id, "%s", (const char *)sqlite3_column_text(st, 0));
+        r->kind = strdup((const char *)sqlite3_column_text(st, 1));
+        r->spec = strdup((const char *)sqlite3_column_text(st, 2));
+        r->succeeded = !strcmp((const char *)sqlite3_column_text(st, 3), "succeeded");
+    }
+    done(st);
+    if (n == BRIEF_BATCH || s == SQLITE_DONE) return n;
+    for (int i = 0; i < n; i++) { /* a failed read: nothing is kept */
+        free(rows[i].kind);
+        free(rows[i].spec);
+    }
+    return -1;
+}
+
+/* Writes the briefs of rows (JSON null where none could be made) in one transaction; 0, or -1. */
+static int brief_write(sqlite3 *db, brief_row *rows, int n)
+{
+    if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) return -1;
+    int rc = 0;
+    for (int i = 0; i < n && rc == 0; i++) {
+        sqlite3_stmt *u = prep(db, "UPDATE jobs SET brief=?2 WHERE id=?1");
+        if (!u || bind_text(u, 1, rows[i].id) != SQLITE_OK ||
+            bind_text(u, 2, rows[i].brief ? rows[i].brief : "null") != SQLITE_OK ||
+            step_done(db, u))
+            rc = -1;
+        done(u);
+    }
+    if (rc == 0 && sqlite3_exec(db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK) rc = -1;
+    if (!sqlite3_get_autocommit(db)) sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL);
+    return rc;
+}
+
+int store_fill_briefs(store_brief_fn make)
+{
+    sqlite3 *db = conn();
+    if (!db) return -1;
+    brief_row rows[BRIEF_BATCH];
+    int filled = 0, n;
+    while ((n = brief_rows(db, memset(rows, 0, sizeof rows))) > 0) {
+        for (int i = 0; i < n; i++) {
+            char *summary = NULL, st[16];
+            if (rows[i].succeeded) store_get_summary(rows[i].id, &summary, NULL, NULL, st);
+            if (rows[i].kind && rows[i].spec)
+                rows[i].brief = make(rows[i].kind, rows[i].spec, summary);
+            free(summary);
+        }
+        int rc = brief_write(db, rows, n);
+        for (int i = 0; i < n; i++) {
+            free(rows[i].kind);
+            free(rows[i].spec);
+            free(rows[i].brief);
+        }
+        if (rc) break;
+        filled += n;
+    }
+    /* n > 0: a batch could not be written; n < 0: not read */
+    if (n != 0)
+        gpd_log(GPD_LOG_ERROR, "filling in the briefs of older jobs: %s", sqlite3_errmsg(db));
+    return n == 0 ? filled : -1;
+}
+
 store_rc store_fail(const char *id, const char *code, const char *message)
 {
     char now[40];
@@ -1053,8 +1164,8 @@ store_rc store_fail(const char *id, const char *code, const char *message)
     char *et = e ? json_dumps(e, JSON_COMPACT) : NULL;
     json_decref(e);
     if (!et) return STORE_ERROR;
-    store_rc rc = update_running("UPDATE jobs SET status='failed', error=?2, finished_at=?3 "
-                                 "WHERE id=?1 AND status='running'",
+    store_rc rc = update_running("UPDATE jobs SET status='failed', error=?2, finished_at=?3, "
+                                 PROGRESS_ENDED " WHERE id=?1 AND status='running'",
                                  id, et, now, NULL);
     free(et);
     return rc;
@@ -1084,7 +1195,7 @@ store_rc store_cancel(const char *id, int *was_running, char status_out[16], cha
     sqlite3_stmt *q = prep(db, "SELECT status, kind FROM jobs WHERE id=?1");
     sqlite3_stmt *u = prep(db, "UPDATE jobs SET status='cancelled', finished_at=?2, "
                                "error='{\"code\":\"cancelled\",\"message\":\"cancelled by a "
-                               "DELETE request\"}' WHERE id=?1");
+                               "DELETE request\"}', " PROGRESS_ENDED " WHERE id=?1");
     if (q && u) {
         bind_text(q, 1, id);
         int s = sqlite3_step(q);

@@ -14,6 +14,10 @@
  *   result      TEXT                               JSON, written in the same statement as
  *                                                  status='succeeded' (durable before it shows)
  *   attempts    INTEGER NOT NULL DEFAULT 0         times a worker claimed the job
+ *   brief       TEXT                               JSON, the job object's "brief" (kind.h):
+ *                                                  written at submit, replaced at success;
+ *                                                  added by store_open to a database made
+ *                                                  before it, filled by store_fill_briefs
  * and exports(seq INTEGER PRIMARY KEY = jobs.seq, pack BLOB NOT NULL): the export pack of a
  * succeeded job (core/export/gp_export.h), committed with the result;
  * and summaries(seq INTEGER PRIMARY KEY = jobs.seq, summary TEXT NOT NULL, arrays TEXT): the
@@ -72,10 +76,21 @@ void store_thread_done(void);
 /* Crash recovery at startup (rule above). Returns the number of jobs requeued and failed. */
 int store_recover(int *requeued, int *failed);
 
-/* Inserts a queued job; fills id. With max_queued > 0 the job is inserted only while fewer than
- * max_queued jobs are queued, checked in the same statement (atomic with respect to every
- * other writer): STORE_FULL when the queue is full. */
-store_rc store_insert(const char *kind, const char *spec_json, long max_queued, char id_out[33]);
+/* Inserts a queued job (brief_json: its brief, may be NULL); fills id. With max_queued > 0 the
+ * job is inserted only while fewer than max_queued jobs are queued, checked in the same
+ * statement (atomic with respect to every other writer): STORE_FULL when the queue is full. */
+store_rc store_insert(const char *kind, const char *spec_json, const char *brief_json,
+                      long max_queued, char id_out[33]);
+
+/* Makes the brief of a job as text (malloc'ed; NULL when it cannot) from its kind, its effective
+ * spec and, when it has succeeded, its result summary (NULL otherwise): gpd_brief_text. */
+typedef char *(*store_brief_fn)(const char *kind, const char *spec, const char *summary);
+/* Fills in the brief of every job that has none (stored by a daemon from before briefs): from
+ * its spec, and its summary once succeeded (store_get_summary: a scan of the result where the
+ * summary was not stored either). A job whose brief cannot be made gets JSON null, so that it is
+ * not tried again. Run once at start-up, before the workers. Returns how many were filled, -1
+ * on an error (logged). */
+int store_fill_briefs(store_brief_fn make);
 
 /* The job object of api.md (a new reference), or NULL with *rc set. */
 json_t *store_get_job(const char *id, store_rc *rc);
@@ -117,7 +132,10 @@ store_rc store_progress(const char *id, const char *progress_json);
  * STORE_ERROR: anything else (disk full, I/O error, a failed commit...), which may pass on a
  * retry. On both, why (may be NULL) gets a sentence saying what went wrong (status 500). */
 store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
-                       const void *pack, size_t pack_len, gpd_err *why);
+                       const char *brief_json, const void *pack, size_t pack_len, gpd_err *why);
+/* brief_json: the brief with what the run achieved (NULL: the one of the submit is kept).
+ * store_fail, store_cancel and the restart rule's failures keep the last progress's phase and
+ * fraction and set its eta_s to null: a job that has ended says no time is left to wait. */
 store_rc store_fail(const char *id, const char *code, const char *message);
 /* Back to queued (graceful shutdown): the attempt is not counted. */
 store_rc store_requeue(const char *id);

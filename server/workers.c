@@ -1,6 +1,7 @@
 /* workers.c -- worker threads: claim, run, progress, cancel, requeue on shutdown. */
 #include "workers.h"
 
+#include <errno.h>
 #include <malloc.h>
 #include <math.h>
 #include <pthread.h>
@@ -13,6 +14,7 @@
 
 #include "kind.h"
 #include "metrics.h"
+#include "progress.h"
 #include "result_json.h"
 
 #define PROGRESS_MIN_INTERVAL_S 0.25 /* <= 4 Hz per job */
@@ -160,12 +162,22 @@ typedef struct run_ctx {
     slot *s;
     const char *id;
     const gpd_kind *kind;
+    const json_t *spec_json; /* the effective spec */
     double t0;
     double last_write;
     char phase[32]; /* the last phase the core reported ("starting" before the first) */
+    gpd_progress_model pm; /* the fraction and ETA (progress.h); planned: it has a plan */
+    int planned;
+    /* the ticker: a thread that writes the progress of the "result" phase, during which the
+     * worker builds, packs and serialises the result and no core reports come */
+    pthread_t tick_thread;
+    int ticking;
+    int tick_stop; /* guarded by tick_mu */
+    pthread_mutex_t tick_mu;
+    pthread_cond_t tick_cv;
 } run_ctx;
 
-/* detail: NULL = {} (taken) */
+/* detail: NULL = {} (taken); eta: NaN = null */
 static char *progress_text(const char *phase, double fraction, double eta, json_t *detail)
 {
     if (!detail) detail = json_object();
@@ -185,6 +197,19 @@ static void write_progress(run_ctx *c, char *text)
     free(text);
 }
 
+/* The fraction and ETA at now: the progress model's; without a plan (the kind could not make
+ * one) the core's own fraction, extrapolated. */
+static void estimate(run_ctx *c, const gp_progress *p, double now, double *f, double *eta)
+{
+    if (c->planned) {
+        gpd_progress_estimate(&c->pm, now, f, eta);
+        return;
+    }
+    *f = p && p->fraction >= 0 ? fmin(p->fraction, 1) : 0;
+    double elapsed = now - c->t0;
+    *eta = (*f >= 0.01 && *f < 1) ? elapsed * (1 - *f) / *f : NAN;
+}
+
 /* The core's progress callback: a throttled write, with the kind's detail; returns non-zero
  * when the job must stop. */
 static int on_progress(void *user, const gp_progress *p)
@@ -194,26 +219,79 @@ static int on_progress(void *user, const gp_progress *p)
         snprintf(c->phase, sizeof c->phase, "%s", p->phase);
     if (__atomic_load_n(&c->s->cancel, __ATOMIC_RELAXED)) return 1;
     double now = gpd_monotonic_s();
+    gpd_progress_report(&c->pm, p->phase, p->phase_fraction, now);
     if (now - c->last_write < PROGRESS_MIN_INTERVAL_S) return 0;
     c->last_write = now;
-    double f = p->fraction;
-    if (!(f >= 0)) f = 0;
-    if (f > 1) f = 1;
-    double elapsed = now - c->t0;
-    double eta = (f >= 0.01 && f < 1) ? elapsed * (1 - f) / f : (f >= 1 ? 0 : NAN);
-    write_progress(c, progress_text(p->phase, f, eta, c->kind->progress_detail(p)));
+    double f, eta;
+    estimate(c, p, now, &f, &eta);
+    /* the core's "done" comes before the result is written: the model's phase stays shown */
+    const char *name = p->phase && strcmp(p->phase, "done") ? p->phase
+                                                             : gpd_progress_phase(&c->pm);
+    write_progress(c, progress_text(name, f, eta, c->kind->progress_detail(p)));
     return __atomic_load_n(&c->s->cancel, __ATOMIC_RELAXED);
 }
 
-/* Says "result" in the job's progress while a large result is built and written (seconds for
- * 10^5 spheres or 10^4 grains), keeping the 4 Hz bound: waits out what is left of the interval
- * since the last write (at most 0.25 s, next to seconds of work). */
-static void report_result_phase(run_ctx *c, double fraction)
+/* One write of the "result" phase's progress (the ticker's; the interval is its own). */
+static void write_result_progress(run_ctx *c)
 {
-    gpd_sleep_s(c->last_write + PROGRESS_MIN_INTERVAL_S - gpd_monotonic_s());
+    double now = gpd_monotonic_s(), f, eta;
+    estimate(c, NULL, now, &f, &eta);
+    c->last_write = now;
+    write_progress(c, progress_text("result", c->planned ? f : 1.0, c->planned ? eta : NAN,
+                                    NULL));
+}
+
+static void *ticker_main(void *arg)
+{
+    run_ctx *c = arg;
+    pthread_mutex_lock(&c->tick_mu);
+    while (!c->tick_stop) {
+        struct timespec dl;
+        clock_gettime(CLOCK_REALTIME, &dl);
+        dl.tv_nsec += (long)(PROGRESS_MIN_INTERVAL_S * 1e9);
+        if (dl.tv_nsec >= 1000000000L) {
+            dl.tv_sec++;
+            dl.tv_nsec -= 1000000000L;
+        }
+        if (pthread_cond_timedwait(&c->tick_cv, &c->tick_mu, &dl) != ETIMEDOUT) continue;
+        pthread_mutex_unlock(&c->tick_mu);
+        write_result_progress(c);
+        pthread_mutex_lock(&c->tick_mu);
+    }
+    pthread_mutex_unlock(&c->tick_mu);
+    store_thread_done(); /* its connection */
+    return NULL;
+}
+
+/* Enters the "result" phase (its cost from the built specimen) and starts the ticker that
+ * shows it moving; without a thread the phase shows once. */
+static void result_phase_start(run_ctx *c, const void *specimen)
+{
     snprintf(c->phase, sizeof c->phase, "result");
-    c->last_write = gpd_monotonic_s();
-    write_progress(c, progress_text("result", fraction, NAN, NULL));
+    gpd_progress_result(&c->pm, c->kind->result_cost(specimen), gpd_monotonic_s());
+    c->tick_stop = 0;
+    pthread_mutex_init(&c->tick_mu, NULL);
+    pthread_cond_init(&c->tick_cv, NULL);
+    c->ticking = pthread_create(&c->tick_thread, NULL, ticker_main, c) == 0;
+    if (!c->ticking) {
+        pthread_mutex_destroy(&c->tick_mu);
+        pthread_cond_destroy(&c->tick_cv);
+        write_result_progress(c);
+    }
+}
+
+/* Stops the ticker (at once; no write of it comes after); a no-op when none runs. */
+static void result_phase_stop(run_ctx *c)
+{
+    if (!c->ticking) return;
+    pthread_mutex_lock(&c->tick_mu);
+    c->tick_stop = 1;
+    pthread_cond_signal(&c->tick_cv);
+    pthread_mutex_unlock(&c->tick_mu);
+    pthread_join(c->tick_thread, NULL);
+    pthread_mutex_destroy(&c->tick_mu);
+    pthread_cond_destroy(&c->tick_cv);
+    c->ticking = 0;
 }
 
 /* ------------------------------------------------------------------ one job */
@@ -345,16 +423,16 @@ static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err, const
 /* The result text, the "done" progress and the pack committed with status succeeded; a write
  * the database refuses is tried once more, and a result it can never take fails the job.
  * timings: the result's "timings" (may be NULL), observed by the metrics once it is stored. */
-static void store_result(run_ctx *ctx, const char *text, const char *prog, const void *pack,
-                         size_t pack_len, const json_t *timings)
+static void store_result(run_ctx *ctx, const char *text, const char *prog, const char *brief,
+                         const void *pack, size_t pack_len, const json_t *timings)
 {
     gpd_err why;
-    store_rc rc = store_succeed(ctx->id, text, prog, pack, pack_len, &why);
+    store_rc rc = store_succeed(ctx->id, text, prog, brief, pack, pack_len, &why);
     if (rc == STORE_ERROR) { /* maybe passing (busy, I/O): once more after a pause */
         gpd_log(GPD_LOG_WARN, "job %s: storing the result failed (%s); retrying once", ctx->id,
                 why.msg);
         gpd_sleep_s(STORE_RETRY_PAUSE_S);
-        rc = store_succeed(ctx->id, text, prog, pack, pack_len, &why);
+        rc = store_succeed(ctx->id, text, prog, brief, pack, pack_len, &why);
     }
     char msg[600];
     if (rc == STORE_OK) {
@@ -383,8 +461,13 @@ static void finish_succeeded(run_ctx *ctx, json_t *r, json_t *detail, void *pack
 {
     char *text = r ? gpd_dumps_c(r, JSON_COMPACT | JSON_REAL_PRECISION(17), &ctx->s->cancel)
                    : NULL;
+    result_phase_stop(ctx); /* what follows writes the job's final state */
     /* the timings (a few numbers) outlive the tree, for the metrics */
     json_t *timings = r ? json_deep_copy(json_object_get(r, "timings")) : NULL;
+    /* the brief with what was achieved, from the result's stats (NULL: the submit's is kept) */
+    json_t *bj = r ? ctx->kind->brief(ctx->spec_json, json_object_get(r, "stats")) : NULL;
+    char *brief = bj ? json_dumps(bj, JSON_COMPACT) : NULL;
+    json_decref(bj);
     reap_later(r);
     int reason = __atomic_load_n(&ctx->s->reason, __ATOMIC_RELAXED);
     int stopped = __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED) &&
@@ -405,8 +488,9 @@ static void finish_succeeded(run_ctx *ctx, json_t *r, json_t *detail, void *pack
         finish_failed(ctx->id, ctx->kind->name, ctx->t0, "internal",
                       "out of memory while serialising the result");
     } else {
-        store_result(ctx, text, prog, pack, pack_len, timings);
+        store_result(ctx, text, prog, brief, pack, pack_len, timings);
     }
+    free(brief);
     json_decref(timings);
     json_decref(detail);
     free(text);
@@ -437,9 +521,10 @@ static void unavailable(const char *id, const char *kind)
 static void finish_built(run_ctx *ctx, const void *spec, const json_t *spec_json, void *out)
 {
     const gpd_kind *k = ctx->kind;
-    if (k->large_result(out)) report_result_phase(ctx, 1.0);
+    result_phase_start(ctx, out);
     json_t *r = k->result(out, spec, spec_json, &ctx->s->cancel);
     if (!r || __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED)) { /* (r: partial) */
+        result_phase_stop(ctx);
         reap_later(r);
         k->destroy(out);
         result_not_built(ctx);
@@ -471,8 +556,12 @@ static void run_kind(slot *s, const char *id, const gpd_kind *k, const json_t *s
         finish_failed(id, k->name, 0, "invalid_spec", prob.message);
         return;
     }
-    run_ctx ctx = {.s = s, .id = id, .kind = k, .t0 = gpd_monotonic_s(), .last_write = 0,
-                   .phase = "starting"};
+    run_ctx ctx = {.s = s, .id = id, .kind = k, .spec_json = spec_json, .t0 = gpd_monotonic_s(),
+                   .last_write = 0, .phase = "starting"};
+    gpd_phase plan[GPD_PLAN_MAX];
+    int nplan = k->plan(spec, spec_json, plan, GPD_PLAN_MAX);
+    ctx.planned = nplan > 0;
+    gpd_progress_init(&ctx.pm, plan, nplan, ctx.t0);
     gp_error err;
     gp_error_clear(&err);
     gp_status st = GP_ERR_INTERNAL;

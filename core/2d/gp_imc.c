@@ -701,7 +701,8 @@ static int report(gp_progress_fn progress, void *user, const gp_imc_params *p, r
         frac = 1.0;
     else if (ro->error0 > p->threshold && error > 0.0)
         frac = fmin(1.0, fmax(0.0, log(ro->error0 / error) / log(ro->error0 / p->threshold)));
-    gp_progress r = {.phase = "imc", .fraction = frac, .steps = ro->steps, .error = error};
+    gp_progress r = {.phase = "imc", .fraction = frac, .phase_fraction = frac, .steps = ro->steps,
+                     .error = error};
     return progress(user, &r);
 }
 

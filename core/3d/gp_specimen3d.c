@@ -75,6 +75,13 @@
 #define RELAX_DAMPING 0.7        /* local damping during relaxation (the static state does not
                                     depend on it; Sc <= 1e-4 comes ~2x sooner than at 0.2) */
 
+/* the phase fractions of the progress reports (gp_progress.h) */
+#define COMPACT_GAP_END 3e-4     /* compaction: the log of the wall's gap to b_z, from its start
+                                    to this fraction of b_z (nearly the end: the last stretch,
+                                    at a constant speed, is quicker on this scale) */
+#define TILE_FLIP_PF 0.4         /* tiling: the flip done ... */
+#define TILE_MEASURE_PF 0.6      /* ... and the tiled relaxation, before the measures */
+
 static const gp_sieve_row TABLE2[5] = {
     {0.010, 0}, {0.020, 2}, {0.050, 50}, {0.080, 95}, {0.100, 100}};
 
@@ -113,8 +120,8 @@ static int cancel_raised(const volatile int *cancel)
     return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
 }
 
-static int report(progress_ctx *c, const char *phase, double fraction, long steps, double porosity,
-                  double sc, int force)
+static int report(progress_ctx *c, const char *phase, double fraction, double pf, long steps,
+                  double porosity, double sc, int force)
 {
     if (cancel_raised(c->cancel))
         return 1;
@@ -126,10 +133,19 @@ static int report(progress_ctx *c, const char *phase, double fraction, long step
     c->last = t;
     gp_progress p = {.phase = phase,
                      .fraction = fraction < 0 ? 0 : (fraction > 1 ? 1 : fraction),
+                     .phase_fraction = pf < 0 ? 0 : (pf > 1 ? 1 : pf),
                      .steps = steps,
                      .porosity = porosity,
                      .stability = isfinite(sc) ? sc : 0};
     return c->fn(c->user, &p) != 0;
+}
+
+/* How far a gap closing towards end has come from g0, on a log scale: 0 at g0, 1 at end or
+ * below (a servo's gap and S_c both close about exponentially: this grows with the time). */
+static double gap_progress(double g0, double g, double end)
+{
+    if (!(g0 > end) || !(g > end)) return 1;
+    return fmax(0, log(g0 / g) / log(g0 / end));
 }
 
 void gp_specimen3d_destroy(gp_specimen3d *s)
@@ -361,7 +377,9 @@ static gp_status relax_tiled(const gp_spec3d *spec, const gp_dem3d_params *dp, p
     for (long s = 0; !st && s < spec->tile_relax_steps; s += CHUNK) {
         st = gp_dem3d_run(dem, CHUNK, err);
         gp_dem3d_get_state(dem, &ds);
-        if (!st && report(rc, "tiling", 0.9 + 0.1 * s / spec->tile_relax_steps,
+        double f = (double)s / spec->tile_relax_steps;
+        if (!st && report(rc, "tiling", 0.9 + 0.1 * f,
+                          TILE_FLIP_PF + (TILE_MEASURE_PF - TILE_FLIP_PF) * f,
                           S->steps + ds.steps, spec->porosity, ds.stability, 0))
             st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
         if (ds.stability <= STABILITY)
@@ -649,7 +667,8 @@ static gp_status deposit(build_run *R)
         gp_dem3d_set_radius_scale(dem, lam + (1 - lam) * (double)(s + 10) / grow_steps);
         if ((st = gp_dem3d_run(dem, 10, R->err)))
             return st;
-        if (report(&R->rc, "deposition", 0.1 * s / grow_steps, s, 0, 0, 0))
+        if (report(&R->rc, "deposition", 0.1 * s / grow_steps,
+                   (double)s / (grow_steps + settle_steps), s, 0, 0, 0))
             return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
     }
     gp_dem3d_set_radius_scale(dem, 1.0);
@@ -657,7 +676,8 @@ static gp_status deposit(build_run *R)
         if ((st = gp_dem3d_run(dem, CHUNK, R->err)))
             return st;
         gp_dem3d_get_state(dem, ds);
-        if (report(&R->rc, "deposition", 0.1 + 0.1 * s / settle_steps, ds->steps, 0,
+        if (report(&R->rc, "deposition", 0.1 + 0.1 * s / settle_steps,
+                   (double)(grow_steps + s) / (grow_steps + settle_steps), ds->steps, 0,
                    ds->stability, 0))
             return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
         if (ds->stability < SETTLE_SC)
@@ -696,8 +716,9 @@ static gp_status compact(build_run *R)
         gp_dem3d_get_state(dem, ds);
         double h = gp_dem3d_wall(dem, 5);
         double por = 1 - vs / (area * h);
-        if (report(&R->rc, "compaction", 0.2 + 0.4 * fmin(1, (H0 - h) / (H0 - B[2])), ds->steps,
-                   por, ds->stability, 0))
+        if (report(&R->rc, "compaction", 0.2 + 0.4 * fmin(1, (H0 - h) / (H0 - B[2])),
+                   gap_progress(H0 - B[2], h - B[2], COMPACT_GAP_END * B[2]), ds->steps, por,
+                   ds->stability, 0))
             return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
         R->pushed |= ds->wall_force[5] > 0;
         if (h <= B[2]) {
@@ -791,6 +812,7 @@ static gp_status relax(build_run *R)
         gp_dem3d_set_friction(dem, spec->material.friction_deg);
         gp_dem3d_set_damping(dem, fmax(spec->material.damping, RELAX_DAMPING));
         double h_sink = vs / (area * (1 - (p - POROSITY_SLACK)));
+        double sc0 = -1, pf = 0; /* progress: log(S_c) from its first value towards STABILITY */
         for (int pass = 0; pass < 2 && R->outcome == GP_OK; pass++) {
             if (pass == 1) {
                 if (ds->wall_force[5] > 0 || !R->pushed)
@@ -804,7 +826,9 @@ static gp_status relax(build_run *R)
                 gp_dem3d_get_state(dem, ds);
                 double sc = ds->stability;
                 double fr = log(fmax(sc, STABILITY) / 1.0) / log(STABILITY);
-                if (report(&R->rc, "relaxation", 0.6 + 0.3 * fmin(1, fmax(0, fr)), ds->steps,
+                if (sc0 < 0) sc0 = fmax(sc, 2 * STABILITY);
+                pf = fmax(pf, gap_progress(sc0, sc, STABILITY));
+                if (report(&R->rc, "relaxation", 0.6 + 0.3 * fmin(1, fmax(0, fr)), pf, ds->steps,
                            1 - vs / (area * gp_dem3d_wall(dem, 5)), sc, 0))
                     return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
                 /* (pass 1: and the wall is back on the packing, or as low as it may go) */
@@ -878,12 +902,12 @@ static gp_status tile_sample(build_run *R)
         S->porosity = S->sample_porosity;
         return GP_OK;
     }
-    report(&R->rc, "tiling", 0.9, S->steps, R->p, S->stability, 1);
+    report(&R->rc, "tiling", 0.9, 0, S->steps, R->p, S->stability, 1);
     gp_status st = gp_flip_tile(R->xyzr, R->n, res->sample_box, spec->tiling,
                                 MAX_TILED_SPHERES, R->cancel, &R->tiled, &R->ntiled, R->err);
     /* (the reports between the steps show the phase: a tiling of 10^7 spheres takes
      * seconds, and the first report may have come too soon after the last to be shown) */
-    if (!st && report(&R->rc, "tiling", 0.93, S->steps, R->p, S->stability, 0))
+    if (!st && report(&R->rc, "tiling", 0.93, TILE_FLIP_PF, S->steps, R->p, S->stability, 0))
         st = gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
     for (int a = 0; a < 3; a++)
         res->box[a] = res->sample_box[a] * spec->tiling[a];
@@ -902,7 +926,8 @@ static gp_status tile_sample(build_run *R)
 static gp_status measure_final(build_run *R)
 {
     gp_stats3d *S = &R->res->stats;
-    if (report(&R->rc, "tiling", 0.96, S->steps, R->p, S->stability, 0))
+    if (report(&R->rc, "tiling", 0.96, R->tile ? TILE_MEASURE_PF : 0, S->steps, R->p,
+               S->stability, 0))
         return gp_error_set(R->err, GP_ERR_CANCELLED, "cancelled");
     S->particles = R->tile ? R->ntiled : R->n;
     R->res->count = S->particles;
@@ -959,7 +984,8 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress_fn progress, vo
     }
     res->t_tiling = gp_clock_seconds() - t_phase;
     hand_out_spheres(&R);
-    report(&R.rc, "tiling", 1.0, res->stats.steps, res->stats.porosity, res->stats.stability, 1);
+    report(&R.rc, "tiling", 1.0, 1.0, res->stats.steps, res->stats.porosity, res->stats.stability,
+           1);
     build_run_release(&R);
     res->t_total = gp_clock_seconds() - t0;
     *out = res;

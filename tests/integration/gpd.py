@@ -57,7 +57,8 @@ TIME_SCALE = float(os.environ.get("GPD_TEST_TIME_SCALE", "1"))
 
 VIEWS_2D = ["packing", "cells", "size", "orientation", "descriptors"]
 FINAL = ("succeeded", "failed", "cancelled")
-JOB_KEYS = {"id", "kind", "status", "created_at", "started_at", "finished_at", "progress", "error"}
+JOB_KEYS = {"id", "kind", "status", "created_at", "started_at", "finished_at", "progress", "error",
+            "brief"}
 
 
 class Daemon:
@@ -247,6 +248,19 @@ def check_job_object(j):
     assert set(p) >= {"phase", "fraction", "eta_s", "detail"}, p
     assert 0.0 <= p["fraction"] <= 1.0, p
     assert j["error"] is None or set(j["error"]) >= {"code", "message"}, j
+    check_brief(j["brief"])
+
+
+def check_brief(b):
+    """The job object's brief (README: the job's brief)."""
+    assert set(b) == {"particles", "seed", "headline"}, b
+    assert b["particles"] is None or (isinstance(b["particles"], int) and b["particles"] > 0), b
+    assert isinstance(b["seed"], int) and b["seed"] >= 0, b
+    h = b["headline"]
+    assert set(h) == {"name", "target", "achieved"} and h["name"] in ("solid_fraction",
+                                                                       "porosity"), b
+    assert isinstance(h["target"], (int, float)), b
+    assert h["achieved"] is None or isinstance(h["achieved"], (int, float)), b
 
 
 def main(tests):
