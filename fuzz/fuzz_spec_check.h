@@ -86,6 +86,14 @@ static const char *gp_fuzz_check_2d(const gp_spec2d *s)
     }
     if (s->has_spectrum && (!s->spectrum || s->nspectrum > s->contour_points / 2))
         return "2D: a spectrum longer than contour_points / 2";
+    if (s->shape_form == GP_SHAPE_FORM_DESCRIPTORS && (s->desc_given == 0 || s->desc_given > 15))
+        return "2D: target descriptors without a descriptor";
+    if (s->shape_form == GP_SHAPE_FORM_OUTLINES) {
+        if (!s->outlines || s->noutlines < GP_SHAPE_OUTLINES_MIN) return "2D: too few outlines";
+        for (size_t i = 0; i < s->noutlines; i++)
+            if (!s->outlines[i].pts || s->outlines[i].n < 3) return "2D: an outline of < 3 points";
+    }
+    if (!(s->spread >= 0 && s->spread <= GP_SHAPE_SPREAD_MAX)) return "2D: spread out of [0, 1]";
     if (s->contour_points < 16) return "2D: contour_points < 16";
     if (!(s->solid_fraction > 0 && s->solid_fraction <= 1)) return "2D: solid_fraction out of (0, 1]";
     if (!(s->imc_threshold > 0)) return "2D: imc threshold <= 0";

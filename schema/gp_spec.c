@@ -173,7 +173,9 @@ static const gp_spec_kind *schema_validate(const json_t *spec, gp_spec_problem *
         gp_problem(p, "internal", "", "the embedded schema of kind %s is broken", k->name);
         return NULL;
     }
-    return gp_schema_validate(schema, spec, p) ? NULL : k;
+    if (gp_schema_validate(schema, spec, p) == 0) return k;
+    if (k->explain) k->explain(spec, p);
+    return NULL;
 }
 
 /* the schema, the kind's rules on the posted spec, then every default; *k the kind. NULL with

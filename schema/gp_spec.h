@@ -7,7 +7,9 @@
  * time. The validator interprets those documents (type, properties, required,
  * additionalProperties, minimum/maximum/exclusiveMinimum/exclusiveMaximum, minItems/maxItems,
  * items, prefixItems, enum, const, oneOf, uniqueItems, minLength/maxLength, local $ref) and the
- * defaults are read from their "default" keywords.
+ * defaults are read from their "default" keywords. Other keywords are annotations to the
+ * engine: the one the schemas use, minProperties (shape.descriptors), is checked by the kind's
+ * C code with its own message.
  *
  * Layout (schema/): gp_schema_engine.c, the generic JSON Schema interpreter; gp_spec.c, the
  * table of kinds and what they share (dispatch, defaults, problems, bounds entry points);
@@ -33,9 +35,18 @@
  *                     (self-intersecting polygon, hole outside the container, sieve rows not
  *                     increasing, largest sieve diameter larger than the box, a size.cov out of
  *                     its law's range, a field that size.law excludes or needs, an E1-E3
- *                     imc.threshold below the integer-count floor of the cell count, ...);
+ *                     imc.threshold below the integer-count floor of the cell count, two shape
+ *                     forms mixed (at the field that starts the second: "/shape/descriptors:
+ *                     cannot be combined with "D2" ..."), empty shape.descriptors, target
+ *                     descriptors that no star-shaped Fourier grain reaches (at
+ *                     /shape/descriptors/<name>, the first in the order elongation,
+ *                     circularity, roundness, regularity, with the nearest reachable value:
+ *                     gp_shapemap_check), an outline that is not star-shaped from any interior
+ *                     point, crosses itself or has no area (at /shape/outlines/<i>, the first,
+ *                     naming the others), ...);
  *   "too_large"    -- a 2D sieve law whose derived cell count exceeds the schema's particles
- *                     maximum (/size/sieve); a 3D sample of more spheres than the DEM takes
+ *                     maximum (/size/sieve); 2D shape.outlines of more than 1,000,000 vertices
+ *                     in all (/shape/outlines); a 3D sample of more spheres than the DEM takes
  *                     (/box) or a tiling beyond its sphere limit (/tiling); a spec whose
  *                     estimated work is over GP_SPEC_WORK_BUDGET_S (see gp_spec_bounds), at the
  *                     field that drives it; a result over the server's bound;
@@ -95,10 +106,13 @@ json_t *gp_spec_with_defaults(const json_t *spec, gp_spec_problem *p);
 /* Parses an effective spec of the 2D kind -- one that gp_spec_with_defaults() returned (or
  * its JSON text read back) -- into *out, WITHOUT validating it again: the input must come from
  * gp_spec_with_defaults. out->threads is 0 (the caller picks); out->particles
- * is 0 with a sieve law, whose sieve_d are in metres, converted from size.sieve_units. A cheap
+ * is 0 with a sieve law, whose sieve_d are in metres, converted from size.sieve_units. The
+ * shape: shape_form and its fields (D2 .. beta; spectrum; desc_given and desc_target; outlines
+ * as given, vertices in their order), spread and spread_given (absent: 0 and 0). A cheap
  * guard only: another kind is refused with invalid_spec at /kind, a field missing or of the
  * wrong form with "internal" at that field. Returns 0 on success; *out then owns its arrays
- * (outer.pts, holes[*].pts, holes, spectrum, sieve_d, sieve_pass) and must be released with
+ * (outer.pts, holes[*].pts, holes, spectrum, sieve_d, sieve_pass, outlines[*].pts, outlines)
+ * and must be released with
  * gp_spec2d_free(). On failure returns -1, fills *p, and *out owns nothing (freeing it is still
  * allowed). */
 int gp_spec2d_read(const json_t *effective_spec, gp_spec2d *out, gp_spec_problem *p);
@@ -117,8 +131,10 @@ void gp_spec3d_free(gp_spec3d *s);
  * spelling (1e6 is the integer 1000000), in one place per kind:
  *   2D: cells = particles, or the count a sieve law derives; the IMC at its cap
  *     (imc.max_steps moves, each costing a little more on more cells), the filling, ODEC and
- *     descriptors per grain in proportion to contour_points; the result as server/http.c has
- *     always estimated it (bytes per grain by outputs and contour_points);
+ *     descriptors per grain in proportion to contour_points, the shape's own work (target
+ *     descriptors: the fit and the calibration's fills; outlines: one description each); the
+ *     result as server/http.c has always estimated it (bytes per grain by outputs and
+ *     contour_points);
  *   3D: the sample's spheres (gp_sieve_expected_count, the count the DEM draws), its
  *     time step (gp_dem3d.h: 0.3 sqrt(m / 2 E R) at the density-scaling radius of
  *     gp_specimen3d.c) and the steps its protocol needs (durations are multiples of

@@ -1,12 +1,14 @@
 /* gp_spec2d.c -- the kind "fourier-voronoi-2d": the field rules that the schema cannot express
  * (on the spec as posted), the defaults that depend on other fields, the reader of an effective
  * spec into gp_spec2d, its semantic checks (the container's rings through gp_rings, the size
- * law, the spectrum, the cell count, seeding, the IMC threshold, the work budget) and its work
- * and result bounds. See gp_spec.h. */
+ * law, the spectrum, the shape's descriptors and outlines, the cell count, seeding, the IMC
+ * threshold, the work budget) and its work and result bounds. See gp_spec.h. */
 #include "gp_spec_internal.h"
 
 #include "gp_imc.h"
+#include "gp_outline.h"
 #include "gp_rings.h"
+#include "gp_shapemap.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -21,6 +23,16 @@ static const char *const g_errors[] = {"E1", "E2", "E3", "AD"}; /* gp_imc_error_
 static const char *const g_inits[] = {"uniform", "halton"};     /* gp_init_kind */
 static const char *const g_of[] = {"cells", "grains"};          /* size_of_grains */
 static const char *const g_outputs[] = {"grains", "odec", "descriptors", "cells"}; /* GP_OUT2_ */
+/* shape.descriptors' names, in the order of gp_descriptors and GP_SHAPEMAP_BIT */
+static const char *const g_descriptors[] = {"elongation", "roundness", "circularity",
+                                            "regularity"};
+
+/* shape.outlines: vertices in all at most. Why a total: the schema bounds each outline (10,000
+ * points) and their number (10,000), but not the product; the submit check (star shape, by
+ * index) and the run's analysis are linear in the vertices (~0.1 s per million to check), the
+ * stored spec is ~20 bytes a vertex, and a million vertices -- 10,000 outlines of 100 points,
+ * or 1,000 traced at 1,000 -- is more than a mean spectrum and its spread need. */
+#define OUTLINE_VERTICES_MAX 1000000
 
 /* o[key] is the string value */
 static int str_is(const json_t *o, const char *key, const char *value)
@@ -34,7 +46,7 @@ static int str_is(const json_t *o, const char *key, const char *value)
 
 /* size.law decides which size fields belong; checked on the spec as posted, since particles
  * and size.cov have schema defaults */
-static int check_posted_2d(const json_t *spec, gp_spec_problem *p)
+static int check_size_posted(const json_t *spec, gp_spec_problem *p)
 {
     const json_t *size = json_object_get(spec, "size");
     const char *law = json_string_value(json_object_get(size, "law"));
@@ -61,6 +73,59 @@ static int check_posted_2d(const json_t *spec, gp_spec_problem *p)
     if (str_is(size, "of", "cells"))
         return gp_problem(p, "invalid_spec", "/size/of", "expected \"grains\" (or nothing) with "
                           "law \"sieve\", got \"cells\": a sieve curve is a law of the grains");
+    return 0;
+}
+
+/* shape.descriptors names at least one (the schema's minProperties, which its engine leaves
+ * to this check for a clearer message) */
+static int check_shape_posted(const json_t *spec, gp_spec_problem *p)
+{
+    const json_t *d = json_object_get(json_object_get(spec, "shape"), "descriptors");
+    if (!d || json_object_size(d) > 0) return 0;
+    return gp_problem(p, "invalid_spec", "/shape/descriptors", "give at least one of "
+                      "elongation, roundness, circularity, regularity");
+}
+
+static int check_posted_2d(const json_t *spec, gp_spec_problem *p)
+{
+    return check_size_posted(spec, p) || check_shape_posted(spec, p) ? -1 : 0;
+}
+
+/* The shape's forms, by the fields that make them; spread goes with any. */
+static int shape_form_of(const char *key)
+{
+    static const char *const forms[][5] = {{"D2", "D3", "D8", "alpha", "beta"}, {"spectrum"},
+                                           {"descriptors"}, {"outlines"}};
+    for (int f = 0; f < 4; f++)
+        for (int k = 0; k < 5 && forms[f][k]; k++)
+            if (!strcmp(key, forms[f][k])) return f;
+    return -1;
+}
+
+/* explain: a shape that mixes two forms fits no branch of the schema's oneOf, which can only
+ * say "/shape: expected <every form>"; name the field that starts the second form instead */
+static int explain_2d(const json_t *spec, gp_spec_problem *p)
+{
+    const json_t *shape = json_object_get(spec, "shape");
+    if (strcmp(p->pointer, "/shape") != 0 || !json_is_object(shape)) return 0;
+    const char *first = NULL, *key;
+    int form = -1;
+    const json_t *v;
+    json_object_foreach((json_t *)shape, key, v) {
+        int f = shape_form_of(key);
+        if (f < 0) continue;
+        if (form < 0) {
+            form = f;
+            first = key;
+        } else if (f != form) {
+            char ptr[96];
+            snprintf(ptr, sizeof ptr, "/shape/%s", key);
+            gp_problem(p, "invalid_spec", ptr, "cannot be combined with \"%s\": give the shape "
+                       "one way -- D2, D3, D8 (with alpha, beta), spectrum, descriptors or "
+                       "outlines -- each with an optional spread", first);
+            return 1;
+        }
+    }
     return 0;
 }
 
@@ -98,6 +163,8 @@ void gp_spec2d_free(gp_spec2d *s)
     free((double *)s->spectrum);
     free((double *)s->sieve_d);
     free((double *)s->sieve_pass);
+    for (size_t i = 0; s->outlines && i < s->noutlines; i++) free(s->outlines[i].pts);
+    free((gp_ring *)s->outlines);
     memset(s, 0, sizeof *s);
 }
 
@@ -172,9 +239,64 @@ static int read_size_2d(gp_spec_reader *r, const json_t *size, gp_spec2d *out)
     return 0;
 }
 
-/* the descriptors, or a spectrum (D2, D3, D8 then taken from it); -1 out of memory */
+/* shape.descriptors: the given ones and their values */
+static void read_descriptors_2d(gp_spec_reader *r, const json_t *d, gp_spec2d *out)
+{
+    static const char *const ptrs[4] = {"/shape/descriptors/elongation",
+                                        "/shape/descriptors/roundness",
+                                        "/shape/descriptors/circularity",
+                                        "/shape/descriptors/regularity"};
+    out->shape_form = GP_SHAPE_FORM_DESCRIPTORS;
+    for (int k = 0; k < 4; k++) {
+        const json_t *v = gp_rd_member(r, d, ptrs[k], JSON_REAL, 1);
+        if (!v) continue;
+        out->desc_given |= GP_SHAPEMAP_BIT(k);
+        out->desc_target[k] = gp_rd_value(r, v, ptrs[k], -GP_RD_ANY, GP_RD_ANY);
+    }
+}
+
+/* shape.outlines, each as given (gp_outline cleans them and says what it dropped); -1 out of
+ * memory */
+static int read_outlines_2d(gp_spec_reader *r, const json_t *arr, gp_spec2d *out)
+{
+    size_t n = json_array_size(arr);
+    gp_ring *rings = calloc(n ? n : 1, sizeof *rings);
+    if (!rings) return -1;
+    out->shape_form = GP_SHAPE_FORM_OUTLINES;
+    out->outlines = rings;
+    out->noutlines = n;
+    for (size_t i = 0; i < n; i++) {
+        const json_t *o = json_array_get(arr, i);
+        size_t m = json_array_size(o);
+        if (!json_is_array(o) || m < 3) gp_rd_bad(r, "/shape/outlines");
+        rings[i].pts = malloc((m ? m : 1) * sizeof *rings[i].pts);
+        if (!rings[i].pts) return -1;
+        rings[i].n = m;
+        for (size_t k = 0; k < m; k++) {
+            double q[2];
+            gp_rd_pair(r, json_array_get(o, k), "/shape/outlines", q);
+            rings[i].pts[k] = (gp_vec2){q[0], q[1]};
+        }
+    }
+    return 0;
+}
+
+/* the descriptors, or a spectrum (D2, D3, D8 then taken from it), or target descriptors, or
+ * outlines; and the spread of any; -1 out of memory */
 static int read_shape_2d(gp_spec_reader *r, const json_t *shape, gp_spec2d *out)
 {
+    const json_t *spread = gp_rd_member(r, shape, "/shape/spread", JSON_REAL, 1);
+    if (spread) {
+        out->spread = gp_rd_value(r, spread, "/shape/spread", 0, GP_SHAPE_SPREAD_MAX);
+        out->spread_given = 1;
+    }
+    const json_t *desc = gp_rd_member(r, shape, "/shape/descriptors", JSON_OBJECT, 1);
+    const json_t *outl = gp_rd_array(r, shape, "/shape/outlines", 1, SIZE_MAX, 1);
+    if (desc) {
+        read_descriptors_2d(r, desc, out);
+        return 0;
+    }
+    if (outl) return read_outlines_2d(r, outl, out);
     const json_t *spec = gp_rd_array(r, shape, "/shape/spectrum", 1, SIZE_MAX, 1);
     if (!spec) {
         out->D2 = gp_rd_num(r, shape, "/shape/D2", -GP_RD_ANY, GP_RD_ANY);
@@ -190,6 +312,7 @@ static int read_shape_2d(gp_spec_reader *r, const json_t *shape, gp_spec2d *out)
     for (size_t i = 0; i < n; i++)
         d[i] = gp_rd_value(r, json_array_get(spec, i), "/shape/spectrum", -GP_RD_ANY, GP_RD_ANY);
     out->has_spectrum = 1;
+    out->shape_form = GP_SHAPE_FORM_SPECTRUM;
     out->spectrum = d;
     out->nspectrum = n;
     /* D2, D3, D8 are still meaningful for reporting: take them from the spectrum */
@@ -344,6 +467,94 @@ static int check_spectrum_2d(const gp_spec2d *s, gp_spec_problem *p)
     if (!s->has_spectrum || s->nspectrum <= most) return 0;
     return gp_problem(p, "invalid_spec", "/shape/spectrum", "%zu amplitudes are too many for "
                       "contour_points = %zu (at most %zu)", s->nspectrum, s->contour_points, most);
+}
+
+/* invalid_spec at the first refused outline: its reason, and the indices of the others */
+static int outline_problem(const gp_outline_set_result *res, gp_spec_problem *p)
+{
+    size_t i = res->refused[0];
+    char ptr[64], more[160] = "";
+    snprintf(ptr, sizeof ptr, "/shape/outlines/%zu", i);
+    size_t len = 0;
+    for (size_t k = 1; k < res->nrefused && k <= 8 && len < sizeof more; k++)
+        len += (size_t)snprintf(more + len, sizeof more - len, "%s%zu", k > 1 ? ", " : "",
+                                res->refused[k]);
+    const char *msg = res->info[i].error.message;
+    if (!strncmp(msg, "outline: ", 9)) msg += 9; /* the pointer already says what it is */
+    if (res->nrefused == 1)
+        return gp_problem(p, "invalid_spec", ptr, "%s", msg);
+    return gp_problem(p, "invalid_spec", ptr, "%s; %zu more outline%s refused: %s%s", msg,
+                      res->nrefused - 1, res->nrefused > 2 ? "s" : "", more,
+                      res->nrefused > 9 ? ", ..." : "");
+}
+
+/* shape.descriptors: reachable by star-shaped Fourier grains (gp_shapemap_check, the table
+ * only: about a millisecond), else invalid_spec at the first unreachable descriptor in the
+ * paper's order of scales (elongation, circularity, roundness, regularity), with the nearest
+ * reachable value of each in the message */
+static int check_descriptors_2d(const gp_spec2d *s, gp_spec_problem *p)
+{
+    static const int order[4] = {GP_SHAPEMAP_ELONGATION, GP_SHAPEMAP_CIRCULARITY,
+                                 GP_SHAPEMAP_ROUNDNESS, GP_SHAPEMAP_REGULARITY};
+    gp_shapemap_target t;
+    memset(&t, 0, sizeof t);
+    t.given = s->desc_given;
+    memcpy(t.value, s->desc_target, sizeof t.value);
+    gp_shapemap_result r;
+    gp_error e;
+    gp_status st = gp_shapemap_check(&t, &r, &e);
+    if (st == GP_OK) return 0;
+    if (st == GP_ERR_NOMEM) return gp_spec_no_memory(p);
+    char ptr[64] = "/shape/descriptors";
+    for (int q = 0; st == GP_ERR_INFEASIBLE && q < 4; q++)
+        if (r.missed & GP_SHAPEMAP_BIT(order[q])) {
+            snprintf(ptr, sizeof ptr, "/shape/descriptors/%s", g_descriptors[order[q]]);
+            break;
+        }
+    return gp_problem(p, "invalid_spec", ptr, "%s", e.message);
+}
+
+/* shape.outlines: at most OUTLINE_VERTICES_MAX vertices in all (too_large), then each one
+ * analysable (gp_outline: cleaned, star-shaped from an interior point, winding once, with an
+ * area), else invalid_spec at the first refused one, naming its reason and the others. The
+ * refusal does not depend on the rays, so the check analyses at the fewest (16). */
+static int check_outlines_2d(const gp_spec2d *s, gp_spec_problem *p)
+{
+    size_t total = 0;
+    for (size_t i = 0; i < s->noutlines; i++) total += s->outlines[i].n;
+    if (total > OUTLINE_VERTICES_MAX)
+        return gp_spec_too_large(p, "/shape/outlines", "%zu outlines of %zu vertices in all, "
+                                 "over the limit of %d; give fewer outlines or simplify them "
+                                 "(a few hundred points each carry their spectrum)",
+                                 s->noutlines, total, OUTLINE_VERTICES_MAX);
+    gp_outline_points *pts = malloc((s->noutlines ? s->noutlines : 1) * sizeof *pts);
+    if (!pts) return gp_spec_no_memory(p);
+    for (size_t i = 0; i < s->noutlines; i++)
+        pts[i] = (gp_outline_points){s->outlines[i].pts, s->outlines[i].n};
+    gp_outline_params op;
+    gp_outline_params_defaults(&op);
+    op.np = 16;
+    op.nmodes = 8;
+    op.descriptors = 0;
+    op.min_outlines = 1;
+    gp_outline_set_result res;
+    gp_error e;
+    gp_status st = gp_outline_set_analyze(pts, s->noutlines, &op, NULL, &res, &e);
+    free(pts);
+    int rc = 0;
+    if (st == GP_ERR_NOMEM) rc = gp_spec_no_memory(p);
+    else if (res.nrefused > 0) rc = outline_problem(&res, p);
+    else if (st != GP_OK) rc = gp_problem(p, "internal", "/shape/outlines", "%s", e.message);
+    gp_outline_set_result_free(&res);
+    return rc;
+}
+
+static int check_shape_2d(const gp_spec2d *s, gp_spec_problem *p)
+{
+    if (s->has_spectrum) return 0;
+    if (s->shape_form == GP_SHAPE_FORM_DESCRIPTORS) return check_descriptors_2d(s, p);
+    if (s->shape_form == GP_SHAPE_FORM_OUTLINES) return check_outlines_2d(s, p);
+    return 0;
 }
 
 /* the schema's particles maximum: the bound of a derived cell count too */
@@ -509,6 +720,11 @@ static int check_threshold_2d(const gp_spec2d *s, size_t n, gp_spec_problem *p)
 #define COST_FILL_S 2.5e-3        /* filling one grain of 128 contour points (~400-600 grains/s) */
 #define COST_ODEC_S 0.5e-3        /* its ODEC discs, at 128 points */
 #define COST_DESC_S 0.5e-3        /* its descriptors, at 128 points */
+/* shape.descriptors: gp_shapemap_fit (at most 6 x 256 sampled grains, ~0.6 s) and the
+ * calibration (gp_specimen2d.c: up to 2 rounds of filling and describing up to 500 cells) */
+#define COST_SHAPE_FIT_S 0.6
+#define CAL_CELLS 500.0
+#define CAL_ROUNDS 2.0
 
 /* result bytes of one 2D grain, by outputs (as server/http.c has estimated them) */
 static double bytes_per_grain(unsigned outputs, double np)
@@ -529,6 +745,20 @@ static size_t edges_2d(const gp_spec2d *s)
     return edges;
 }
 
+/* the shape's own work: the descriptor fit and calibration, or the outlines' analysis (each
+ * outline described like a grain); 0 for the other forms */
+static double shape_work_2d(const gp_spec2d *s, double cells)
+{
+    double np = (double)s->contour_points;
+    if (s->has_spectrum) return 0;
+    if (s->shape_form == GP_SHAPE_FORM_DESCRIPTORS)
+        return COST_SHAPE_FIT_S +
+               CAL_ROUNDS * fmin(cells, CAL_CELLS) * (COST_FILL_S + COST_DESC_S) * np / 128;
+    if (s->shape_form == GP_SHAPE_FORM_OUTLINES)
+        return (double)s->noutlines * COST_DESC_S * np / 128;
+    return 0;
+}
+
 static void bounds_2d(const gp_spec2d *s, size_t n, gp_spec_bounds_t *b)
 {
     memset(b, 0, sizeof *b);
@@ -544,7 +774,7 @@ static void bounds_2d(const gp_spec2d *s, size_t n, gp_spec_bounds_t *b)
     double per = COST_FILL_S;
     if (s->outputs & GP_OUT2_ODEC) per += COST_ODEC_S;
     if (s->outputs & GP_OUT2_DESCRIPTORS) per += COST_DESC_S;
-    double grains = cells * per * np / 128;
+    double grains = cells * per * np / 128 + shape_work_2d(s, cells);
     b->work_s = imc + imc_edges + grains;
     b->work_pointer = imc_edges > imc && imc_edges > grains ? "/container"
                       : imc > grains                       ? "/imc/max_steps"
@@ -585,8 +815,8 @@ static int check_2d(const json_t *full, gp_spec_problem *p)
     gp_spec2d s;
     size_t n = 0;
     int rc = read_counted_2d(full, &s, 1, &n, p);
-    if (rc == 0 && (check_seed_draws_2d(&s, n, p) || check_threshold_2d(&s, n, p) ||
-                    check_budget_2d(&s, n, p)))
+    if (rc == 0 && (check_shape_2d(&s, p) || check_seed_draws_2d(&s, n, p) ||
+                    check_threshold_2d(&s, n, p) || check_budget_2d(&s, n, p)))
         rc = -1;
     gp_spec2d_free(&s);
     return rc;
@@ -606,6 +836,7 @@ static int spec_bounds_2d(const json_t *full, gp_spec_bounds_t *b, gp_spec_probl
 const gp_spec_kind gp_spec_kind_2d = {
     .name = "fourier-voronoi-2d",
     .schema_text = gp_schema_text_fourier_voronoi_2d,
+    .explain = explain_2d,
     .check_posted = check_posted_2d,
     .settle_defaults = settle_defaults_2d,
     .check = check_2d,

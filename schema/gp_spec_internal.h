@@ -23,6 +23,10 @@ typedef struct gp_spec_advice {
 typedef struct gp_spec_kind {
     const char *name;                   /* the value of "kind" */
     const unsigned char *schema_text;   /* its embedded schema (NUL-terminated JSON) */
+    /* once the schema refused spec with *p: a clearer problem where the schema can only say
+     * something vague (NULL: none), e.g. two forms of a oneOf mixed in one object, which no
+     * branch knows ("/shape: expected ... or ..."); replaces *p (returns 1) or leaves it (0) */
+    int (*explain)(const json_t *spec, gp_spec_problem *p);
     /* rules on the spec as posted, once it fits the schema and before the defaults fill it
      * (NULL: none); 0 or -1 with *p */
     int (*check_posted)(const json_t *spec, gp_spec_problem *p);

@@ -180,6 +180,20 @@ gp_fill_workspace *gp_fill_workspace_create(const gp_fill_params *p, gp_error *e
     return ws;
 }
 
+gp_status gp_fill_workspace_set_spectrum(gp_fill_workspace *ws, const double *D, gp_error *err)
+{
+    if (!ws)
+        return gp_error_set(err, GP_ERR_INVALID, "fill: NULL workspace");
+    gp_fill_params p = ws->p;
+    p.D = D;
+    gp_status st = check_params(&p, err);
+    if (st != GP_OK)
+        return st;
+    ws->p.D = D;
+    ws->unit_area = spectrum_area(&ws->p); /* the area constant is the spectrum's */
+    return GP_OK;
+}
+
 /* ------------------------------------------------------------------ rays (any cell) */
 
 /* The exit of ray (ux, uy) from c through edge k of p, or -1 when the ray misses it. */

@@ -61,6 +61,11 @@ typedef struct gp_fill_workspace gp_fill_workspace;
 gp_fill_workspace *gp_fill_workspace_create(const gp_fill_params *p, gp_error *err);
 void gp_fill_workspace_destroy(gp_fill_workspace *ws);
 
+/* Gives the workspace another spectrum of the same nmodes (a grain's own, issue #17 spread):
+ * D (not copied; it must outlive the fills that use it) is checked as at creation.
+ * GP_ERR_INVALID leaves the workspace as it was. */
+gp_status gp_fill_workspace_set_spectrum(gp_fill_workspace *ws, const double *D, gp_error *err);
+
 typedef struct gp_fill_result {
     gp_vec2 centre;
     double r0;

@@ -24,6 +24,16 @@
  * The number of grains of a sieve law follows from the container: N = round(solid_fraction x
  * area / mean grain area of the law) (gp_spec2d_cell_count).
  *
+ * Shape (issue #17; api.md "2D shape"). The grains' mean spectrum comes from the spec's shape
+ * form: D2/D3/D8 with alpha, beta (Eqs. 10-12), a spectrum as given, target mean descriptors
+ * (gp_shapemap_fit, then calibrated on the specimen's own filled grains: gp_specimen2d.c,
+ * "descriptors calibration"), or outlines (gp_outline_set_analyze: their mean spectrum at
+ * contour_points rays and contour_points / 2 modes, D_1 kept). With a spread, or with outlines
+ * whose own per-mode cov is the default spread, every grain draws its own amplitudes around the
+ * mean (gp_grainshape.h: lognormal per mode, stream 2^62 + i, redrawn while not star-shaped)
+ * and is filled and described with them. No spread (or 0) is the paper's setting, bit for bit
+ * what the specimen was before. The result's stats.shape is out->shape (gp_shape_used).
+ *
  * Fit and warnings. Every result carries stats.fit (gp_fit.h), measured on the cells and
  * grains themselves, and a list of warnings: each target not reached (IMC threshold, a KS
  * distance above its 5 % critical value, a sieve missed by more than 3 points, a solid
@@ -61,6 +71,23 @@ typedef struct gp_ring {
     size_t n;
 } gp_ring;
 
+/* The form of shape (api.md "2D shape"): D2/D3/D8 with alpha, beta (Eqs. 10-12); a full
+ * spectrum; target mean descriptors (gp_shapemap.h); or real grain outlines (gp_outline.h). */
+typedef enum {
+    GP_SHAPE_FORM_D = 0,
+    GP_SHAPE_FORM_SPECTRUM = 1,
+    GP_SHAPE_FORM_DESCRIPTORS = 2,
+    GP_SHAPE_FORM_OUTLINES = 3
+} gp_shape_form;
+
+/* shape.spread is a coefficient of variation of each D_n from grain to grain, at most this:
+ * beyond 1 a lognormal law's typical grain (its median, mean / sqrt(1 + cov^2)) drifts far
+ * below the mean and its heavy tail makes grains that are not star-shaped common, so the
+ * redraws (gp_grainshape.h) would cut the asked spread down instead of giving it. */
+#define GP_SHAPE_SPREAD_MAX 1.0
+/* shape.outlines: at least 10 outlines (api.md; the schema also bounds them at 10,000) */
+#define GP_SHAPE_OUTLINES_MIN 10
+
 /* The spec of kind "fourier-voronoi-2d" (names as in shared/spec/api.md). The caller owns all
  * arrays; gp_specimen2d_build() only reads them. */
 typedef struct gp_spec2d {
@@ -81,10 +108,20 @@ typedef struct gp_spec2d {
     int size_of_grains;         /* size.of: 0 "cells" (the paper), 1 "grains" */
     double mean_deg;            /* orientation.mean_deg */
     double anisotropy;          /* orientation.anisotropy (min/max ratio, in (0, 1]) */
-    int has_spectrum;           /* shape.spectrum given in full */
+    int has_spectrum;           /* shape.spectrum given in full (it wins over shape_form) */
     double D2, D3, D8, alpha, beta;
     const double *spectrum;     /* D0, D1, D2, ... when has_spectrum */
     size_t nspectrum;
+    gp_shape_form shape_form;   /* GP_SHAPE_FORM_D (0, the default) unless given otherwise */
+    unsigned desc_given;        /* descriptors: bit k (GP_SHAPEMAP_BIT) for each asked one */
+    double desc_target[4];      /* the asked means: elongation, roundness, circularity,
+                                 * regularity (the order of gp_descriptors) */
+    const gp_ring *outlines;    /* outlines: noutlines outlines, vertices in order */
+    size_t noutlines;
+    double spread;              /* shape.spread in [0, GP_SHAPE_SPREAD_MAX]; 0 = the paper */
+    int spread_given;           /* shape.spread was given: with outlines it replaces the set's
+                                 * own per-mode spread (0 then means every grain the mean);
+                                 * a spread > 0 counts as given */
     double solid_fraction;
     gp_imc_error_kind imc_error;
     double imc_threshold;
@@ -156,6 +193,41 @@ typedef struct gp_cell2d {
     double orientation_deg;
 } gp_cell2d;
 
+/* The shape the grains were given (issue #17), for the result: stats.shape and
+ * stats.descriptors.<name>.target. Grain g's own amplitudes are drawn around `spectrum` with
+ * the per-mode coefficients of variation `cov` (gp_grainshape.h). */
+typedef struct gp_shape_used {
+    gp_shape_form form;
+    size_t nmodes;              /* length of spectrum and cov (contour_points / 2) */
+    double *spectrum;           /* the mean spectrum used: D_0 = 1, D_1, ... */
+    double *cov;                /* per-mode spread used; NULL when every grain has the mean */
+    double spread;              /* shape.spread as used (0 when none); with outlines and no
+                                 * spread given, cov[] is the set's own and this is its
+                                 * summary: sum_{n>=2} D_n cov_n / sum_{n>=2} D_n */
+    int spread_from_outlines;   /* cov[] is the outlines' measured cov (capped at 1) */
+    double D2, D3, D8, alpha, beta; /* forms D and descriptors (fitted); spectrum and outlines:
+                                 * D2, D3, D8 read off the mean spectrum, alpha = beta = NaN */
+    unsigned targets;           /* bits of target[] that are set: descriptors, the asked ones;
+                                 * outlines, all four (the outlines' own means) */
+    double target[4];           /* descriptors: asked means; outlines: the outlines' means */
+    double target_sd[4];        /* outlines: the outlines' sds (0 otherwise) */
+    double predicted[4];        /* descriptors: the means gp_shapemap_fit's sampled grains had
+                                 * at its spectrum (before the calibration below) */
+    double calibrated[4];       /* descriptors: the means measured on the filled calibration
+                                 * grains at the spectrum used (0 without calibration) */
+    size_t calibration_grains;  /* grains behind calibrated[] (0: not calibrated) */
+    int calibration_rounds;     /* filled-and-measured rounds spent (0, 1 or 2) */
+    int fit_evaluations;        /* descriptors: gp_shapemap_fit's sampled evaluations */
+    unsigned missed;            /* descriptors: bits of targets the calibration (or the fit,
+                                 * without one) left outside their tolerance */
+    size_t noutlines;           /* outlines given, and those analysed (all, or the run fails) */
+    size_t noutlines_analysed;
+    size_t grains_redrawn;      /* spread: grains whose first draw was not star-shaped */
+    size_t grains_clipped;      /* ... those still not after GP_GRAINSHAPE_TRIES draws (pulled
+                                 * toward the mean), or whose own spectrum the fill found no
+                                 * star-shaped phases for (given the mean); warned */
+} gp_shape_used;
+
 typedef struct gp_specimen2d {
     gp_grain2d *grains;
     size_t ngrains;
@@ -183,9 +255,12 @@ typedef struct gp_specimen2d {
     gp_hist orientation_hist;   /* cells: degrees in [-90, 90), target cosine law vs achieved */
     gp_hist grain_orientation_hist; /* grains, same classes and target */
     gp_descriptors descriptor_mean; /* with GP_OUT2_DESCRIPTORS */
+    gp_descriptors descriptor_sd;   /* their standard deviations (n - 1) over the grains */
+    gp_shape_used shape;        /* the spectrum and spread used, the targets (always set) */
     gp_hist descriptor_hist[4]; /* elongation, roundness, circularity, regularity */
-    /* timings, seconds */
-    double t_tessellation, t_imc, t_fill, t_odec, t_descriptors, t_total;
+    /* timings, seconds; t_shape: the shape's setup (descriptor fit or outlines' analysis)
+     * and the descriptors' calibration, which the others then leave out */
+    double t_tessellation, t_imc, t_fill, t_odec, t_descriptors, t_shape, t_total;
 } gp_specimen2d;
 
 /* Builds the specimen. Returns GP_OK, or an error with a message (GP_ERR_CANCELLED when the

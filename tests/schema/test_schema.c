@@ -229,7 +229,7 @@ static const bad_case k_refused[] = {
     {EX2D, "/shape/D3", "-0.01", "/shape/D3", ""},
     {EX2D, "/shape/D8", "\"x\"", "/shape/D8", ""},
     {EX2D, "/shape/alpha", "[]", "/shape/alpha", "got an array of 0 items"},
-    {EX2D, "/shape/spectrum", "[1, 0.1, 0.2]", "/shape", "expected a shape by descriptors"},
+    {EX2D, "/shape/spectrum", "[1, 0.1, 0.2]", "/shape/spectrum", "cannot be combined with \"D2\""},
     {EX2D, "/solid_fraction", "0", "/solid_fraction", "expected a number in (0, 1], got 0"},
     {EX2D, "/solid_fraction", "1.2", "/solid_fraction", ""},
     {EX2D, "/imc/error", "\"E4\"", "/imc/error", "expected one of \"AD\", \"E1\", \"E2\", \"E3\", got \"E4\""},
