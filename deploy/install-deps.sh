@@ -2,7 +2,9 @@
 # Installs the Debian packages grainpack builds against. With --test, also the tools its tests
 # use: the DEM programs lammps, liggghts and yade, and VTK's Python reader, which prove that the
 # export files load, node (the dashboard's script) and promtool (package prometheus: checks the
-# /metrics text) (tests/run.sh passes it).
+# /metrics text), and for the dashboard's browser test chromium, npm and then, by `npm ci` in
+# tests/integration/browser/, puppeteer-core as pinned in its package-lock.json (tests/run.sh
+# passes --test). npm runs as the user running this script; only apt-get goes through sudo.
 # Idempotent; needs root (or sudo). Usage: bash deploy/install-deps.sh [--test]
 set -euo pipefail
 SUDO=""
@@ -10,14 +12,30 @@ if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PKGS="build-essential cmake pkg-config \
   libmicrohttpd-dev libjansson-dev libsqlite3-dev libfftw3-dev libgsl-dev \
   python3 curl wrk"
+TEST=0
 if [ "${1:-}" = "--test" ]; then
-  PKGS="$PKGS lammps liggghts yade python3-vtk9 nodejs prometheus"
+  TEST=1
+  PKGS="$PKGS lammps liggghts yade python3-vtk9 nodejs prometheus chromium fonts-dejavu-core"
 fi
 missing=""
 for p in $PKGS; do
   dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
 done
+# Debian's nodejs comes without npm (package npm); a nodejs that bundles npm (NodeSource) conflicts
+# with that package, so it is only asked for when there is no npm at all.
+if [ "$TEST" = 1 ] && ! command -v npm >/dev/null 2>&1; then
+  missing="$missing npm"
+fi
 if [ -n "$missing" ]; then
   $SUDO apt-get update
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y --no-install-recommends $missing
+fi
+if [ "$TEST" = 1 ]; then
+  # The browser test's node_modules, next to its script (found from there wherever the clone is);
+  # again only when package-lock.json changed since the last `npm ci`.
+  browser="$(cd "$(dirname "$0")/../tests/integration/browser" && pwd)"
+  if ! cmp -s "$browser/package-lock.json" "$browser/node_modules/.grainpack-lock.json"; then
+    (cd "$browser" && npm ci --no-audit --no-fund --ignore-scripts)
+    cp "$browser/package-lock.json" "$browser/node_modules/.grainpack-lock.json"
+  fi
 fi
