@@ -24,6 +24,7 @@
 #include "metrics.h"
 #include "offload.h"
 #include "page.h"
+#include "shapes.h"
 #include "store.h"
 #include "svg_job.h"
 #include "workers.h"
@@ -367,6 +368,14 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
     char loc[64];
     snprintf(loc, sizeof loc, "/v1/jobs/%s", id);
     return send_json_hdr(c, r, 201, job, MHD_HTTP_HEADER_LOCATION, loc);
+}
+
+/* POST /v1/shapes/analyze: outlines or an image -> their spectrum, at once (shapes.h) */
+static enum MHD_Result h_shapes(struct MHD_Connection *c, req *r)
+{
+    int status = 500;
+    json_t *j = gpd_shapes_analyze(r->body, r->len, &status);
+    return send_json(c, r, (unsigned)status, j);
 }
 
 static enum MHD_Result h_list(struct MHD_Connection *c, req *r)
@@ -848,6 +857,11 @@ static enum MHD_Result route(struct MHD_Connection *c, req *r, const char *url,
         if (!strcmp(method, "POST")) return offload(c, r, h_submit);
         if (is_get(method)) return h_list(c, r);
         return method_not_allowed(c, r, method, path, "GET, HEAD, POST");
+    }
+    if (!strcmp(path, "/v1/shapes/analyze")) {
+        /* the analysis costs CPU in proportion to the body: off the HTTP threads */
+        if (!strcmp(method, "POST")) return offload(c, r, h_shapes);
+        return method_not_allowed(c, r, method, path, "POST");
     }
     if (!strncmp(path, "/v1/jobs/", 9)) {
         char id[80];

@@ -22,6 +22,7 @@ static const char *const routes[] = {"/",
                                      "/metrics",
                                      "/v1/health",
                                      "/v1/schema",
+                                     "/v1/shapes/analyze",
                                      "/v1/jobs",
                                      "/v1/jobs/:id",
                                      "/v1/jobs/:id/result",
@@ -31,7 +32,7 @@ static const char *const routes[] = {"/",
                                      "/v1/jobs/:id/summary",
                                      "other"};
 #define NROUTES (sizeof routes / sizeof *routes)
-#define ROUTE_JOB 5   /* "/v1/jobs/:id", the subresources follow it */
+#define ROUTE_JOB 6   /* "/v1/jobs/:id", the subresources follow it */
 #define ROUTE_OTHER (NROUTES - 1)
 #define STATUS_LO 100 /* statuses 100..599 are counted */
 #define NSTATUS 500

@@ -14,7 +14,9 @@
 //    to the job's progress detail;
 //  - pictures: a button per view, img#picture with data-view / data-job-id / data-state, the
 //    download link, the z slider of the section view re-requesting the picture;
-//  - the header says the service's state in words.
+//  - the header says the service's state in words;
+//  - grain outlines from a file (2D): the parser of both formats (JSON, one outline a line),
+//    the file input that makes them the spec's shape.outlines, the analyse button.
 // Usage: node tests/server/dashboard_check.js PAGE.html   (tests/server/test_dashboard.c runs it; exit 0 = ok)
 "use strict";
 const fs = require("fs");
@@ -242,6 +244,60 @@ routes[`/v1/jobs/${W}/summary`] = () => ({status: 404, body: {error: {code: "not
   eq(JSON.parse($("spec").value).porosity, 0.4, "quick porosity edits the spec");
   $("spec").value = "{\"kind\": \"" + k3 + "\", \"porosity\": 0.41}"; $("spec").oninput();
   eq($("q-porosity").value, "0.41", "the quick field follows the spec typed");
+
+  // grain outlines from a file: the parser (JSON or one outline a line), the file input that
+  // puts them in the spec as shape.outlines, the analyse button (POST /v1/shapes/analyze)
+  eq($("outlines-row").style.display, "none", "no outline file for the 3D kind");
+  $("kind").value = k2; ctx.loadExample();
+  eq($("outlines-row").style.display, "", "an outline file input for the 2D kind");
+  const txt = "# two grains\n0 0 1 0 1 1 0 1\n\n0,0 2,0 2,2  0,2 1,3\r\n";
+  const fromText = [[[0, 0], [1, 0], [1, 1], [0, 1]], [[0, 0], [2, 0], [2, 2], [0, 2], [1, 3]]];
+  check(deepEqual(ctx.parseOutlines(txt), fromText), "outline text: one a line, x y or x,y pairs, comments skipped");
+  const arr = [[[0, 0], [1, 0], [0, 1]], [[5, 5], [6, 5.5], [6, 6]]];
+  check(deepEqual(ctx.parseOutlines(JSON.stringify(arr)), arr), "outline JSON: an array of outlines");
+  check(deepEqual(ctx.parseOutlines(JSON.stringify({outlines: arr})), arr), "outline JSON: an object with outlines");
+  const throws = (t) => { try { ctx.parseOutlines(t); return ""; } catch (e) { return e.message; } };
+  check(/line 2.*pairs/.test(throws("0 0 1 0 1 1\n0 0 1 0 1")), "an odd count of numbers names its line: " + throws("0 0 1 0 1 1\n0 0 1 0 1"));
+  check(/line 1/.test(throws("0 0 a 1 1 1")), "a word among the numbers names its line");
+  check(/without outlines/.test(throws("{\"x\": 1}")), "JSON without outlines: " + throws("{\"x\": 1}"));
+  check(/outline 2/.test(throws("[[[0, 0], [1, 0], [0, 1]], [1, 2]]")), "JSON: a bad outline named");
+  check(throws("# nothing\n") !== "", "an empty file is an error");
+  const ex2 = KINDS[k2].example;
+  $("q-outlines").files = [{name: "grains.txt", text: () => Promise.resolve(txt)}];
+  await $("q-outlines").onchange(); await settle();
+  const withOutl = JSON.parse($("spec").value);
+  check(deepEqual(withOutl.shape, {outlines: fromText}) && withOutl.kind === k2 && withOutl.particles === ex2.particles,
+        "the file's outlines are the spec's shape, the rest kept: " + JSON.stringify(withOutl).slice(0, 160));
+  check($("outlines-info").textContent.startsWith("2 outlines, 9 points"), "the count shown: " + $("outlines-info").textContent);
+  $("q-outlines").files = [{name: "grains.json", text: () => Promise.resolve(JSON.stringify({outlines: arr}))}];
+  await $("q-outlines").onchange(); await settle();
+  check(deepEqual(JSON.parse($("spec").value).shape, {outlines: arr}), "a JSON file too");
+  $("q-outlines").files = [{name: "bad.txt", text: () => Promise.resolve("0 0 1")}];
+  await $("q-outlines").onchange(); await settle();
+  check($("analyse-msg").classes().includes("err") && $("analyse-msg").textContent.includes("bad.txt"),
+        "a bad file: its name and the problem: " + $("analyse-msg").textContent);
+  check(deepEqual(JSON.parse($("spec").value).shape, {outlines: arr}), "a bad file leaves the spec as it was");
+  let sent = null;
+  routes["/v1/shapes/analyze"] = (path, opts) => {
+    sent = JSON.parse(opts.body);
+    const mean = [1, 0.004, 0.1003, 0.0495].concat(Array(60).fill(0.001)); mean[8] = 0.0199;
+    return {status: 200, body: {outlines: 2, analysed: 2, described: 2, modes: 64, contour_points: 128,
+      spectrum: {mean, cov: Array(64).fill(0.2), sd: Array(64).fill(0.01), spread: 0.2},
+      descriptors: {elongation: {mean: 0.8248, sd: 0.01}, roundness: {mean: 0.7614, sd: 0.03},
+                    circularity: {mean: 0.8939, sd: 0.002}, regularity: {mean: 3.355, sd: 0.16}},
+      reversed: [1], pole_moved: [], deduplicated: [], no_descriptors: [], refused: []}};
+  };
+  await $("analyse").onclick(); await settle();
+  check(sent && deepEqual(sent.outlines, arr) && sent.contour_points === ex2.contour_points,
+        "analyse posts the spec's outlines and contour_points: " + JSON.stringify(sent).slice(0, 120));
+  const am = $("analyse-msg").textContent;
+  check(am.includes("D2 0.1") && am.includes("D3 0.0495") && am.includes("D8 0.0199") && am.includes("elongation 0.825") &&
+        am.includes("regularity 3.35") && am.includes("1 clockwise"), "the analysis shown: " + am);
+  routes["/v1/shapes/analyze"] = () => ({status: 422, body: {error: {code: "invalid_spec", message: "/outlines/1: not star-shaped", pointer: "/outlines/1"}}});
+  await $("analyse").onclick(); await settle();
+  check($("analyse-msg").classes().includes("err") && $("analyse-msg").textContent.includes("/outlines/1"),
+        "an analysis refused: code, message and pointer: " + $("analyse-msg").textContent);
+  eq($("analyse").disabled, false, "the analyse button usable again");
 
   // submit: an error shows code, message and pointer
   routes["/v1/jobs"] = () => ({status: 422, body: {error: {code: "invalid_spec", message: "must be in (0, 1)", pointer: "/porosity"}}});

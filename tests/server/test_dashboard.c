@@ -3,7 +3,8 @@
  * summary (targets next to achieved values, from GET .../summary, never .../result), timings,
  * warnings (amber), SVG views (a download link each, the section's z slider) and exports; the
  * DOM contract the browser test relies on (ids and data- attributes); a URL per job
- * (#/jobs/{id}); the kinds, their examples, views and export formats filled in from the
+ * (#/jobs/{id}); an outline file made the spec's shape.outlines and analysed at once (POST
+ * /v1/shapes/analyze); the kinds, their examples, views and export formats filled in from the
  * daemon's kind table (server/page.c), none of them written in the page itself; and
  * dashboard.c is in sync with dashboard.html. With node installed, the page's script also runs
  * against a stand-in DOM and service (tests/server/dashboard_check.js) to check how it
@@ -101,6 +102,9 @@ int main(void)
         "id=\"picture\"", "id=\"svg-download\"", "id=\"z\"", "id=\"exports\"",
         "\"data-job-id\"", "\"data-status\"", "\"data-quantity\"", "\"data-view\"",
         "\"data-state\"", "\"data-format\"", "\"class\": \"job\"", "\"target\"", "\"achieved\"",
+        /* grain outlines from a file (2D), put in the spec; their analysis at once */
+        "id=\"q-outlines\"", "type=\"file\"", "id=\"analyse\"", "shape.outlines",
+        "api(\"POST\", \"/v1/shapes/analyze\"",
         /* a URL per job */
         "\"#/jobs/\"", "\"hashchange\"",
         /* filled in from the kind table: every kind, view and export format of api.md, and the

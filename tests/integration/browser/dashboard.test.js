@@ -11,6 +11,7 @@
 // it, compares the #summary with GET /v1/jobs/{id}/result fetched here (not through the page),
 // loads every view in #views (each picture must load, and the SVG fetched here must be XML with
 // an <svg> root) and saves a screenshot of each; then cancels a long 2D job through #cancel, and
+// uploads a grain outline file into #q-outlines, analyses it (#analyse) and submits a job from it;
 // reloads the page at #/jobs/{id}. Any console error, uncaught page error or CSP violation fails.
 // --smoke only loads the page, checks the console and saves one screenshot (to check the set-up).
 // Exit status 0 = pass; failures print what went wrong and save FAILED-*.png in SCREENSHOT_DIR.
@@ -414,6 +415,71 @@ async function cancelThroughPage() {
   log('cancel: job ' + id + ' cancelled through #cancel');
 }
 
+// a grain outline file (text, one outline a line) of 30 grains from D2 0.1, D3 0.05, D8 0.02
+function outlineFile() {
+  const lines = ['# 30 grains, x1 y1 x2 y2 ...'];
+  let seed = 12345;
+  const rnd = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
+  for (let g = 0; g < 30; g++) {
+    const ph = [2, 3, 8].map(() => (rnd() * 2 - 1) * Math.PI), nums = [];
+    for (let i = 0; i < 64; i++) {
+      const t = 2 * Math.PI * i / 64;
+      const r = 1 + 0.1 * Math.cos(2 * t - ph[0]) + 0.05 * Math.cos(3 * t - ph[1]) + 0.02 * Math.cos(8 * t - ph[2]);
+      nums.push((10 * g + r * Math.cos(t)).toFixed(5), (r * Math.sin(t)).toFixed(5));
+    }
+    lines.push(nums.join(' '));
+  }
+  const file = path.join(OUT, 'outlines.txt');
+  fs.writeFileSync(file, lines.join('\n') + '\n');
+  return file;
+}
+
+// the 2D form with an uploaded outline file: the count shown, the analysis (POST
+// /v1/shapes/analyze) shown, and a job submitted with the file's outlines as shape.outlines
+async function outlinesThroughPage() {
+  const kind = 'fourier-voronoi-2d';
+  step = 'outlines upload';
+  await page.select('#kind', kind);
+  const input = await page.$('#q-outlines');
+  check(input, 'no #q-outlines for ' + kind);
+  await input.uploadFile(outlineFile());
+  await page.waitForFunction(() => /^30 outlines/.test(document.querySelector('#outlines-info').textContent),
+    { timeout: T(10000), polling: 100 }).catch(async () => fail('#outlines-info says ' +
+      JSON.stringify(await page.$eval('#analyse-msg', (e) => e.textContent))));
+  const spec = JSON.parse(await page.$eval('#spec', (t) => t.value));
+  check(spec.shape && Array.isArray(spec.shape.outlines) && spec.shape.outlines.length === 30 &&
+    spec.shape.outlines[0].length === 64, 'the spec\'s shape after the upload: ' + JSON.stringify(spec.shape).slice(0, 200));
+  step = 'outlines analyse';
+  await page.click('#analyse');
+  await page.waitForFunction(() => /D2 /.test(document.querySelector('#analyse-msg').textContent),
+    { timeout: T(20000), polling: 100 }).catch(async () => fail('#analyse-msg says ' +
+      JSON.stringify(await page.$eval('#analyse-msg', (e) => e.textContent))));
+  const msg = await page.$eval('#analyse-msg', (e) => e.textContent);
+  const d2 = /D2 ([0-9.]+)/.exec(msg), d3 = /D3 ([0-9.]+)/.exec(msg);
+  check(d2 && Math.abs(parseFloat(d2[1]) - 0.1) < 0.005 && d3 && Math.abs(parseFloat(d3[1]) - 0.05) < 0.003,
+    '#analyse-msg: ' + msg);
+  await page.$eval('#analyse-msg', (e) => e.scrollIntoView({ block: 'center' }));
+  await shot('2d-outlines');
+  log('outlines: ' + msg);
+  step = 'outlines submit';
+  const before = new Set(await jobIds());
+  await typeInto('#q-particles', 100);
+  await page.click('#submit');
+  let id = null;
+  const deadline = Date.now() + T(15000);
+  while (!id && Date.now() < deadline) {
+    id = (await jobIds()).find((x) => x && !before.has(x)) || null;
+    if (!id) await sleep(100);
+  }
+  check(id, 'no new row after submitting the outlines: ' + (await page.$eval('#submit-msg', (e) => e.textContent)));
+  const sent = await apiJson('/v1/jobs/' + id + '/spec');
+  check(sent.shape && sent.shape.outlines && sent.shape.outlines.length === 30 && sent.particles === 100,
+    'the daemon got shape ' + JSON.stringify(sent.shape).slice(0, 200));
+  const status = await waitAttr(rowSel(id), 'data-status', FINAL, T(120000), 'the row of job ' + id);
+  check(status === 'succeeded', 'the job from the outline file ended ' + status);
+  log('outlines: job ' + id + ' from the uploaded file succeeded');
+}
+
 async function reloadAt(id, conf) {
   step = 'reload at #/jobs/' + id;
   await page.evaluate((h) => { location.hash = h; }, '#/jobs/' + id);
@@ -505,6 +571,7 @@ async function main() {
       const id2d = await runKind('fourier-voronoi-2d');
       const id3d = await runKind('spheres-3d');
       await cancelThroughPage();
+      await outlinesThroughPage();
       await reloadAt(id2d, KINDS['fourier-voronoi-2d']);
       await deepLink(browser, id3d, KINDS['spheres-3d']);
     }
