@@ -18,8 +18,11 @@
  *    "size_histogram":        {"edges": [k+1], "target": [k], "achieved": [k]}  (cell areas)
  *    "grain_size_histogram":  {"edges", "target", "achieved"}                   (grain areas)
  *    "orientation_histogram": {"edges" (deg), "target", "achieved"}
- *    "descriptors": {"elongation": {"mean", "edges", "target", "achieved"}, "roundness": ...,
- *                    "circularity": ..., "regularity": ...}       (with output "descriptors")
+ *    "descriptors": {"elongation": {"edges", "target", "achieved", "mean", "sd"},
+ *                    "roundness": ..., "circularity": ..., "regularity": ...}
+ *                   (with output "descriptors"; "target" is null, or the target mean where
+ *                    there is one: shape.descriptors' asked ones, the outlines' own means;
+ *                    "sd" the grains' standard deviation, n - 1)
  *    "fit": {                                           (api.md; a block only when measured)
  *      "cell_area": {"law": "lognormal|normal|uniform|sieve",
  *                    "target": {"mean", "cov"}, "achieved": {"mean", "cov"},
@@ -31,11 +34,24 @@
  *      "cell_orientation":  {"target": {"mean_deg", "anisotropy"}, "ks", "ks_critical", "n"},
  *      "grain_orientation": the same,
  *      "passing": {"diameters": [m], "target": [m] %, "achieved": [m] %, "max_error_pp"}
- *                 (grains by mass; sieve law only)}
+ *                 (grains by mass; sieve law only)},
+ *    "shape": {"form": "D|spectrum|descriptors|outlines",     (every job; gp_shape_used)
+ *              "spectrum": [D0 = 1, D1, ...] (the mean spectrum used, contour_points / 2),
+ *              "D2", "D3", "D8", "alpha", "beta" (null where NaN: spectrum and outlines),
+ *              "spread": s (0: none), "spread_source": "spec|outlines|none",
+ *              "spread_cov": [per mode] (only when the grains' spectra vary),
+ *              "fit": {"predicted": {<4 names>}, "calibrated": {<4 names>} | null,
+ *                      "calibration_grains", "calibration_rounds", "fit_evaluations",
+ *                      "missed": [names]}                         (form descriptors),
+ *              "outlines": {"n", "analysed",
+ *                           "descriptors": {<name>: {"mean", "sd"}}}  (form outlines),
+ *              "grains_redrawn", "grains_clipped"}
  *  },
  *  "warnings": ["one line each: a target not reached and how close it came", ...]
  *              (always there; [] when every target was met),
- *  "timings": {"tessellation", "imc", "fill", "odec", "descriptors", "total"}  (seconds),
+ *  "timings": {"shape" (forms descriptors and outlines: the fit or analysis and the
+ *              calibration), "tessellation", "imc", "fill", "odec", "descriptors", "total"}
+ *             (seconds),
  *  "grains": [{"id", "cell", "contour": [[x,y],...], "area", "orientation_deg",
  *              "cell_fraction", "descriptors": {...} (output descriptors),
  *              "discs": [[x,y,r],...] (output odec)}]   (with any of grains/odec/descriptors),
@@ -187,6 +203,92 @@ static json_t *imc_error(const gp_specimen2d *s, const gp_spec2d *spec)
                      s->imc_stop_reason ? s->imc_stop_reason : "");
 }
 
+/* ---- stats.shape: the shape the grains were given (gp_shape_used) ---- */
+
+static const char *const DESC_NAMES[4] = {"elongation", "roundness", "circularity",
+                                          "regularity"}; /* the order of gp_descriptors */
+
+static const char *shape_form_name(gp_shape_form f)
+{
+    switch (f) {
+    case GP_SHAPE_FORM_SPECTRUM: return "spectrum";
+    case GP_SHAPE_FORM_DESCRIPTORS: return "descriptors";
+    case GP_SHAPE_FORM_OUTLINES: return "outlines";
+    default: return "D";
+    }
+}
+
+/* the forms whose shape is computed (a descriptor fit, the outlines' analysis): the core
+ * reports a "shape" phase for them and times it (t_shape) */
+static int shape_computed(gp_shape_form f)
+{
+    return f == GP_SHAPE_FORM_DESCRIPTORS || f == GP_SHAPE_FORM_OUTLINES;
+}
+
+/* {"elongation": v[0], "roundness": v[1], "circularity": v[2], "regularity": v[3]} */
+static json_t *per_descriptor(const double *v)
+{
+    json_t *o = json_object();
+    for (int k = 0; o && k < 4; k++) json_object_set_new(o, DESC_NAMES[k], gpd_jreal(v[k]));
+    return o;
+}
+
+/* the descriptors form: what the fit predicted, what the calibration measured */
+static json_t *shape_fit(const gp_shape_used *u)
+{
+    json_t *missed = json_array();
+    for (int k = 0; missed && k < 4; k++)
+        if (u->missed & (1u << k)) json_array_append_new(missed, json_string(DESC_NAMES[k]));
+    return json_pack("{s:o, s:o, s:I, s:i, s:i, s:o}", "predicted", per_descriptor(u->predicted),
+                     "calibrated",
+                     u->calibration_grains ? per_descriptor(u->calibrated) : json_null(),
+                     "calibration_grains", (json_int_t)u->calibration_grains,
+                     "calibration_rounds", u->calibration_rounds, "fit_evaluations",
+                     u->fit_evaluations, "missed", missed);
+}
+
+/* the outlines form: how many were given and analysed, their descriptors' mean and sd */
+static json_t *shape_outlines(const gp_shape_used *u)
+{
+    json_t *o = json_pack("{s:I, s:I}", "n", (json_int_t)u->noutlines, "analysed",
+                          (json_int_t)u->noutlines_analysed);
+    if (!o || !u->targets) return o;
+    json_t *d = json_object();
+    for (int k = 0; d && k < 4; k++)
+        if (u->targets & (1u << k))
+            json_object_set_new(d, DESC_NAMES[k],
+                                json_pack("{s:o, s:o}", "mean", gpd_jreal(u->target[k]), "sd",
+                                          gpd_jreal(u->target_sd[k])));
+    json_object_set_new(o, "descriptors", d);
+    return o;
+}
+
+/* stats.shape (see the top of the file) */
+static json_t *shape_json(const gp_specimen2d *s, const gp_spec2d *spec)
+{
+    const gp_shape_used *u = &s->shape;
+    json_t *o = json_object();
+    if (!o) return NULL;
+    json_object_set_new(o, "form", json_string(shape_form_name(u->form)));
+    json_object_set_new(o, "spectrum", gpd_jreals(u->spectrum, u->nmodes));
+    json_object_set_new(o, "D2", gpd_jreal(u->D2));
+    json_object_set_new(o, "D3", gpd_jreal(u->D3));
+    json_object_set_new(o, "D8", gpd_jreal(u->D8));
+    json_object_set_new(o, "alpha", gpd_jreal(u->alpha));
+    json_object_set_new(o, "beta", gpd_jreal(u->beta));
+    json_object_set_new(o, "spread", gpd_jreal(u->spread));
+    json_object_set_new(o, "spread_source",
+                        json_string(u->spread_from_outlines                  ? "outlines"
+                                    : spec->spread_given || spec->spread > 0 ? "spec"
+                                                                             : "none"));
+    if (u->cov) json_object_set_new(o, "spread_cov", gpd_jreals(u->cov, u->nmodes));
+    if (u->form == GP_SHAPE_FORM_DESCRIPTORS) json_object_set_new(o, "fit", shape_fit(u));
+    if (u->form == GP_SHAPE_FORM_OUTLINES) json_object_set_new(o, "outlines", shape_outlines(u));
+    json_object_set_new(o, "grains_redrawn", json_integer((json_int_t)u->grains_redrawn));
+    json_object_set_new(o, "grains_clipped", json_integer((json_int_t)u->grains_clipped));
+    return o;
+}
+
 /* stats: the targets against what was achieved */
 static json_t *stats_2d(const gp_specimen2d *s, const gp_spec2d *spec)
 {
@@ -211,9 +313,10 @@ static json_t *stats_2d(const gp_specimen2d *s, const gp_spec2d *spec)
     json_object_set_new(st, "grain_size_histogram", hist_json(&s->grain_size_hist));
     json_object_set_new(st, "orientation_histogram", hist_json(&s->orientation_hist));
     if (spec->outputs & GP_OUT2_DESCRIPTORS) {
-        static const char *names[4] = {"elongation", "roundness", "circularity", "regularity"};
         const double means[4] = {s->descriptor_mean.elongation, s->descriptor_mean.roundness,
                                  s->descriptor_mean.circularity, s->descriptor_mean.regularity};
+        const double sds[4] = {s->descriptor_sd.elongation, s->descriptor_sd.roundness,
+                               s->descriptor_sd.circularity, s->descriptor_sd.regularity};
         json_t *d = json_object();
         for (int k = 0; k < 4; k++) {
             json_t *h = hist_json(&s->descriptor_hist[k]);
@@ -221,12 +324,18 @@ static json_t *stats_2d(const gp_specimen2d *s, const gp_spec2d *spec)
                 json_decref(h);
                 h = json_object();
             }
+            /* the histogram has no target classes ("target": null): a target mean (shape
+             * descriptors, or the outlines' own means) takes its place as a number */
+            if (s->shape.targets & (1u << k))
+                json_object_set_new(h, "target", gpd_jreal(s->shape.target[k]));
             json_object_set_new(h, "mean", gpd_jreal(means[k]));
-            json_object_set_new(d, names[k], h);
+            json_object_set_new(h, "sd", gpd_jreal(sds[k]));
+            json_object_set_new(d, DESC_NAMES[k], h);
         }
         json_object_set_new(st, "descriptors", d);
     }
     json_object_set_new(st, "fit", gpd_fit_2d(&s->fit, 1));
+    json_object_set_new(st, "shape", shape_json(s, spec));
     return st;
 }
 
@@ -272,12 +381,16 @@ json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_
     if (c) json_object_set(r, "container", c);
     json_object_set_new(r, "stats", stats_2d(s, spec));
     json_object_set_new(r, "warnings", gpd_warnings_2d(s));
-    json_object_set_new(
-        r, "timings",
-        json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}", "tessellation", gpd_jreal(s->t_tessellation),
-                  "imc", gpd_jreal(s->t_imc), "fill", gpd_jreal(s->t_fill), "odec",
-                  gpd_jreal(s->t_odec), "descriptors", gpd_jreal(s->t_descriptors), "total",
-                  gpd_jreal(s->t_total)));
+    /* "shape" (first, as it ran first) only when a shape phase ran */
+    json_t *tm = json_object();
+    if (shape_computed(s->shape.form)) json_object_set_new(tm, "shape", gpd_jreal(s->t_shape));
+    json_object_set_new(tm, "tessellation", gpd_jreal(s->t_tessellation));
+    json_object_set_new(tm, "imc", gpd_jreal(s->t_imc));
+    json_object_set_new(tm, "fill", gpd_jreal(s->t_fill));
+    json_object_set_new(tm, "odec", gpd_jreal(s->t_odec));
+    json_object_set_new(tm, "descriptors", gpd_jreal(s->t_descriptors));
+    json_object_set_new(tm, "total", gpd_jreal(s->t_total));
+    json_object_set_new(r, "timings", tm);
     /* the arrays are filled in place: a cancelled tree goes back partial, dropped with r */
     if (out & (GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS)) {
         json_t *ga = json_array();
@@ -342,6 +455,30 @@ static json_t *brief(const json_t *spec, const json_t *stats)
                                the cells that reached the fraction (measured 0.16 to 0.47) */
 #define COST_ODEC_S 0.3e-3  /* its ODEC discs (0.2 to 0.46 of its filling, measured) */
 #define COST_DESC_S 0.3e-3  /* its descriptors */
+/* the shape (issue #17), timed through the daemon (one worker) on a shared, loaded 2-core
+ * machine (figures +-30 %) whose fill and descriptors ran 1.06x and 1.27x the figures above:
+ * these are divided by ~1.15 to be at their speed.
+ * - shape.descriptors, phase "shape": gp_shapemap_fit, a table search (milliseconds) and
+ *   sampled evaluations of 256 grains at min(contour_points, 512) points, 1 or 2 of them
+ *   (1.3 on average over six targets, two seeds, Np 64, 128, 256); an evaluation took
+ *   0.08-0.09 s at Np 64, 0.10-0.12 s at 128, 0.15-0.19 s at 256: ~Np^0.75. The number of
+ *   evaluations is not known beforehand: a guessed (unsized) phase. */
+#define COST_FIT_EVAL_S 0.09   /* a sampled evaluation at 128 points ... */
+#define FIT_NP_EXPONENT 0.75   /* ... times (Np / 128)^this */
+#define FIT_NP_MAX 512         /* the fit samples at most this many points (core's cap) */
+#define FIT_EVALS_GUESS 1.3
+/* - shape.descriptors, phase "calibration" (grains only): rounds of filling and describing
+ *   min(cells, 500) cells at the specimen's Np, one or two (2 in 30 of 48 runs above): a
+ *   round measured 1.0-1.7 ms a cell at Np 128 (2.0-2.5 at 256), i.e. a fill and a
+ *   description as planned above (COST_FILL_S + COST_DESC_S). The core reports each pass
+ *   (fill, then describe) with its own fraction: the plan has the first round's two passes
+ *   and the second round as one entry weighted by how often it runs (its describe pass is a
+ *   repass of that entry, progress.c). */
+#define CAL_CELLS_MAX 500      /* the core's CAL_MAX_CELLS */
+#define CAL_ROUND2_SHARE 0.6
+/* - shape.outlines, phase "shape": gp_outline_set_analyze, ~0.37 ms an outline at Np 128
+ *   and ~1.7 ms at 512 (100-1,000 outlines of 64-1,000 vertices: the vertices barely count) */
+#define COST_OUTLINE_S 0.33e-3 /* an outline at 128 points, times Np / 128 */
 #define DISCS_GUESS 20      /* ODEC discs of a grain, for the plan */
 #define CORNERS_GUESS 7     /* corners of a cell, for the plan */
 /* bytes of the result's text (at 17 digits): a grain's own members, a contour point, a disc,
@@ -351,34 +488,54 @@ static json_t *brief(const json_t *spec, const json_t *stats)
 #define BYTES_DISC 60
 #define BYTES_CELL 120
 
+/* The phases, in the core's order: shape (forms descriptors and outlines), tessellation, imc,
+ * calibration (descriptors, with grains), fill and its refill, odec (and descriptors),
+ * result. */
 static int plan(const void *spec_, const json_t *spec_json, gpd_phase *out, int max)
 {
     const gp_spec2d *spec = spec_;
     double np = (double)spec->contour_points, scale = np / 128;
     gp_spec_bounds_t b;
     gp_spec_problem p;
-    if (gp_spec_bounds(spec_json, &b, &p) || max < 6) return 0;
+    if (gp_spec_bounds(spec_json, &b, &p)) return 0;
     double n = b.cells, moves = fmin((double)spec->imc_max_steps, IMC_MOVES_GUESS * n);
     unsigned o = spec->outputs;
     int grains = (o & (GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS)) != 0;
     int finish = (o & (GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS)) ||
                  spec->size_of_grains || spec->size_law == GP_LAW_SIEVE;
+    /* the core's shape_step: only these forms compute their shape (spectrum wins) */
+    gp_shape_form form = spec->has_spectrum ? GP_SHAPE_FORM_SPECTRUM : spec->shape_form;
+    gpd_phase ph[12];
     int k = 0;
-    out[k++] = (gpd_phase){"tessellation", COST_TESS_S * n, 1};
-    out[k++] = (gpd_phase){"imc", moves * COST_IMC_S *
-                                      (1 + COST_IMC_DECADE * log10(fmax(n, 1000) / 1000)), 0};
-    if (grains) out[k++] = (gpd_phase){"fill", COST_FILL_S * n * scale, 1};
+    if (form == GP_SHAPE_FORM_DESCRIPTORS)
+        ph[k++] = (gpd_phase){"shape", FIT_EVALS_GUESS * COST_FIT_EVAL_S *
+                                           pow(fmin(np, FIT_NP_MAX) / 128, FIT_NP_EXPONENT), 0};
+    if (form == GP_SHAPE_FORM_OUTLINES)
+        ph[k++] = (gpd_phase){"shape", COST_OUTLINE_S * (double)spec->noutlines * scale, 1};
+    ph[k++] = (gpd_phase){"tessellation", COST_TESS_S * n, 1};
+    ph[k++] = (gpd_phase){"imc", moves * COST_IMC_S *
+                                     (1 + COST_IMC_DECADE * log10(fmax(n, 1000) / 1000)), 0};
+    if (grains && form == GP_SHAPE_FORM_DESCRIPTORS) {
+        double m = fmin(n, CAL_CELLS_MAX) * scale;
+        ph[k++] = (gpd_phase){"calibration", COST_FILL_S * m, 1};
+        ph[k++] = (gpd_phase){"calibration", COST_DESC_S * m, 1};
+        ph[k++] = (gpd_phase){"calibration", CAL_ROUND2_SHARE * (COST_FILL_S + COST_DESC_S) * m,
+                              0};
+    }
+    if (grains) ph[k++] = (gpd_phase){"fill", COST_FILL_S * n * scale, 1};
     if (grains && !spec->size_of_grains && spec->size_law != GP_LAW_SIEVE)
-        out[k++] = (gpd_phase){"fill", REFILL_SHARE * COST_FILL_S * n * scale, 0};
+        ph[k++] = (gpd_phase){"fill", REFILL_SHARE * COST_FILL_S * n * scale, 0};
     if (grains && finish)
-        out[k++] = (gpd_phase){"odec", n * scale * (((o & GP_OUT2_ODEC) ? COST_ODEC_S : 0) +
-                                                    ((o & GP_OUT2_DESCRIPTORS) ? COST_DESC_S : 0)),
-                               1};
+        ph[k++] = (gpd_phase){"odec", n * scale * (((o & GP_OUT2_ODEC) ? COST_ODEC_S : 0) +
+                                                   ((o & GP_OUT2_DESCRIPTORS) ? COST_DESC_S : 0)),
+                              1};
     double bytes = ((o & GP_OUT2_CELLS) ? n * (BYTES_CELL + BYTES_POINT * CORNERS_GUESS) : 0) +
                    (grains ? n * (BYTES_GRAIN + BYTES_POINT * np +
                                   ((o & GP_OUT2_ODEC) ? BYTES_DISC * DISCS_GUESS : 0))
                            : 0);
-    out[k++] = (gpd_phase){"result", GPD_RESULT_S_PER_BYTE * bytes, 1};
+    ph[k++] = (gpd_phase){"result", GPD_RESULT_S_PER_BYTE * bytes, 1};
+    if (k > max) return 0;
+    memcpy(out, ph, (size_t)k * sizeof *ph);
     return k;
 }
 
@@ -448,9 +605,9 @@ static const char example[] =
     " \"init\": \"uniform\"},"
     " \"contour_points\": 128, \"outputs\": [\"grains\", \"odec\", \"descriptors\", \"cells\"]}";
 
-/* the phases of its "timings" (gpd_result_2d) */
-static const char *const phases[] = {"tessellation", "imc", "fill", "odec", "descriptors",
-                                     "total", NULL};
+/* the phases of its "timings" (gpd_result_2d; "shape" only in some) */
+static const char *const phases[] = {"shape", "tessellation", "imc", "fill", "odec",
+                                     "descriptors", "total", NULL};
 
 const gpd_kind gpd_kind_fv2d = {
     .name = KIND_NAME, .example = example, .bounds = gp_spec_check_result, .brief = brief,

@@ -26,11 +26,16 @@ static int find(const gpd_progress_model *m, const char *name, int from)
 void gpd_progress_init(gpd_progress_model *m, const gpd_phase *plan, int n, double t0)
 {
     memset(m, 0, sizeof *m);
-    if (n > GPD_PLAN_MAX - 1) n = GPD_PLAN_MAX - 1; /* room for "result" */
+    if (n > GPD_PLAN_MAX) n = GPD_PLAN_MAX;
     for (int i = 0; i < n; i++) m->plan[i] = plan[i];
     m->nplan = n > 0 ? n : 0;
-    /* writing the result is always the last phase (workers.c enters it) */
-    if (find(m, "result", 0) < 0) m->plan[m->nplan++] = (gpd_phase){"result", 0, 1};
+    /* writing the result is always the last phase (workers.c enters it): a plan without it
+     * gets it, in place of its last phase when it is full (a full plan that ends with it, as
+     * the kinds' do, is kept whole) */
+    if (find(m, "result", 0) < 0) {
+        if (m->nplan == GPD_PLAN_MAX) m->nplan--;
+        m->plan[m->nplan++] = (gpd_phase){"result", 0, 1};
+    }
     m->cur = -1;
     m->t0 = t0;
     m->t_phase = t0;
