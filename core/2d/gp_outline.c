@@ -27,6 +27,7 @@ void gp_outline_params_defaults(gp_outline_params *p)
 {
     if (!p)
         return;
+    *p = (gp_outline_params){0};
     p->np = GP_FOURIER_NP_DEFAULT;
     p->nmodes = GP_FOURIER_NP_DEFAULT / 2;
     p->descriptors = 1;
@@ -635,6 +636,14 @@ static gp_status too_few(const gp_outline_set_result *res, size_t need, gp_error
                         res->nanalysed, res->n, need, list, res->nrefused > 4 ? ", ..." : "");
 }
 
+/* the progress report of outline i of n, every GP_OUTLINE_REPORT_EVERY: 1 = stop */
+static int report_progress(const gp_outline_params *p, size_t i, size_t n)
+{
+    if (!p->progress || i == 0 || i % GP_OUTLINE_REPORT_EVERY) return 0;
+    gp_progress r = {.phase = "shape", .phase_fraction = (double)i / (double)n};
+    return p->progress(p->progress_user, &r) != 0;
+}
+
 gp_status gp_outline_set_analyze(const gp_outline_points *outlines, size_t n,
                                  const gp_outline_params *p, const volatile int *cancel,
                                  gp_outline_set_result *res, gp_error *err)
@@ -653,7 +662,7 @@ gp_status gp_outline_set_analyze(const gp_outline_points *outlines, size_t n,
         return err ? err->code : GP_ERR_INVALID;
     gp_status st = set_alloc(res, n, p->nmodes, err);
     for (size_t i = 0; st == GP_OK && i < n; i++) {
-        if (cancel && *cancel)
+        if ((cancel && *cancel) || report_progress(p, i, n))
             st = gp_error_set(err, GP_ERR_CANCELLED, "outline set: cancelled at outline %zu", i);
         else if (gp_outline_analyze(o, outlines[i].pts, outlines[i].n,
                                     res->spectra + i * p->nmodes, NULL, &res->info[i],

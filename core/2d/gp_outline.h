@@ -84,6 +84,7 @@
 #include <stddef.h>
 
 #include "gp_error.h"
+#include "gp_progress.h"
 #include "gp_geom.h"
 
 /* info.flags */
@@ -99,7 +100,14 @@ typedef struct gp_outline_params {
                           * (default 64) */
     int descriptors;     /* 1 (default): describe each outline (step 5); 0: skip */
     size_t min_outlines; /* a set needs this many analysed outlines (default 10), >= 1 */
+    /* gp_outline_set_analyze reports phase "shape" every GP_OUTLINE_REPORT_EVERY outlines
+     * (phase_fraction = outlines done / n) when progress is not NULL: 10,000 outlines take
+     * seconds, and a job's progress would stand still meanwhile. A non-zero return cancels. */
+    gp_progress_fn progress;
+    void *progress_user;
 } gp_outline_params;
+
+#define GP_OUTLINE_REPORT_EVERY 64
 
 void gp_outline_params_defaults(gp_outline_params *p);
 

@@ -1421,7 +1421,8 @@ static gp_status shape_step(build_ctx *b, gp_error *err)
     }
     double t0 = gp_clock_seconds();
     gp_status st = gp_specimen2d_shape_setup(spec, spec->contour_points / 2, b->cancel,
-                                             &out->shape, err);
+                                             work ? b->progress : NULL, b->user, &out->shape,
+                                             err);
     out->t_shape = gp_clock_seconds() - t0;
     b->gs = (gp_grainshape){out->shape.nmodes, out->shape.spectrum, out->shape.cov, spec->seed};
     if (st == GP_OK && work && b->progress) {

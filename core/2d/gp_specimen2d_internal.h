@@ -12,10 +12,11 @@
  * Deterministic from the spec (the descriptor fit samples its grains from a seed derived from
  * spec->seed). cancel is polled by the outlines' analysis. Errors: GP_ERR_INVALID /
  * GP_ERR_INFEASIBLE (unreachable descriptors, too few analysable outlines) with a message,
- * GP_ERR_NOMEM, GP_ERR_CANCELLED. */
+ * GP_ERR_NOMEM, GP_ERR_CANCELLED. progress (may be NULL) hears the outlines' analysis
+ * (phase "shape", gp_outline_params). */
 gp_status gp_specimen2d_shape_setup(const gp_spec2d *spec, size_t nmodes,
-                                    const volatile int *cancel, gp_shape_used *used,
-                                    gp_error *err);
+                                    const volatile int *cancel, gp_progress_fn progress,
+                                    void *user, gp_shape_used *used, gp_error *err);
 
 /* Frees the arrays of *used and zeroes it. */
 void gp_specimen2d_shape_free(gp_shape_used *used);

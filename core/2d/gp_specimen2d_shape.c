@@ -139,7 +139,8 @@ static gp_status take_outline_stats(const gp_spec2d *s, const gp_outline_set_res
 
 /* the outlines: gp_outline_set_analyze at the specimen's rays and modes */
 static gp_status setup_outlines(const gp_spec2d *s, const volatile int *cancel,
-                                gp_shape_used *u, gp_error *err)
+                                gp_progress_fn progress, void *user, gp_shape_used *u,
+                                gp_error *err)
 {
     if (!s->outlines || s->noutlines < GP_SHAPE_OUTLINES_MIN)
         return gp_error_set(err, GP_ERR_INVALID, "shape.outlines: %zu outlines, need >= %d",
@@ -154,6 +155,8 @@ static gp_status setup_outlines(const gp_spec2d *s, const volatile int *cancel,
     p.np = s->contour_points;
     p.nmodes = u->nmodes;
     p.min_outlines = GP_SHAPE_OUTLINES_MIN;
+    p.progress = progress;
+    p.progress_user = user;
     gp_outline_set_result res;
     gp_status st = gp_outline_set_analyze(pts, s->noutlines, &p, cancel, &res, err);
     free(pts);
@@ -185,8 +188,8 @@ static gp_status setup_spread(const gp_spec2d *s, gp_shape_used *u, gp_error *er
 }
 
 gp_status gp_specimen2d_shape_setup(const gp_spec2d *s, size_t nmodes,
-                                    const volatile int *cancel, gp_shape_used *used,
-                                    gp_error *err)
+                                    const volatile int *cancel, gp_progress_fn progress,
+                                    void *user, gp_shape_used *used, gp_error *err)
 {
     memset(used, 0, sizeof *used);
     used->form = s->has_spectrum ? GP_SHAPE_FORM_SPECTRUM : s->shape_form;
@@ -204,7 +207,7 @@ gp_status gp_specimen2d_shape_setup(const gp_spec2d *s, size_t nmodes,
         break;
     case GP_SHAPE_FORM_SPECTRUM: st = setup_spectrum(s, used, err); break;
     case GP_SHAPE_FORM_DESCRIPTORS: st = setup_descriptors(s, used, err); break;
-    case GP_SHAPE_FORM_OUTLINES: st = setup_outlines(s, cancel, used, err); break;
+    case GP_SHAPE_FORM_OUTLINES: st = setup_outlines(s, cancel, progress, user, used, err); break;
     default: st = gp_error_set(err, GP_ERR_INVALID, "unknown shape form %d", (int)used->form);
     }
     if (st == GP_OK)
