@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian packages grainpack builds against. With --test, also the tools its tests
-# use: the DEM programs lammps, liggghts and yade, and VTK's Python reader, which prove that the
-# export files load, node (the dashboard's script) and promtool (package prometheus: checks the
-# /metrics text), and for the dashboard's browser test chromium, npm and then, by `npm ci` in
+# use: the DEM programs lammps (with openmpi-bin: mpirun runs the lammps-relax script on 2
+# ranks), liggghts and yade, and VTK's Python reader, which prove that the export files load,
+# node (the dashboard's script) and promtool (package prometheus: checks the /metrics text),
+# and for the dashboard's browser test chromium, npm and then, by `npm ci` in
 # tests/integration/browser/, puppeteer-core as pinned in its package-lock.json (tests/run.sh
 # passes --test). npm runs as the user running this script; only apt-get goes through sudo.
 # Idempotent; needs root (or sudo). Usage: bash deploy/install-deps.sh [--test]
@@ -15,7 +16,7 @@ PKGS="build-essential cmake pkg-config \
 TEST=0
 if [ "${1:-}" = "--test" ]; then
   TEST=1
-  PKGS="$PKGS lammps liggghts yade python3-vtk9 nodejs prometheus chromium fonts-dejavu-core"
+  PKGS="$PKGS lammps openmpi-bin liggghts yade python3-vtk9 nodejs prometheus chromium fonts-dejavu-core"
 fi
 missing=""
 for p in $PKGS; do

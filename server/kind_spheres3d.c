@@ -192,13 +192,13 @@ static double result_cost(const void *specimen)
            (s->contacts ? COST_CONTACT_S * (double)s->ncontacts : 0);
 }
 
-/* the sphere list, when the spec asked for it */
+/* the sphere list, when the spec asked for it, with the material and DEM settings that the
+ * lammps-relax export writes into its LAMMPS script */
 static int pack(const void *specimen, const void *spec, void **pack, size_t *len, gp_error *err)
 {
     const gp_specimen3d *s = specimen;
     if (!s->spheres) return 1;
-    return gp_export_pack_3d(s, ((const gp_spec3d *)spec)->material.density, pack, len, err) ? -1
-                                                                                            : 0;
+    return gp_export_pack_3d_dem(s, spec, pack, len, err) ? -1 : 0;
 }
 
 /* an infeasible or unconverged packing says why it stopped */

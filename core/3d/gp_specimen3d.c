@@ -46,8 +46,8 @@
 
 #define MAX_SAMPLE_SPHERES 400000
 #define MAX_TILED_SPHERES 20000000
-#define GRAVITY 9.81
-#define STABILITY 1e-4           /* Eq. 7: 0.01 % */
+#define GRAVITY GP_SPEC3D_GRAVITY
+#define STABILITY GP_SPEC3D_STABILITY /* Eq. 7: 0.01 % */
 #define GROW_FROM 0.6            /* initial radius scale of the placement */
 /* durations, in units of sqrt(d50 / g) (see where tu is computed; the paper's sieve has ~860
  * steps per unit, and these are its former step counts) */
@@ -72,8 +72,9 @@
 #define DT_SAFETY 0.3            /* of sqrt(m / 2 E R): omega dt <= 0.3 sqrt(12) ~ 1 < 2 even
                                     with 12 contacts as stiff as a wall */
 #define COMPACTION_STRESS 1.0    /* top-wall stress, times the geostatic stress at the bottom */
-#define RELAX_DAMPING 0.7        /* local damping during relaxation (the static state does not
-                                    depend on it; Sc <= 1e-4 comes ~2x sooner than at 0.2) */
+/* local damping during relaxation (the static state does not depend on it; Sc <= 1e-4 comes
+ * ~2x sooner than at 0.2) */
+#define RELAX_DAMPING GP_SPEC3D_RELAX_DAMPING
 
 /* the phase fractions of the progress reports (gp_progress.h) */
 #define COMPACT_GAP_END 3e-4     /* compaction: the log of the wall's gap to b_z, from its start
@@ -617,6 +618,7 @@ static gp_status start_dem(build_run *R)
     dp->skin = 0.5 * diam[n - 1]; /* the smallest radius (rebuilds against candidates; results
                                      do not depend on it) */
     dp->dt_safety = DT_SAFETY;
+    R->res->stats.scaled_radius = dp->scaled_radius;
     dp->threads = spec->threads > 0 ? spec->threads : 1;
     for (size_t i = 0; i < n; i++)
         R->xyzr[4 * i + 3] = 0.5 * diam[i]; /* full radii; the DEM scales them */

@@ -27,6 +27,13 @@
 #include "gp_error.h"
 #include "gp_progress.h"
 
+/* The protocol's constants that an export reproduces outside grainpack (core/export's
+ * lammps-relax writes a LAMMPS relaxation with them): gravity (m/s^2, along -z), the stability
+ * threshold of Eq. 7 (0.01 %, NOTES.md), and the least local damping of the relaxation. */
+#define GP_SPEC3D_GRAVITY 9.81
+#define GP_SPEC3D_STABILITY 1e-4
+#define GP_SPEC3D_RELAX_DAMPING 0.7
+
 /* outputs (bit flags); porosity, coordination number, PSD and timings are always reported */
 enum {
     GP_OUT3_SPHERES = 1u << 0,  /* the sphere list (of the tiled packing when tiled) */
@@ -111,6 +118,7 @@ typedef struct gp_stats3d {
     double compaction_friction_deg; /* friction angle in use when the target height was reached */
     long steps;                  /* DEM steps of the sample, all phases */
     double dt;                   /* DEM time step, s */
+    double scaled_radius;        /* the DEM's density scaling radius, m (gp_dem3d_params) */
 } gp_stats3d;
 
 typedef struct gp_specimen3d {

@@ -1,5 +1,5 @@
 /* gp_export.c -- format registry, packs, the cached pack reader and the pull-stream driver.
- * The formats themselves are in gp_export_{lammps,yade,vtk,csv}.c. */
+ * The formats themselves are in gp_export_{lammps,lammps_relax,yade,vtk,csv}.c. */
 #include "gp_export_internal.h"
 
 #include <math.h>
@@ -21,6 +21,7 @@ static const struct {
     [GP_EXPORT_YADE] = {"yade", "txt", "text/plain; charset=utf-8", 1u << 2 | 1u << 3},
     [GP_EXPORT_VTK] = {"vtk", "vtk", "application/octet-stream", 1u << 2 | 1u << 3},
     [GP_EXPORT_CSV] = {"csv", "csv", "text/csv; charset=utf-8", 1u << 2 | 1u << 3},
+    [GP_EXPORT_LAMMPS_RELAX] = {"lammps-relax", "tar", "application/x-tar", 1u << 3},
 };
 
 int gp_export_format_parse(const char *name)
@@ -44,7 +45,7 @@ int gp_export_format_supports(gp_export_format f, int dim)
 
 const char *gp_export_format_list(int dim)
 {
-    return dim == 2 ? "lammps, yade, vtk, csv" : "lammps, liggghts, yade, vtk, csv";
+    return dim == 2 ? "lammps, yade, vtk, csv" : "lammps, liggghts, yade, vtk, csv, lammps-relax";
 }
 
 const char *gp_export_format_extension(gp_export_format f)
@@ -87,8 +88,34 @@ static gp_status check_density(double density, gp_error *err)
     return GP_OK;
 }
 
-gp_status gp_export_pack_3d(const gp_specimen3d *s, double density, void **pack, size_t *len,
-                            gp_error *err)
+static void put_f64(unsigned char **w, double v);
+
+/* The DEM block (gp_export.h) of s built from spec, at w (GP_PACK_DEM zeroed bytes). */
+static void put_dem_block(unsigned char *w, const gp_specimen3d *s, const gp_spec3d *spec)
+{
+    double rmin = 0, rmax = 0;
+    for (size_t i = 0; i < s->count; i++) {
+        double r = s->spheres[4 * i + 3];
+        if (i == 0 || r < rmin) rmin = r;
+        if (i == 0 || r > rmax) rmax = r;
+    }
+    const gp_material3d *m = &spec->material;
+    memcpy(w, GP_PACK_DEM_MAGIC, 8);
+    w += 8;
+    const double v[13] = {m->young, m->poisson, m->friction_deg, m->damping,
+                          fmax(m->damping, GP_SPEC3D_RELAX_DAMPING), GP_SPEC3D_GRAVITY,
+                          s->stats.dt, s->stats.scaled_radius, GP_SPEC3D_STABILITY, rmin, rmax,
+                          s->stats.porosity, s->stats.coordination_number};
+    for (int k = 0; k < 13; k++) put_f64(&w, v[k]);
+    for (int a = 0; a < 3; a++) {
+        int32_t t = spec->tiling[a];
+        memcpy(w + 4 * a, &t, 4);
+    }
+}
+
+/* gp_export_pack_3d, with the DEM block when spec is given */
+static gp_status pack_3d(const gp_specimen3d *s, double density, const gp_spec3d *spec,
+                         void **pack, size_t *len, gp_error *err)
 {
     *pack = NULL;
     *len = 0;
@@ -98,23 +125,43 @@ gp_status gp_export_pack_3d(const gp_specimen3d *s, double density, void **pack,
                             "the specimen has no sphere list (outputs must include \"spheres\")");
     gp_status st = check_density(density, err);
     if (st) return st;
-    if (s->count > (SIZE_MAX - GP_PACK_HEADER) / 32)
+    size_t dem = spec ? GP_PACK_DEM : 0;
+    if (s->count > (SIZE_MAX - GP_PACK_HEADER - dem) / 32)
         return gp_error_set(err, GP_ERR_NOMEM, "too many spheres to pack");
-    size_t n = GP_PACK_HEADER + 32 * s->count;
+    size_t n = GP_PACK_HEADER + 32 * s->count + dem;
     unsigned char *p = calloc(1, n);
     if (!p) return gp_error_set(err, GP_ERR_NOMEM, "out of memory packing %zu spheres", s->count);
     pack_header h;
     header_init(&h, 3, density);
     h.nitems = s->count;
+    h.flags = spec ? GP_EXPORT_HAS_DEM : 0;
     for (int k = 0; k < 3; k++) {
         h.lo[k] = 0.0;
         h.hi[k] = s->box[k];
     }
     memcpy(p, &h, sizeof h);
     if (s->count) memcpy(p + GP_PACK_HEADER, s->spheres, 32 * s->count);
+    if (spec) put_dem_block(p + GP_PACK_HEADER + 32 * s->count, s, spec);
     *pack = p;
     *len = n;
     return GP_OK;
+}
+
+gp_status gp_export_pack_3d(const gp_specimen3d *s, double density, void **pack, size_t *len,
+                            gp_error *err)
+{
+    return pack_3d(s, density, NULL, pack, len, err);
+}
+
+gp_status gp_export_pack_3d_dem(const gp_specimen3d *s, const gp_spec3d *spec, void **pack,
+                                size_t *len, gp_error *err)
+{
+    if (!spec) {
+        *pack = NULL;
+        *len = 0;
+        return gp_error_set(err, GP_ERR_INVALID, "no spec");
+    }
+    return pack_3d(s, spec->material.density, spec, pack, len, err);
 }
 
 static void put_u64(unsigned char **w, uint64_t v)
@@ -314,6 +361,24 @@ int gp_xr_disc(gp_export *e, uint64_t k, double d[3])
 
 /* ------------------------------------------------------------------ writer */
 
+int gp_xw_bytes(gp_export *e, const void *p, size_t n)
+{
+    if (n > e->cap - e->len) {
+        size_t ncap = e->cap * 2 > e->len + n ? e->cap * 2 : e->len + n;
+        char *nb = realloc(e->buf, ncap);
+        if (!nb) {
+            gp_error_set(&e->err, GP_ERR_NOMEM, "out of memory writing a record");
+            return -1;
+        }
+        e->buf = nb;
+        e->cap = ncap;
+    }
+    if (p) memcpy(e->buf + e->len, p, n);
+    else memset(e->buf + e->len, 0, n);
+    e->len += n;
+    return 0;
+}
+
 int gp_xw_printf(gp_export *e, const char *fmt, ...)
 {
     for (;;) {
@@ -371,6 +436,34 @@ int gp_xw_lines(gp_export *e, const gp_xlines *f)
 
 /* ------------------------------------------------------------------ stream */
 
+/* The DEM block after the spheres into e->dem; -1 when its magic is not there. */
+static int read_dem(gp_export *e)
+{
+    const unsigned char *p = cache_get(e, GP_PACK_HEADER + 32 * e->nitems, GP_PACK_DEM);
+    if (!p || memcmp(p, GP_PACK_DEM_MAGIC, 8)) return -1;
+    double v[13];
+    memcpy(v, p + 8, sizeof v);
+    gp_xdem *d = &e->dem;
+    d->young = v[0]; d->poisson = v[1]; d->friction_deg = v[2]; d->damping = v[3];
+    d->relax_damping = v[4]; d->gravity = v[5]; d->dt = v[6]; d->scaled_radius = v[7];
+    d->stability = v[8]; d->rmin = v[9]; d->rmax = v[10]; d->porosity = v[11];
+    d->coordination = v[12];
+    memcpy(d->tiling, p + 8 + sizeof v, sizeof d->tiling);
+    d->present = 1;
+    return 0;
+}
+
+/* Whether a DEM block can drive a relaxation (the writer divides by and takes logs of these). */
+static int dem_usable(const gp_xdem *d)
+{
+    return d->present && d->young > 0 && d->young < INFINITY && d->poisson >= 0 &&
+           d->poisson < INFINITY && d->friction_deg >= 0 && d->friction_deg < 90 &&
+           d->relax_damping >= 0 && d->relax_damping < 1 && isfinite(d->gravity) && d->dt > 0 &&
+           d->dt < INFINITY && d->scaled_radius >= 0 && d->scaled_radius < INFINITY &&
+           d->stability > 0 && d->stability < 1 && d->rmin > 0 && d->rmax >= d->rmin &&
+           d->rmax < INFINITY && d->tiling[0] >= 1 && d->tiling[1] >= 1 && d->tiling[2] >= 1;
+}
+
 gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_export **out,
                          gp_error *err)
 {
@@ -420,6 +513,7 @@ gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_exp
         double need;
         if (e->dim == 3) {
             need = GP_PACK_HEADER + 32.0 * (double)e->nitems;
+            if (e->flags & GP_EXPORT_HAS_DEM) need += GP_PACK_DEM;
         } else {
             need = GP_PACK_HEADER + (double)GP_PACK_GRAIN * (double)e->nitems +
                    16.0 * (double)e->npoints + 24.0 * (double)e->ndiscs;
@@ -428,6 +522,8 @@ gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_exp
         }
         if (need != (double)src->size) why = "its size does not match its counts";
     }
+    if (!why && e->dim == 3 && (e->flags & GP_EXPORT_HAS_DEM) && read_dem(e))
+        why = "bad DEM block";
     if (why) {
         gp_export_destroy(e);
         return gp_error_set(err, GP_ERR_INVALID, "not an export pack: %s", why);
@@ -443,7 +539,17 @@ gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_exp
     case GP_EXPORT_LIGGGHTS: e->step = gp_export_step_lammps; break;
     case GP_EXPORT_YADE: e->step = gp_export_step_yade; break;
     case GP_EXPORT_VTK: e->step = e->dim == 3 ? gp_export_step_vtk3d : gp_export_step_vtk2d; break;
+    case GP_EXPORT_LAMMPS_RELAX: e->step = gp_export_step_lammps_relax; break;
     default: e->step = gp_export_step_csv; break;
+    }
+    if (f == GP_EXPORT_LAMMPS_RELAX && !dem_usable(&e->dem)) {
+        int old = !e->dem.present;
+        gp_export_destroy(e);
+        return gp_error_set(err, GP_ERR_INVALID,
+                            old ? "lammps-relax needs the job's material and DEM settings, which "
+                                  "its export pack (made before lammps-relax existed) lacks: "
+                                  "submit the job again"
+                                : "lammps-relax: the pack's DEM settings are out of range");
     }
     *out = e;
     return GP_OK;

@@ -11,8 +11,9 @@
  *     size. Working memory is O(1) in the specimen size: one staging buffer of one record (a
  *     line) and a 64 KiB read cache.
  *
- * The format families live in gp_export_lammps.c (lammps, liggghts), gp_export_yade.c,
- * gp_export_vtk.c and gp_export_csv.c, behind one small record-writer interface
+ * The format families live in gp_export_lammps.c (lammps, liggghts), gp_export_lammps_relax.c
+ * (lammps-relax), gp_export_yade.c, gp_export_vtk.c and gp_export_csv.c, behind one small
+ * record-writer interface
  * (gp_export_internal.h). Everything is SI, as in the JSON result; reals are written with
  * %.17g, which reads back bit for bit.
  *
@@ -37,7 +38,17 @@
  *     double   lo[3], hi[3]  the box (3D: [0, box]; 2D: the container's bounding box, z 0)
  *     double   max_extent 2D: the largest grain's bounding-box diagonal (for LAMMPS' cutoff)
  *     (zero padding to 128)
- *   3D: nitems records of 4 doubles x, y, z, r.
+ *   3D: nitems records of 4 doubles x, y, z, r; then, with flag GP_EXPORT_HAS_DEM
+ *       (gp_export_pack_3d_dem), the DEM block of 128 bytes that lammps-relax needs:
+ *         char     magic[8]  "GPEXDEM3"
+ *         double   young, poisson (k_s / k_n), friction_deg, damping   the spec's material
+ *         double   relax_damping   local damping of the relaxation (gp_specimen3d.c's rule)
+ *         double   gravity         m/s^2, along -z
+ *         double   dt, scaled_radius  the DEM's time step and density scaling radius (stats)
+ *         double   stability       the threshold of Eq. 7 (S_c)
+ *         double   rmin, rmax      the smallest and largest radius of the spheres
+ *         double   porosity, coordination_number   the result's (stats)
+ *         int32    tiling[3]       (zero padding to 128)
  *   2D: nitems grain records of 10 x 8 bytes:
  *         uint64 point_first, point_count, disc_first, disc_count;
  *         double area, orientation_deg, elongation, roundness, circularity, regularity
@@ -59,10 +70,13 @@ typedef enum gp_export_format {
     GP_EXPORT_YADE,       /* ymport.text (3D: x y z r) / ymport.textClumps (2D: x y z r clump) */
     GP_EXPORT_VTK,        /* legacy VTK polydata, ASCII (ParaView, VTK readers) */
     GP_EXPORT_CSV,        /* 3D: x,y,z,r; 2D: grain,x,y,r (one disc per line) */
+    GP_EXPORT_LAMMPS_RELAX, /* 3D: a tar of a LAMMPS data file and an input script that relaxes
+                               the packing to S_c <= 1e-4 (needs a pack with GP_EXPORT_HAS_DEM) */
     GP_EXPORT_NFORMATS
 } gp_export_format;
 
 #define GP_EXPORT_HAS_DESCRIPTORS 1u
+#define GP_EXPORT_HAS_DEM 2u /* 3D: the pack ends with the DEM block (layout above) */
 
 /* The 2D default density (kg/m^3) when a spec has no material: quartz, 2650. */
 #define GP_EXPORT_DEFAULT_DENSITY 2650.0
@@ -72,7 +86,8 @@ int gp_export_format_parse(const char *name);
 const char *gp_export_format_name(gp_export_format f);
 /* Whether the format exists for specimens of dimension dim (2 or 3). */
 int gp_export_format_supports(gp_export_format f, int dim);
-/* "lammps, liggghts, yade, vtk, csv" for dim 3, "lammps, yade, vtk, csv" for dim 2. */
+/* "lammps, liggghts, yade, vtk, csv, lammps-relax" for dim 3, "lammps, yade, vtk, csv" for
+ * dim 2. */
 const char *gp_export_format_list(int dim);
 /* File name extension (without dot) and MIME type of a format. */
 const char *gp_export_format_extension(gp_export_format f);
@@ -84,6 +99,11 @@ const char *gp_export_format_mime(gp_export_format f);
  * malloc'ed; free() it. */
 gp_status gp_export_pack_3d(const gp_specimen3d *s, double density, void **pack, size_t *len,
                             gp_error *err);
+
+/* The same, with the DEM block (GP_EXPORT_HAS_DEM) that lammps-relax needs: spec's material
+ * (its density too), and s's DEM settings (stats.dt, stats.scaled_radius) and measures. */
+gp_status gp_export_pack_3d_dem(const gp_specimen3d *s, const gp_spec3d *spec, void **pack,
+                                size_t *len, gp_error *err);
 
 /* Packs a 2D specimen, which must carry its ODEC discs (outputs "odec"). The box is the
  * bounding box of spec's container; descriptors are packed when spec->outputs asks for them. */

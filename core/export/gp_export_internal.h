@@ -16,12 +16,22 @@
 #define GP_PACK_VERSION 1u
 #define GP_PACK_HEADER 128u
 #define GP_PACK_GRAIN 80u /* bytes per 2D grain record */
+#define GP_PACK_DEM 128u  /* bytes of the 3D DEM block (GP_EXPORT_HAS_DEM) */
+#define GP_PACK_DEM_MAGIC "GPEXDEM3"
 
 /* One 2D grain record of the pack. */
 typedef struct gp_xgrain {
     uint64_t point_first, point_count, disc_first, disc_count;
     double area, orientation_deg, elongation, roundness, circularity, regularity;
 } gp_xgrain;
+
+/* The 3D DEM block of a pack (gp_export.h has its layout); present = 0 without one. */
+typedef struct gp_xdem {
+    int present;
+    double young, poisson, friction_deg, damping, relax_damping, gravity;
+    double dt, scaled_radius, stability, rmin, rmax, porosity, coordination;
+    int32_t tiling[3];
+} gp_xdem;
 
 struct gp_export {
     gp_export_format format;
@@ -33,6 +43,7 @@ struct gp_export {
     double density;
     double lo[3], hi[3];
     double max_extent;    /* 2D: largest grain bounding-box diagonal */
+    gp_xdem dem;          /* 3D: the DEM block, if the pack has one */
     uint64_t off_items, off_points, off_discs; /* byte offsets of the arrays */
     /* read cache */
     unsigned char *cache;
@@ -47,6 +58,9 @@ struct gp_export {
     uint64_t index, sub;
     gp_xgrain grain;      /* the grain at e->index (2D), loaded by the family */
     double aux;           /* per-grain scratch (e.g. LAMMPS 2D density scale) */
+    uint64_t file_bytes;  /* lammps-relax: size of the data file in the tar */
+    int ntypes;           /* lammps-relax: size classes (atom types) */
+    double type_ratio;    /* lammps-relax: radius ratio of one class */
     int done;
     gp_error err;
     int failed;
@@ -54,6 +68,8 @@ struct gp_export {
 
 /* Appends formatted text to the staging buffer (grows it); -1 on out of memory. */
 int gp_xw_printf(gp_export *e, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Appends n raw bytes (p == NULL: n zero bytes); -1 on out of memory. */
+int gp_xw_bytes(gp_export *e, const void *p, size_t n);
 
 /* Record readers (0 on success, -1 with e->err set). */
 int gp_xr_sphere(gp_export *e, uint64_t i, double q[4]);
@@ -85,5 +101,6 @@ int gp_export_step_yade(gp_export *e);
 int gp_export_step_vtk3d(gp_export *e);
 int gp_export_step_vtk2d(gp_export *e);
 int gp_export_step_csv(gp_export *e);
+int gp_export_step_lammps_relax(gp_export *e);
 
 #endif /* GP_EXPORT_INTERNAL_H */

@@ -195,6 +195,8 @@ static void test_pieces_identical(void)
                 CHECK(e == NULL && strstr(err.message, "valid: ") != NULL);
                 continue;
             }
+            if (f == GP_EXPORT_LAMMPS_RELAX) /* a binary tar from a pack with a DEM block: */
+                continue;                    /* test_export_relax.c reads it in pieces */
             char *ref = export_in_pieces(f, dim == 2 ? p2 : p3, dim == 2 ? n2 : n3, pieces[2]);
             CHECK(ref != NULL && strlen(ref) > 20);
             for (int k = 0; k < 2 && ref; k++) {
