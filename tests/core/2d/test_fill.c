@@ -3,7 +3,9 @@
  * triangle (off its centroid) and a 48-edge ellipse (the large-cell LP), exact hits of
  * reachable targets, orientation following the cell, containment in a non-convex cell, the
  * reported rotation and phases reproducing the contour, scale invariance, determinism (also
- * across cells filled with one workspace) and bad input. */
+ * across cells filled with one workspace), the stall stop on a cell that cannot reach F_S, a
+ * contour size that is not a multiple of 4 (the shape summed without the quadrant symmetry)
+ * and bad input. */
 #include "gp_fill.h"
 #include "gp_geom.h"
 #include "gp_test.h"
@@ -232,7 +234,56 @@ int main(void)
     CHECK(r1.evals == r2.evals && r1.rotation == r2.rotation);
     gp_fill_workspace_destroy(ws);
 
-    /* 12. bad input: errors, no crash */
+    /* 12. a cell that cannot reach F_S: a circle grain in a 3:1 rectangle turned by 0.3 rad is
+     * limited by the width 1: the Np-gon whose vertex nearest the strip's normal (angle
+     * 0.3 + pi/2, off a vertex by d) touches, R cos(d) = 1/2 (fraction ~pi/12). The phases
+     * change nothing, so every simplex run stalls at once: 324 evaluations in all, where
+     * they took 1,104 before runs stopped on a stall. */
+    gp_vec2 strip[4];
+    rect(strip, 3, 1, 0.3, -2, 7);
+    ws = make(0.65, 0, 0, 0, 1);
+    CHECK(gp_fill_cell(ws, strip, 4, ph, contour, &r, &e) == GP_OK);
+    CHECK(!r.target_met);
+    double step = 2 * M_PI / NP, d = fabs(remainder(0.3 + M_PI / 2, step));
+    CHECK_NEAR(r.fraction, np_gon_area(0.5 / cos(d)) / 3, 1e-8);
+    CHECK(gp_poly_inside_poly(contour, NP, strip, 4));
+    CHECK(r.evals < 400);
+    gp_fill_workspace_destroy(ws);
+
+    /* 13. Np = 90, not a multiple of 4: the optimised modes are summed ray by ray instead of
+     * by the quadrant symmetry; the contour is still the curve the result describes (direct
+     * cosine sum), inside its cell, and the elongated grain fills the 3:1 cell as in 4. */
+    {
+        enum { N90 = 90 };
+        double D90[N90 / 2] = {0}, ph90[N90 / 2];
+        D90[0] = 1.0, D90[2] = 0.2, D90[3] = 0.02, D90[8] = 0.01;
+        for (int n = 0; n < N90 / 2; n++) ph90[n] = fmod(n * 2.39996322972865332, 2 * M_PI) - M_PI;
+        gp_fill_params p;
+        gp_fill_params_defaults(&p);
+        p.solid_fraction = 0.6;
+        p.D = D90;
+        p.nmodes = N90 / 2;
+        p.contour_points = N90;
+        gp_fill_workspace *w90 = gp_fill_workspace_create(&p, &e);
+        CHECK(w90 != NULL);
+        gp_vec2 rc[4], c90[N90];
+        rect(rc, 3, 1, 0.5, 3, 1);
+        CHECK(gp_fill_cell(w90, rc, 4, ph90, c90, &r, &e) == GP_OK);
+        double worst = 0.0;
+        for (int i = 0; i < N90; i++) {
+            double th = 2 * M_PI * i / N90, rho = 1.0;
+            for (int n = 1; n < N90 / 2; n++)
+                rho += D90[n] * cos(n * (th - r.rotation) - ((n >= 2 && n <= 7) ? r.phases[n] : ph90[n]));
+            worst = fmax(worst, hypot(r.centre.x + r.r0 * rho * cos(th) - c90[i].x,
+                                      r.centre.y + r.r0 * rho * sin(th) - c90[i].y) / r.r0);
+        }
+        CHECK(worst < 1e-9);
+        CHECK(gp_poly_inside_poly(c90, N90, rc, 4));
+        CHECK(r.fraction > 0.40);
+        gp_fill_workspace_destroy(w90);
+    }
+
+    /* 14. bad input: errors, no crash */
     ws = make(0.65, 0.1, 0.05, 0.02, 1);
     gp_vec2 line[3] = {{0, 0}, {1, 1}, {2, 2}};
     CHECK(gp_fill_cell(ws, line, 3, ph, contour, &r, &e) == GP_ERR_DEGENERATE);
