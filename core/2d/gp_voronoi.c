@@ -13,9 +13,9 @@
  *   seed there can cut it), and the search stops when the next ring is that far. When the outer
  *   ring is convex its edges are clipped in the same loop (their half-planes contain the
  *   container), so a convex container costs nothing extra: the polygon IS the cell.
- *   The order of the clips is canonical (rings in a fixed order, seeds by index), hence a cell
- *   is a pure function of the seed set: local updates equal a fresh build bit for bit, and
- *   rollback needs no copy (see below).
+ *   The order of the clips is canonical (rings in a fixed order, seeds by index), and so are
+ *   the vertices (below): a cell is a pure function of the seed set. A full build uses this
+ *   search; a move uses the neighbour lists (below) and gets the same cells bit for bit.
  *
  * - Holes and non-convex outer rings ("general" rings) are binned too. A cell whose convex
  *   polygon C reaches a bin holding general edges is intersected with the container by a
@@ -26,11 +26,13 @@
  *   contacts (a zero-length chain) are dropped; anything still inconsistent is reported as
  *   GP_ERR_INTERNAL, never guessed. GEOS was not needed: C is convex, which makes this simple.
  *
- * - Moving seed i changes only cells that are Voronoi neighbours of i before or after the move
- *   (insertion/deletion in a Voronoi diagram touch the Delaunay star only). The neighbours used
- *   are those of the convex polygon C (edges of C with a seed tag), which is a superset of the
- *   neighbours inside the container and is valid in non-convex containers too. So a move
- *   recomputes i and nb_old(i) U nb_new(i): about 13 cells, independent of N.
+ * - Moves ("Moves" below): moving seed i changes only i and the cells that are its neighbours
+ *   before or after the move, nb_old(i) U nb_new(i) (about 9 cells, independent of N). The
+ *   neighbours used are those of the convex polygon C (its edges with a seed tag): C is the
+ *   Voronoi cell within the box B, clipped by the outer ring when that is convex, so they are
+ *   the Delaunay neighbours within a convex domain D (B, or the convex container), and in
+ *   non-convex containers too. A move takes each changed cell's candidates from these lists, not
+ *   from the grid (the grid's ring search was 77 % of an IMC step): see "Moves".
  *
  * - Each cell owns a heap buffer (grown, never shrunk). A move computes the new cells into spare
  *   buffers from a pool and swaps pointers; rollback swaps them back (bit-exact, O(1) per cell),
@@ -43,6 +45,33 @@
  * two lines named by its edges' tags, and the polygon starts at its largest tag. So C depends on
  * the seed set only, not on the clipping history (a far seed that cut an intermediate polygon
  * leaves no trace), which is what makes a stale-free local update equal a fresh build.
+ *
+ * Moves. Lemma (D convex, seeds in D): a seed q that is not the nearest to a point x of D has a
+ * neighbour r strictly nearer to x -- the segment from q to x leaves q's cell at a point y of an
+ * edge shared with some r, and |x - r| <= |x - y| + |y - r| = |x - y| + |y - q| = |x - q|, equal
+ * only for degenerate positions. Hence, for a point x in q's cell, x's second-nearest seed is
+ * a neighbour of q (on the segment from x to it only the two cells meet). Three cases:
+ *  - the moved seed i at its new place p (compute_cell_moved): a best-first search of the
+ *    neighbour graph before the move (i at its old place, passed through, never clipped by),
+ *    from the seed nearest to p (a greedy walk from a seed of p's bin: by the lemma it ends at
+ *    the nearest), popping seeds in increasing distance from p and clipping by each. By the
+ *    lemma every seed is reached through a chain of nearer ones, so a seed not popped yet is
+ *    at least as far as the heap's top; the search stops when the top is 2 Rmax away, where
+ *    no seed can cut. The convex ring's edges: those in the bins under the polygon.
+ *  - a former neighbour j of i (compute_cell_nb): removing i hands each point of i's old cell
+ *    to its second-nearest seed, a neighbour of i; so new contacts arise only among nb_old(i),
+ *    and inserting i at p removes contacts except with i: nb_new(j) is in nb_old(j) U nb_old(i)
+ *    U {i}, which are the candidates. The new cell lies in old C_j U old C_i, so the convex
+ *    ring's edges that bound it bound one of those: their edges are the edge candidates.
+ *  - a new neighbour j only (compute_cell_cut): it lost to i and gained nothing (i's old cell
+ *    went to i's old neighbours), so its new
+ *    polygon is the old one (when that was one convex part) cut by the bisector of j and p.
+ * Each result is then made canonical like any cell: which superset of the neighbours clipped it
+ * leaves no trace (canonical vertices, above), so a moved cell equals the one a full build
+ * (from the grid) gives, bit for bit, barring near-degenerate vertices (four seeds co-circular
+ * within ~1e-13 of the container, nearly parallel edges), which no test of 10^4 moves has met.
+ * compute_cell_nb starts from old C_j less i's edge where that polygon closes (half of the
+ * cases), so that only nb_old(i) and i are left to clip.
  */
 #include "gp_voronoi.h"
 
@@ -60,6 +89,7 @@ typedef struct vcell {
     int32_t nv, cap;      /* vertices of all parts / capacity of v, tag */
     int32_t nparts, seed_part, pcap;
     int32_t nnb, nbcap;   /* neighbours of the convex polygon (update set), sorted */
+    int32_t nce;          /* convex outer-ring edges of the convex polygon, in nb[nnb ..) */
     int32_t convex;       /* 1: one convex part (the clipped Voronoi polygon itself) */
     double area, orient;
     gp_vec2 *v;
@@ -118,6 +148,10 @@ struct gp_voronoi {
     uint32_t *rst;
     int32_t *rev;
     uint32_t *cst, cstamp;
+    uint32_t *kst, kstamp; /* candidates of one cell recomputed by a move */
+    double *hq_d;          /* the moved cell's search: a min-heap of (distance, seed) */
+    int32_t *hq_j;
+    int32_t hqcap;
     gp_vec2 *sa, *sb;
     int32_t *ta, *tb;
     double *sd;
@@ -900,7 +934,8 @@ clip_step(gp_voronoi *v, int32_t *m, int *ina, gp_vec2 o, gp_vec2 nrm, double ep
 }
 
 /* the line of a tag, relative to s: n . (x - s) = c */
-static void tag_line(const gp_voronoi *v, gp_vec2 s, int32_t t, gp_vec2 *n, double *c)
+static inline __attribute__((always_inline)) void tag_line(const gp_voronoi *v, gp_vec2 s, int32_t t, gp_vec2 *n,
+                                                          double *c)
 {
     if (t >= 0) {
         gp_vec2 q = v->seed[t];
@@ -1118,14 +1153,19 @@ static int cell_done(const cell_run *R, int32_t r)
     return dmin > 0 && dmin * dmin >= 4.0 * R->rmax2;
 }
 
-/* The neighbours of C (sorted, unique: each line appears once in a convex polygon). */
-static gp_status cell_neighbours(vcell *out, const int32_t *ct, int32_t m)
+/* The neighbours of C (sorted, unique: each line appears once in a convex polygon) into
+ * nb[0 .. nnb), then C's convex outer-ring edges (in C's order) into nb[nnb .. nnb + nce): the
+ * two lists a move reads to find the candidates of the cells it recomputes. */
+static gp_status cell_neighbours(const gp_voronoi *v, vcell *out, const int32_t *ct, int32_t m)
 {
-    int32_t nn = 0;
-    for (int32_t k = 0; k < m; k++)
+    int32_t nn = 0, ne = 0;
+    for (int32_t k = 0; k < m; k++) {
         if (ct[k] >= 0) nn++;
-    if (cell_reserve(out, m, 1, nn)) return GP_ERR_NOMEM;
+        else if (v->outer_convex && ct[k] < -1 && ct[k] > TAG_SMALL && v->ering[-ct[k] - 2] == 0) ne++;
+    }
+    if (cell_reserve(out, m, 1, nn + ne)) return GP_ERR_NOMEM;
     out->nnb = 0;
+    out->nce = 0;
     for (int32_t k = 0; k < m; k++) {
         if (ct[k] < 0) continue;
         int32_t t = ct[k], q = out->nnb++;
@@ -1135,6 +1175,9 @@ static gp_status cell_neighbours(vcell *out, const int32_t *ct, int32_t m)
         }
         out->nb[q] = t;
     }
+    for (int32_t k = 0; k < m && ne; k++)
+        if (ct[k] < -1 && ct[k] > TAG_SMALL && v->ering[-ct[k] - 2] == 0)
+            out->nb[out->nnb + out->nce++] = -ct[k] - 2;
     return GP_OK;
 }
 
@@ -1173,6 +1216,38 @@ static gp_status cell_general_edges(cell_run *R, const gp_vec2 *cv, int32_t m, i
     return GP_OK;
 }
 
+/* The clipped polygon of R made canonical (vertices from its lines), its neighbour lists, and
+ * then either the cell itself (convex case) or its general clip with the container, into out. */
+static gp_status cell_finish(cell_run *R, vcell *out)
+{
+    gp_voronoi *v = R->v;
+    const int32_t m = R->m;
+    gp_vec2 *cv = R->ina ? v->sb : v->sa; /* canonical copy into the other buffer */
+    int32_t *ct = R->ina ? v->tb : v->ta;
+    canonicalise(v, R->s, R->ina ? v->sa : v->sb, R->ina ? v->ta : v->tb, m, cv, ct);
+    gp_status st = cell_neighbours(v, out, ct, m);
+    if (st != GP_OK) return st;
+    if (v->has_general) { /* does C reach a general (hole / non-convex) edge? */
+        int32_t ng = 0;
+        st = cell_general_edges(R, cv, m, &ng);
+        if (st != GP_OK) return st;
+        /* C lives in the scratch buffers that general_clip does not touch */
+        if (ng > 0) return general_clip(v, R->s, cv, ct, m, ng, out);
+    }
+    memcpy(out->v, cv, (size_t)m * sizeof(gp_vec2));
+    memcpy(out->tag, ct, (size_t)m * sizeof(int32_t));
+    out->nv = m;
+    out->nparts = 1;
+    out->seed_part = 0;
+    out->poff[0] = 0;
+    out->poff[1] = m;
+    out->convex = 1;
+    out->area = ring_area_about(cv, m, R->s);
+    out->orient = convex_orientation(cv, m, R->epsr * R->epsr);
+    if (!(out->area > 0.0)) return GP_ERR_INTERNAL;
+    return GP_OK;
+}
+
 static gp_status compute_cell_box(gp_voronoi *v, uint32_t i, vcell *out, int full)
 {
     cell_run R;
@@ -1183,33 +1258,346 @@ static gp_status compute_cell_box(gp_voronoi *v, uint32_t i, vcell *out, int ful
         if (st == GP_OK && cell_done(&R, r)) break;
     }
     if (st != GP_OK) return st;
-    const int32_t m = R.m;
-    for (int32_t k = 0; k < m; k++)
+    for (int32_t k = 0; k < R.m; k++)
         if ((R.ina ? v->ta : v->tb)[k] == TAG_SMALL) return GP_ERR_NOT_CONVERGED; /* box too small */
-    gp_vec2 *cv = R.ina ? v->sb : v->sa; /* canonical copy into the other buffer */
-    int32_t *ct = R.ina ? v->tb : v->ta;
-    canonicalise(v, R.s, R.ina ? v->sa : v->sb, R.ina ? v->ta : v->tb, m, cv, ct);
-    st = cell_neighbours(out, ct, m);
-    if (st != GP_OK) return st;
-    if (v->has_general) { /* does C reach a general (hole / non-convex) edge? */
-        int32_t ng = 0;
-        st = cell_general_edges(&R, cv, m, &ng);
-        if (st != GP_OK) return st;
-        /* C lives in the scratch buffers that general_clip does not touch */
-        if (ng > 0) return general_clip(v, R.s, cv, ct, m, ng, out);
+    return cell_finish(&R, out);
+}
+
+/* Old C_j (one convex part) without its edge on i's bisector, into sa/ta: that edge's two
+ * neighbouring edges extended to their meeting point X. The new cell of j lies in this polygon
+ * (it holds every half-plane of old C_j but i's, and beyond i's edge only the triangle that
+ * the two extended edges close). Returns 2 when X lies strictly inside every other old edge's
+ * half-plane: then the polygon IS the intersection of those half-planes and j's old neighbours
+ * need not clip again; 1 when they must (another line bounds it beyond i's edge); 0, nothing
+ * written, where the two lines do not close (unbounded) or X is ill-conditioned: then the cell
+ * is clipped from the box. */
+static int unclip_start(cell_run *R, const vcell *old_j, uint32_t i)
+{
+    gp_voronoi *v = R->v;
+    const int32_t m = old_j->nv;
+    if (!old_j->convex || m < 4) return 0;
+    int32_t k = 0;
+    while (k < m && old_j->tag[k] != (int32_t)i) k++;
+    if (k == m) return 0;
+    const gp_vec2 *P = old_j->v;
+    int32_t km = k == 0 ? m - 1 : k - 1, k1 = k + 1 == m ? 0 : k + 1, k2 = k1 + 1 == m ? 0 : k1 + 1;
+    gp_vec2 a = P[k], b = P[k1];
+    gp_vec2 da = {P[k].x - P[km].x, P[k].y - P[km].y}, db = {P[k2].x - P[k1].x, P[k2].y - P[k1].y};
+    double det = da.x * db.y - da.y * db.x;
+    double sc = (fabs(da.x) + fabs(da.y)) * (fabs(db.x) + fabs(db.y));
+    if (!(det > 1e-10 * sc)) return 0; /* the two lines must close the polygon (turn left) */
+    /* a + t da = b + u db: t = cross(b - a, db) / cross(da, db) */
+    double t = ((b.x - a.x) * db.y - (b.y - a.y) * db.x) / det;
+    if (!(t >= 0.0)) return 0;
+    gp_vec2 x = {a.x + t * da.x, a.y + t * da.y};
+    int exact = 2;
+    for (int32_t c = 0; c < m && exact == 2; c++) {
+        if (c == km || c == k || c == k1) continue;
+        gp_vec2 n;
+        double cc;
+        tag_line(v, R->s, old_j->tag[c], &n, &cc);
+        double hx = n.x * (x.x - R->s.x) + n.y * (x.y - R->s.y);
+        if (!(hx < cc - R->epsr * (fabs(n.x) + fabs(n.y)))) exact = 1;
     }
-    memcpy(out->v, cv, (size_t)m * sizeof(gp_vec2));
-    memcpy(out->tag, ct, (size_t)m * sizeof(int32_t));
-    out->nv = m;
-    out->nparts = 1;
-    out->seed_part = 0;
-    out->poff[0] = 0;
-    out->poff[1] = m;
-    out->convex = 1;
-    out->area = ring_area_about(cv, m, R.s);
-    out->orient = convex_orientation(cv, m, R.epsr * R.epsr);
-    if (!(out->area > 0.0)) return GP_ERR_INTERNAL;
+    int32_t w = 0;
+    double r2 = 0.0;
+    for (int32_t c = 0; c < m; c++) {
+        if (c == k1) continue; /* b goes, a becomes X (which starts edge k1's line) */
+        gp_vec2 p = c == k ? x : P[c];
+        v->sa[w] = p;
+        v->ta[w++] = c == k ? old_j->tag[k1] : old_j->tag[c];
+        double ex = p.x - R->s.x, ey = p.y - R->s.y;
+        if (ex * ex + ey * ey > r2) r2 = ex * ex + ey * ey;
+    }
+    R->m = w;
+    R->ina = 1;
+    R->rmax2 = r2;
+    return exact;
+}
+
+/* The candidates of compute_cell_nb into cand_d / cand_j, sorted by (distance, index), each
+ * seed once: nb(j) (unless skip_j: they clip the start polygon already), nb_old(i), and i. */
+static gp_status nb_candidates(gp_voronoi *v, const cell_run *R, const vcell *old_j,
+                               const vcell *old_i, uint32_t i, int skip_j, int32_t *ncp)
+{
+    int32_t need = old_j->nnb + old_i->nnb + 1;
+    if (need > v->candcap) {
+        int32_t c0 = v->candcap;
+        if (grow((void **)&v->cand_d, &c0, need, sizeof(double))) return GP_ERR_NOMEM;
+        c0 = v->candcap;
+        if (grow((void **)&v->cand_j, &c0, need, sizeof(int32_t))) return GP_ERR_NOMEM;
+        v->candcap = c0;
+    }
+    stamp_next(&v->kstamp, v->kst, v->n);
+    v->kst[R->i] = v->kstamp;
+    for (int32_t q = 0; skip_j && q < old_j->nnb; q++)
+        if ((uint32_t)old_j->nb[q] != i) v->kst[old_j->nb[q]] = v->kstamp; /* i has moved */
+    const gp_vec2 s = R->s;
+    int32_t nc = 0;
+    for (int32_t part = skip_j; part < 3; part++) {
+        const int32_t *lst = part == 0 ? old_j->nb : part == 1 ? old_i->nb : (const int32_t *)&i;
+        int32_t cnt = part == 0 ? old_j->nnb : part == 1 ? old_i->nnb : 1;
+        for (int32_t q = 0; q < cnt; q++) {
+            int32_t k = lst[q];
+            if (v->kst[k] == v->kstamp) continue;
+            v->kst[k] = v->kstamp;
+            double nx = v->seed[k].x - s.x, ny = v->seed[k].y - s.y, d2 = nx * nx + ny * ny;
+            int32_t w = nc++;
+            while (w > 0 && (v->cand_d[w - 1] > d2 || (v->cand_d[w - 1] == d2 && v->cand_j[w - 1] > k))) {
+                v->cand_d[w] = v->cand_d[w - 1];
+                v->cand_j[w] = v->cand_j[w - 1];
+                w--;
+            }
+            v->cand_d[w] = d2;
+            v->cand_j[w] = k;
+        }
+    }
+    *ncp = nc;
     return GP_OK;
+}
+
+/* The container's lines for compute_cell_nb: with a non-convex container C is bounded by B,
+ * whose sides old_i may have had and old_j not (old_i's stored parts do not show them), so all
+ * four (mostly no cut); with a convex outer ring, the ring edges of old_j (unless skip_j) and
+ * old_i. */
+static gp_status nb_container_lines(cell_run *R, const vcell *old_j, const vcell *old_i, int skip_j,
+                                    int b_sides)
+{
+    gp_voronoi *v = R->v;
+    const gp_vec2 s = R->s;
+    gp_status st = GP_OK;
+    for (int32_t side = 0; b_sides && !v->outer_convex && side < 4 && st == GP_OK; side++) {
+        gp_vec2 n;
+        double c;
+        tag_line(v, s, TAG_B + side, &n, &c);
+        gp_vec2 o = {s.x + c * n.x, s.y + c * n.y}; /* |n| = 1: the point of the line nearest s */
+        st = clip_step(v, &R->m, &R->ina, o, n, R->epsr * (fabs(n.x) + fabs(n.y)), TAG_B + side, s, &R->rmax2);
+    }
+    for (int32_t part = skip_j; part < 2 && v->outer_convex && st == GP_OK; part++) {
+        const vcell *c = part ? old_i : old_j;
+        for (int32_t q = 0; q < c->nce && st == GP_OK; q++) {
+            int32_t e = c->nb[c->nnb + q];
+            if (v->estamp[e] == R->es) continue;
+            v->estamp[e] = R->es;
+            gp_vec2 a = v->rv[e], b = v->rv[v->enext[e]];
+            gp_vec2 nrm = {b.y - a.y, a.x - b.x};
+            st = clip_step(v, &R->m, &R->ina, a, nrm, R->epsr * (fabs(nrm.x) + fabs(nrm.y)), -e - 2, s,
+                           &R->rmax2);
+        }
+    }
+    return st;
+}
+
+/* Cell j (a neighbour of i before the move) from the neighbour lists instead of the grid: the
+ * bisectors of the seeds in nb(j) U nb_old(i) U {i} (old_j, old_i: the cells before the move),
+ * nearest first, and the container's lines of old_j and old_i, clipped from old C_j less i's
+ * edge where that closes (unclip_start), else from the box B. Why that is enough is in the
+ * header of this file ("Moves"); the result is the cell a full build computes (canonical
+ * vertices). */
+static gp_status compute_cell_nb(gp_voronoi *v, uint32_t j, const vcell *old_j, const vcell *old_i,
+                                 uint32_t i, vcell *out)
+{
+    cell_run R;
+    gp_status st = cell_start(&R, v, j, 1);
+    if (st == GP_OK && old_j->nv + 2 > v->scap && scratch_reserve(v, old_j->nv + 2)) st = GP_ERR_NOMEM;
+    if (st != GP_OK) return st;
+    /* from old C_j less i's edge (exactly: 2), j's old lines are in already; else they clip */
+    const int start = unclip_start(&R, old_j, i), skip_j = start == 2;
+    int32_t nc = 0;
+    st = nb_candidates(v, &R, old_j, old_i, i, skip_j, &nc);
+    const gp_vec2 s = R.s;
+    for (int32_t q = 0; q < nc && st == GP_OK; q++) {
+        if (v->cand_d[q] >= 4.0 * R.rmax2) break; /* sorted: no farther seed can cut */
+        int32_t k = v->cand_j[q];
+        double nx = v->seed[k].x - s.x, ny = v->seed[k].y - s.y;
+        gp_vec2 mid = {s.x + 0.5 * nx, s.y + 0.5 * ny};
+        st = clip_step(v, &R.m, &R.ina, mid, (gp_vec2){nx, ny}, R.epsr * (fabs(nx) + fabs(ny)), k, s,
+                       &R.rmax2);
+    }
+    if (st == GP_OK) st = nb_container_lines(&R, old_j, old_i, skip_j, start != 0);
+    return st == GP_OK ? cell_finish(&R, out) : st;
+}
+
+/* The moved seed's search runs on the neighbour graph of the tessellation before the move, in
+ * which seed i still stands at its old place. */
+static inline gp_vec2 node_pos(const gp_voronoi *v, int32_t k)
+{
+    return (uint32_t)k == v->mv_i ? v->mv_seed : v->seed[k];
+}
+
+static inline double node_d2(const gp_voronoi *v, int32_t k, gp_vec2 p)
+{
+    gp_vec2 q = node_pos(v, k);
+    return (q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y);
+}
+
+/* The seed of the old graph nearest to p: from a seed of p's bin (or the old i), step to the
+ * neighbour nearest to p while that is closer. A seed that is not the nearest always has a
+ * closer neighbour (header, "Moves"), so the walk ends at the nearest; a few steps, as it
+ * starts next to p. */
+static int32_t nearest_node(const gp_voronoi *v, gp_vec2 p, double *dcur)
+{
+    int32_t cur = (int32_t)v->mv_i;
+    int32_t bx = bin_x(v, p.x), by = bin_y(v, p.y);
+    for (int32_t r = 0; r <= 1 && cur == (int32_t)v->mv_i; r++)
+        for (int32_t yy = by - r; yy <= by + r && cur == (int32_t)v->mv_i; yy++)
+            for (int32_t xx = bx - r; xx <= bx + r; xx++) {
+                if (xx < 0 || yy < 0 || xx >= v->nbx || yy >= v->nby) continue;
+                const vbin *b = &v->bins[yy * v->nbx + xx];
+                const int32_t *it = b->s ? b->s : b->inl;
+                int32_t q = 0;
+                while (q < b->cnt && (uint32_t)it[q] == v->mv_i) q++;
+                if (q < b->cnt) {
+                    cur = it[q];
+                    break;
+                }
+            }
+    double dc = node_d2(v, cur, p);
+    for (;;) {
+        const vcell *c = v->cell[cur];
+        int32_t best = -1;
+        for (int32_t q = 0; q < c->nnb; q++) {
+            double d = node_d2(v, c->nb[q], p);
+            if (d < dc) {
+                dc = d;
+                best = c->nb[q];
+            }
+        }
+        if (best < 0) break;
+        cur = best;
+    }
+    *dcur = dc;
+    return cur;
+}
+
+static int heap_push(gp_voronoi *v, int32_t *nh, double d, int32_t j)
+{
+    if (*nh + 1 > v->hqcap) {
+        int32_t c0 = v->hqcap;
+        if (grow((void **)&v->hq_d, &c0, *nh + 1, sizeof(double))) return -1;
+        c0 = v->hqcap;
+        if (grow((void **)&v->hq_j, &c0, *nh + 1, sizeof(int32_t))) return -1;
+        v->hqcap = c0;
+    }
+    int32_t k = (*nh)++;
+    while (k > 0) {
+        int32_t up = (k - 1) / 2;
+        if (v->hq_d[up] < d || (v->hq_d[up] == d && v->hq_j[up] < j)) break;
+        v->hq_d[k] = v->hq_d[up];
+        v->hq_j[k] = v->hq_j[up];
+        k = up;
+    }
+    v->hq_d[k] = d;
+    v->hq_j[k] = j;
+    return 0;
+}
+
+static void heap_pop(gp_voronoi *v, int32_t *nh)
+{
+    int32_t n = --(*nh), k = 0;
+    double d = v->hq_d[n];
+    int32_t j = v->hq_j[n];
+    for (;;) {
+        int32_t c = 2 * k + 1;
+        if (c >= n) break;
+        if (c + 1 < n && (v->hq_d[c + 1] < v->hq_d[c] || (v->hq_d[c + 1] == v->hq_d[c] && v->hq_j[c + 1] < v->hq_j[c])))
+            c++;
+        if (d < v->hq_d[c] || (d == v->hq_d[c] && j < v->hq_j[c])) break;
+        v->hq_d[k] = v->hq_d[c];
+        v->hq_j[k] = v->hq_j[c];
+        k = c;
+    }
+    v->hq_d[k] = d;
+    v->hq_j[k] = j;
+}
+
+/* The convex outer ring's edges in the bins that C's bounding box reaches, clipped (the
+ * moved cell: its edges are not known from an old polygon). */
+static gp_status clip_convex_edges_near(cell_run *R)
+{
+    gp_voronoi *v = R->v;
+    gp_vec2 lo, hi;
+    gp_poly_bbox(R->ina ? v->sa : v->sb, (size_t)R->m, &lo, &hi, NULL);
+    double pad = 1e-9 * v->L;
+    int32_t ix0 = bin_x(v, lo.x - pad), ix1 = bin_x(v, hi.x + pad);
+    int32_t iy0 = bin_y(v, lo.y - pad), iy1 = bin_y(v, hi.y + pad);
+    for (int32_t yy = iy0; yy <= iy1; yy++)
+        for (int32_t xx = ix0; xx <= ix1; xx++) {
+            int32_t b = yy * v->nbx + xx;
+            for (uint32_t q = v->ce_off[b]; q < v->ce_off[b + 1]; q++) {
+                uint32_t e = v->ce[q];
+                if (v->estamp[e] == R->es) continue;
+                v->estamp[e] = R->es;
+                gp_vec2 a = v->rv[e], c = v->rv[v->enext[e]];
+                gp_vec2 nrm = {c.y - a.y, a.x - c.x};
+                gp_status st = clip_step(v, &R->m, &R->ina, a, nrm, R->epsr * (fabs(nrm.x) + fabs(nrm.y)),
+                                         -(int32_t)e - 2, R->s, &R->rmax2);
+                if (st != GP_OK) return st;
+            }
+        }
+    return GP_OK;
+}
+
+/* The moved seed i's new cell, before any other cell of the move is replaced: the seeds of the
+ * old graph in increasing distance from the new place p (best-first from the nearest), each
+ * clipping the polygon, until the next is 2 Rmax away -- every seed not reached yet is at least
+ * that far (header, "Moves"). Then the convex outer ring's edges near the polygon. */
+static gp_status compute_cell_moved(gp_voronoi *v, uint32_t i, vcell *out)
+{
+    cell_run R;
+    gp_status st = cell_start(&R, v, i, 1);
+    if (st != GP_OK) return st;
+    const gp_vec2 s = R.s;
+    double d0;
+    int32_t k0 = nearest_node(v, s, &d0), nh = 0;
+    stamp_next(&v->kstamp, v->kst, v->n);
+    v->kst[k0] = v->kstamp;
+    if (heap_push(v, &nh, d0, k0)) return GP_ERR_NOMEM;
+    while (nh > 0 && v->hq_d[0] < 4.0 * R.rmax2) {
+        int32_t k = v->hq_j[0];
+        heap_pop(v, &nh);
+        if ((uint32_t)k != i) {
+            double nx = v->seed[k].x - s.x, ny = v->seed[k].y - s.y;
+            gp_vec2 mid = {s.x + 0.5 * nx, s.y + 0.5 * ny};
+            st = clip_step(v, &R.m, &R.ina, mid, (gp_vec2){nx, ny}, R.epsr * (fabs(nx) + fabs(ny)), k, s,
+                           &R.rmax2);
+            if (st != GP_OK) return st;
+        }
+        const vcell *c = v->cell[k];
+        for (int32_t q = 0; q < c->nnb; q++) {
+            int32_t t = c->nb[q];
+            if (v->kst[t] == v->kstamp) continue;
+            v->kst[t] = v->kstamp;
+            if (heap_push(v, &nh, node_d2(v, t, s), t)) return GP_ERR_NOMEM;
+        }
+    }
+    if (v->outer_convex) {
+        st = clip_convex_edges_near(&R);
+        if (st != GP_OK) return st;
+    }
+    return cell_finish(&R, out);
+}
+
+/* Cell j that was not i's neighbour before the move and is after it: nothing was added to it,
+ * i took a part, so the new cell is the old (convex, unclipped by the container) polygon cut by
+ * the bisector of j and i's new place. */
+static gp_status compute_cell_cut(gp_voronoi *v, uint32_t j, const vcell *old_j, uint32_t i, vcell *out)
+{
+    cell_run R;
+    gp_status st = cell_start(&R, v, j, 1);
+    if (st == GP_OK && old_j->nv + 2 > v->scap && scratch_reserve(v, old_j->nv + 2)) st = GP_ERR_NOMEM;
+    if (st != GP_OK) return st;
+    memcpy(v->sa, old_j->v, (size_t)old_j->nv * sizeof(gp_vec2));
+    memcpy(v->ta, old_j->tag, (size_t)old_j->nv * sizeof(int32_t));
+    R.m = old_j->nv;
+    R.ina = 1;
+    const gp_vec2 s = R.s;
+    double nx = v->seed[i].x - s.x, ny = v->seed[i].y - s.y;
+    gp_vec2 mid = {s.x + 0.5 * nx, s.y + 0.5 * ny};
+    st = clip_step(v, &R.m, &R.ina, mid, (gp_vec2){nx, ny}, R.epsr * (fabs(nx) + fabs(ny)), (int32_t)i, s,
+                   &R.rmax2);
+    if (st != GP_OK) return st;
+    return cell_finish(&R, out);
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -1595,7 +1983,8 @@ static gp_status insert_seeds(gp_voronoi *v, const gp_vec2 *seeds, size_t n,
     v->useed = malloc(n * sizeof(gp_vec2));
     v->cell = calloc(n, sizeof(vcell *));
     v->cst = calloc(n, sizeof(uint32_t));
-    if (!v->seed || !v->useed || !v->cell || !v->cst)
+    v->kst = calloc(n, sizeof(uint32_t));
+    if (!v->seed || !v->useed || !v->cell || !v->cst || !v->kst)
         return gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
     for (size_t i = 0; i < n; i++) {
         if ((i + 1) % (16 * CANCEL_EVERY) == 0 && cancel_raised(cancel))
@@ -1702,6 +2091,9 @@ void gp_voronoi_destroy(gp_voronoi *v)
     free(v->rst);
     free(v->rev);
     free(v->cst);
+    free(v->kst);
+    free(v->hq_d);
+    free(v->hq_j);
     free(v->sa);
     free(v->sb);
     free(v->ta);
@@ -1762,11 +2154,18 @@ static void undo(gp_voronoi *v)
     bin_insert(&v->bins[bin_y(v, v->mv_seed.y) * v->nbx + bin_x(v, v->mv_seed.x)], (int32_t)i);
 }
 
-static gp_status recompute(gp_voronoi *v, uint32_t j)
+/* How a move recomputes a cell: the moved seed's (best-first search), a former neighbour of it
+ * (the neighbour lists), a new neighbour only (one cut of its old polygon). */
+enum { RC_MOVED, RC_NB, RC_CUT };
+
+static gp_status recompute(gp_voronoi *v, uint32_t j, int how, const vcell *old_i)
 {
     vcell *c = pool_get(v);
     if (!c) return GP_ERR_NOMEM;
-    gp_status st = compute_cell(v, j, c);
+    const uint32_t i = v->mv_i;
+    gp_status st = how == RC_MOVED ? compute_cell_moved(v, j, c)
+                   : how == RC_NB  ? compute_cell_nb(v, j, v->cell[j], old_i, i, c)
+                                   : compute_cell_cut(v, j, v->cell[j], i, c);
     if (st == GP_OK && chg_push(v, j, v->cell[j])) st = GP_ERR_NOMEM;
     if (st != GP_OK) {
         pool_put(v, c);
@@ -1810,7 +2209,7 @@ gp_status gp_voronoi_try_move(gp_voronoi *v, size_t i, gp_vec2 pu, gp_error *err
         bin_insert(&v->bins[bin_y(v, v->mv_seed.y) * v->nbx + bin_x(v, v->mv_seed.x)], (int32_t)i);
         return gp_error_set(err, st, "voronoi move: out of memory");
     }
-    st = recompute(v, (uint32_t)i);
+    st = recompute(v, (uint32_t)i, RC_MOVED, NULL);
     if (st == GP_OK) {
         const vcell *nc = v->cell[i];
         if (grow((void **)&v->aff, &v->affcap, na + nc->nnb, sizeof(int32_t))) st = GP_ERR_NOMEM;
@@ -1826,7 +2225,8 @@ gp_status gp_voronoi_try_move(gp_voronoi *v, size_t i, gp_vec2 pu, gp_error *err
             uint32_t j = (uint32_t)v->aff[k];
             if (v->cst[j] == v->cstamp) continue;
             v->cst[j] = v->cstamp;
-            st = recompute(v, j);
+            int how = k < oc->nnb ? RC_NB : v->cell[j]->convex ? RC_CUT : RC_NB;
+            st = recompute(v, j, how, oc);
         }
     }
     if (st != GP_OK) {

@@ -28,11 +28,15 @@
  * Neighbours. j is a neighbour of i when cells i and j share a boundary segment inside the
  * container (of length above ~1e-13 of the container size).
  *
- * Local updates. Moving one seed recomputes only the cells it can affect, in a time independent
- * of N (a uniform grid of seeds, see gp_voronoi.c). Each cell is computed in a canonical order
- * (grid bins in fixed rings, seeds by index inside a bin), so a cell recomputed after moves is
- * bit-for-bit the cell a fresh gp_voronoi_create() of the same seeds gives, and a rolled-back
- * move restores everything bit for bit.
+ * Local updates. Moving one seed recomputes only the cells it can affect (its neighbours before
+ * and after the move, about 9), in a time independent of N: each from candidates taken from the
+ * neighbour lists -- a best-first search of the neighbour graph for the moved seed, the
+ * neighbours of the cell and of the moved seed for the others (gp_voronoi.c, "Moves", says why
+ * these sets hold every new neighbour). A full build finds candidates in a uniform grid of
+ * seeds instead. Either way a cell's vertices are recomputed from the lines that bound it
+ * (canonical), so a cell recomputed after moves is bit-for-bit the cell a fresh
+ * gp_voronoi_create() of the same seeds gives, and a rolled-back move restores everything bit
+ * for bit.
  *
  * Coordinates. Internally everything is relative to the container's bounding box (origin at its
  * lower-left corner, tolerances relative to its size), so the unit square scaled by 1e-6 or 1e6

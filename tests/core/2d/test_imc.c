@@ -219,6 +219,49 @@ static int progress_cb(void *user, const gp_progress *p)
     return user ? (p->steps >= 8192) : 0;
 }
 
+/* 10,000 IMC steps (moves of every kind, most of them rolled back), then the tessellation the
+ * run kept against a fresh gp_voronoi_create of its final seeds: every cell's area,
+ * orientation, parts and neighbours bit for bit. The moves recompute cells from the neighbour
+ * lists (gp_voronoi.c, "Moves"), the fresh build from the grid: two independent routes to the
+ * same cells. */
+static void rebuild_matches(const char *name, const gp_vec2 *outer, size_t no,
+                            const gp_vec2 *const *holes, const size_t *nh, size_t nholes, size_t n)
+{
+    gp_imc_params p;
+    gp_imc_params_defaults(&p);
+    p.cov = 0.8;
+    p.threshold = 1e-12; /* never reached: exactly max_steps steps */
+    p.max_steps = 10000;
+    p.seed = 5;
+    gp_voronoi *v = NULL;
+    gp_imc_report r;
+    gp_imc_run(outer, no, holes, nh, nholes, n, &p, NULL, NULL, NULL, &v, &r, NULL);
+    CHECK(v != NULL && r.steps == 10000 && r.accepted > 100 && r.accepted < r.steps);
+    if (!v) return;
+    gp_vec2 *s = malloc(n * sizeof *s);
+    for (size_t i = 0; i < n; i++) s[i] = gp_voronoi_seed(v, i);
+    gp_voronoi *f = gp_voronoi_create(outer, no, holes, nh, nholes, s, n, NULL);
+    CHECK(f != NULL);
+    int bad = 0;
+    static size_t na[256], nb[256];
+    for (size_t i = 0; f && i < n; i++) {
+        double a = gp_voronoi_cell_area(v, i), b = gp_voronoi_cell_area(f, i);
+        double oa = gp_voronoi_cell_orientation(v, i), ob = gp_voronoi_cell_orientation(f, i);
+        size_t ka = gp_voronoi_neighbours(v, i, na, 256), kb = gp_voronoi_neighbours(f, i, nb, 256);
+        int ok = !memcmp(&a, &b, sizeof a) && !memcmp(&oa, &ob, sizeof oa) && ka == kb &&
+                 !memcmp(na, nb, ka * sizeof *na) && gp_voronoi_cell_parts(v, i) == gp_voronoi_cell_parts(f, i);
+        if (!ok && bad++ < 3)
+            fprintf(stderr, "%s: cell %zu area %.17g vs %.17g, orient %.17g vs %.17g, nb %zu vs %zu\n", name,
+                    i, a, b, oa, ob, ka, kb);
+    }
+    printf("%s: %ld steps (%ld accepted), rebuilt, %d cells differ\n", name, r.steps, r.accepted, bad);
+    CHECK(bad == 0);
+    gp_voronoi_destroy(f);
+    gp_voronoi_destroy(v);
+    gp_imc_report_free(&r);
+    free(s);
+}
+
 int main(void)
 {
     /* --- the paper's two configurations (Mollon & Zhao §3.3.3) and N = 2000 --- */
@@ -464,6 +507,19 @@ int main(void)
         hard("E1", SQ, 4, NULL, NULL, 0, 300, &p);
         p.error_kind = 2;
         hard("E2", SQ, 4, NULL, NULL, 0, 300, &p);
+    }
+    {
+        gp_vec2 L[6] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+        gp_vec2 *c, *h;
+        size_t nc, nh;
+        gp_voronoi_circle_polygon((gp_vec2){0, 0}, 1.0, 1e-3, &c, &nc, NULL);
+        gp_voronoi_circle_polygon((gp_vec2){0, 0}, 0.4, 1e-3, &h, &nh, NULL);
+        const gp_vec2 *holes[1] = {h};
+        rebuild_matches("rebuild: square", SQ, 4, NULL, NULL, 0, 400);
+        rebuild_matches("rebuild: L-shape", L, 6, NULL, NULL, 0, 400);
+        rebuild_matches("rebuild: annulus", c, nc, holes, &nh, 1, 300);
+        free(c);
+        free(h);
     }
     return gp_test_summary();
 }

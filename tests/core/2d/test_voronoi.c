@@ -4,7 +4,10 @@
  *   parts hold them; areas against a point count;
  * - sums of areas, seeds in their cells, neighbour symmetry, orientation against gp_min_caliper;
  * - robustness: duplicates, collinear seeds, seeds on the boundary, scales 1e-6 / 1e6, a 1000:1
- *   strip, an L-shape, an annulus, a U-shape that splits cells. */
+ *   strip, an L-shape, an annulus, a U-shape that splits cells;
+ * - moves (committed and rolled back; near edges, inside cells, anywhere) against a full rebuild
+ *   of the same seeds, bit for bit: 10,000 each on a square, an L-shape, an annulus, and a square
+ *   of 3,000 cells (moves recompute cells from the neighbour lists, a build from the grid). */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -644,7 +647,9 @@ int main(void)
     gp_voronoi_circle_polygon((gp_vec2){0, 0}, 1.0, 1e-3, &c, &nc, NULL);
     gp_voronoi_circle_polygon((gp_vec2){0, 0}, 0.35, 1e-3, &h, &nh, NULL);
     const gp_vec2 *holes[1] = {h};
-    property_moves("annulus N=150", c, nc, holes, &nh, 1, 150, 4000, 8);
+    property_moves("annulus N=150", c, nc, holes, &nh, 1, 150, 10000, 25);
+    /* more cells: the moved seed's search walks far on the neighbour graph (jumps anywhere) */
+    property_moves("square N=3000", sq, 4, NULL, NULL, 0, 3000, 10000, 2500);
     free(c);
     free(h);
     test_cancel(); /* last: it draws from urand() */
