@@ -2,7 +2,9 @@
  * Table 2, porosity 0.38) timed per phase, the DEM's sphere-steps per second, and the flip
  * tiling to 4 x 4 x 4 and to ~230,000 spheres, with the porosity and PSD errors next to the
  * timings; then a size ratio of 20 (1-20 mm, issue #6) the same way.
- * Usage: bench_spheres3d [threads] [seed]. */
+ * Usage: bench_spheres3d [threads] [seed] [--sample]. --sample: the paper's sample only, one
+ * table row (wall and CPU seconds, steps, sphere-steps/s, S_c, porosity, PSD error), the row
+ * bench/bench_peers.py reads. */
 #include "gp_clock.h"
 #include "gp_dem3d.h"
 #include "gp_flip.h"
@@ -11,6 +13,53 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double cpu_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static double psd_error(const gp_stats3d *S)
+{
+    double werr = 0;
+    for (size_t k = 0; k < S->psd.n; k++)
+        werr = fmax(werr, fabs(S->psd.achieved_weight[k] - S->psd.target_weight[k]));
+    return werr;
+}
+
+/* --sample: the paper's sample alone, one row */
+static int sample_row(int threads, unsigned long long seed)
+{
+    gp_spec3d s;
+    gp_spec3d_defaults(&s);
+    s.threads = threads;
+    s.seed = seed;
+    gp_specimen3d *r = NULL;
+    gp_error e;
+    double c0 = cpu_seconds();
+    gp_status st = gp_specimen3d_build(&s, NULL, NULL, NULL, &r, &e);
+    double cpu = cpu_seconds() - c0;
+    if (!r) {
+        printf("build failed: %s\n", e.message);
+        return 1;
+    }
+    const gp_stats3d *S = &r->stats;
+    double dem = r->t_deposition + r->t_compaction + r->t_relaxation;
+    printf("| code | threads | spheres | steps | wall s | CPU s | M sphere-steps/s | S_c | stop | "
+           "porosity | porosity error | max PSD error (pp) | z |\n"
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    printf("| grainpack | %d | %zu | %ld | %.3f | %.3f | %.2f | %.3g | %s%s%s | %.4f | %+.1e | %.2g | %.3f |\n",
+           threads, S->sample_particles, S->steps, r->t_total, cpu,
+           S->steps * (double)S->sample_particles / dem / 1e6, S->stability, S->stop_reason,
+           st ? ": " : "", st ? e.message : "", S->porosity, S->porosity - S->porosity_target,
+           psd_error(S), S->coordination_number);
+    gp_specimen3d_destroy(r);
+    return st != GP_OK;
+}
 
 static void tile_row(const gp_specimen3d *r, const gp_contact3d *c, size_t nc, int nx, int ny,
                      int nz)
@@ -51,10 +100,14 @@ int main(int argc, char **argv)
     gp_spec3d_defaults(&s);
     s.threads = argc > 1 ? atoi(argv[1]) : 1;
     s.seed = argc > 2 ? strtoull(argv[2], NULL, 10) : 7;
+    if (argc > 3 && strcmp(argv[3], "--sample") == 0)
+        return sample_row(s.threads, s.seed);
     s.outputs = GP_OUT3_SPHERES | GP_OUT3_CONTACTS | GP_OUT3_FABRIC | GP_OUT3_STRESS;
     gp_specimen3d *r = NULL;
     gp_error e;
+    double c0 = cpu_seconds();
     gp_status st = gp_specimen3d_build(&s, NULL, NULL, NULL, &r, &e);
+    double cpu = cpu_seconds() - c0;
     if (!r) {
         printf("build failed: %s\n", e.message);
         return 1;
@@ -65,8 +118,8 @@ int main(int argc, char **argv)
            "threads %d, seed %llu: %s%s\n", s.threads, (unsigned long long)s.seed,
            gp_status_name(st), st ? e.message : "");
     printf("| phase | seconds |\n|---|---|\n");
-    printf("| deposition | %.2f |\n| compaction | %.2f |\n| relaxation | %.2f |\n| total | %.2f |\n",
-           r->t_deposition, r->t_compaction, r->t_relaxation, r->t_total);
+    printf("| deposition | %.2f |\n| compaction | %.2f |\n| relaxation | %.2f |\n| total | %.2f "
+           "(CPU %.2f) |\n", r->t_deposition, r->t_compaction, r->t_relaxation, r->t_total, cpu);
     printf("| DEM | %ld steps x %zu spheres, dt %.3g s, %.2f M sphere-steps/s |\n", S->steps,
            S->sample_particles, S->dt, S->steps * (double)S->sample_particles / dem / 1e6);
     printf("| result | porosity %.4f (target %.2f, error %+.1e), phase 0 %.3f, S_c %.2g (%s), "
@@ -78,14 +131,11 @@ int main(int argc, char **argv)
     printf("| stress (Pa) | xx %.0f yy %.0f zz %.0f |\n", S->stress[0][0], S->stress[1][1],
            S->stress[2][2]);
     printf("| sieve (mm) | target wt | achieved wt | target no. (uniform) | achieved no. | paper no. (mid-bin) |\n");
-    double werr = 0;
-    for (size_t k = 0; k < S->psd.n; k++) {
+    for (size_t k = 0; k < S->psd.n; k++)
         printf("| %.0f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", 1000 * S->psd.diameter[k],
                S->psd.target_weight[k], S->psd.achieved_weight[k], S->psd.target_number[k],
                S->psd.achieved_number[k], S->psd.target_number_midbin[k]);
-        werr = fmax(werr, fabs(S->psd.achieved_weight[k] - S->psd.target_weight[k]));
-    }
-    printf("| PSD | max error by weight %.2g pp |\n", werr);
+    printf("| PSD | max error by weight %.2g pp |\n", psd_error(S));
     tile_row(r, r->contacts, r->ncontacts, 4, 4, 4);
     tile_row(r, r->contacts, r->ncontacts, 4, 4, 6);
     gp_specimen3d_destroy(r);
@@ -113,9 +163,7 @@ int main(int argc, char **argv)
             printf("| %.2f | build failed: %s |\n", w.box[0], e.message);
             continue;
         }
-        double we = 0;
-        for (size_t k = 0; k < q->stats.psd.n; k++)
-            we = fmax(we, fabs(q->stats.psd.achieved_weight[k] - q->stats.psd.target_weight[k]));
+        double we = psd_error(&q->stats);
         printf("| %.2f | %.2f | %zu | %ld | %.2f | %.4f | %.2g | %.2f deg | %.2g | %s%s%s |\n",
                w.box[0], w.porosity, q->count, q->stats.steps, q->t_total, q->stats.porosity,
                q->stats.stability, q->stats.compaction_friction_deg, we, q->stats.stop_reason, sq ? ": " : "",

@@ -19,12 +19,21 @@
  *     (free flight: fines fall at g, not at g scaled down; see gp_dem3d.c);
  *   - time step dt = dt_safety * min_i sqrt(m_i / (2 E R_i)) (2 E R_i is the stiffest contact a
  *     sphere of radius R_i can have: with a wall or a much larger sphere);
- *   - contact detection with a linked-cell grid and a Verlet skin (pairs with a gap below
- *     skin + the free-flight gap are listed; rebuilt when a sphere has moved more than
- *     skin / 2; results do not depend on the skin); shear springs persist
- *     across rebuilds by (i, j).
- *   - threads: per-pair forces, then per-sphere sums in a fixed order; every reduction is done
- *     over fixed blocks of spheres, so results are bit for bit the same for any thread count.
+ *   - contact detection: a Verlet list of candidate pairs i < j (a half list: each pair once),
+ *     those with a gap below skin + the free-flight gap, sorted by (i, j); rebuilt only when
+ *     some sphere has moved (or grown) more than skin / 2 since the last rebuild, from
+ *     linked-cell grids, one per size level, in which each pair is looked at once (within a
+ *     level from the first of its two cells in a fixed forward order, across levels from the
+ *     smaller sphere). Shear springs persist across rebuilds by (i, j). Results do not depend
+ *     on the skin, bit for bit (a sphere sums its pairs in (i, j) order, and a pair enters the
+ *     list before it can come within the free-flight gap);
+ *   - a step: the pair forces, then one pass over the spheres (walls, damping, leapfrog). One
+ *     thread adds each pair's force to both spheres inside the pair loop; with threads, the
+ *     pair forces are computed in ranges and each sphere gathers its own in pair order. Both
+ *     sum a sphere's pairs in (i, j) order and every reduction runs over fixed blocks of
+ *     spheres, so results are bit for bit the same for any thread count. Layout: the pair
+ *     list is a structure of arrays (i, j, f_n, then 3-vectors per pair: spring, force), the
+ *     per-sphere sums of the step arrays beside the spheres'.
  * Units SI. Walls 0..5: x-, x+, y-, y+, z-, z+.
  *
  * Ownership: gp_dem3d_create copies the spheres; the gp_dem3d owns its state and its worker

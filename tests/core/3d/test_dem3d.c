@@ -2,6 +2,7 @@
 #include "gp_dem3d.h"
 #include "gp_test.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -241,6 +242,92 @@ static void test_pairs_and_threads(void)
     free(s);
 }
 
+/* The sphere pairs in contact during the next step of d are those that overlap at xyzr (its
+ * spheres now) by brute force, the same test in the same arithmetic as the DEM's. */
+static void check_contacts_brute(gp_dem3d *d, const double *xyzr, size_t n)
+{
+    gp_error e;
+    CHECK(gp_dem3d_run(d, 1, &e) == GP_OK);
+    gp_contact3d *c;
+    size_t nc, k = 0, brute = 0, match = 0;
+    CHECK(gp_dem3d_contacts(d, &c, &nc, &e) == GP_OK);
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = i + 1; j < n; j++) {
+            const double *a = xyzr + 4 * i, *b = xyzr + 4 * j;
+            double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2], R = a[3] + b[3];
+            double d2 = dx * dx + dy * dy + dz * dz;
+            if (!(d2 < R * R && d2 > 0))
+                continue;
+            brute++;
+            if (k < nc && c[k].j >= 0 && c[k].i == i && (size_t)c[k].j == j) {
+                match++;
+                k++;
+            }
+        }
+    CHECK(brute > 0 && match == brute && (k == nc || c[k].j < 0));
+    free(c);
+}
+
+/* The Verlet list: a pair comes into the candidate list before it can touch, whatever the skin,
+ * and a sphere sums its pairs in (i, j) order; so a tiny skin (a rebuild every few steps) and a
+ * wide one (few rebuilds, many idle candidates) must give the same bits, and so must 1 and 2 threads
+ * (two code paths: forces added in the pair loop, or gathered per sphere). Radii 0.5-10 mm
+ * spread over five size levels of the cell grids, so pairs across levels are covered; three servo
+ * walls squeeze the cloud into a packing. */
+static void test_skin_independent(void)
+{
+    size_t n = 500;
+    double *s = malloc(4 * n * sizeof *s);
+    uint64_t st = 777;
+    for (size_t i = 0; i < n; i++) { /* on a 20 mm lattice, so that nothing overlaps at the start */
+        double u = (double)(lcg(&st) % 1000) / 1000.0;
+        s[4 * i + 3] = 0.0005 * pow(20, u * u); /* 0.5-10 mm: many small, a few large */
+        size_t c[3] = {i % 9, (i / 9) % 9, i / 81};
+        for (int a = 0; a < 3; a++)
+            s[4 * i + a] = 0.02 + 0.02 * (double)c[a] + 0.001 * (double)(lcg(&st) % 1000) / 1000.0;
+    }
+    double lo[3] = {0, 0, 0}, hi[3] = {0.2, 0.2, 0.2};
+    double *out[3];
+    long reb[3];
+    size_t ncon[3];
+    static const double skin[3] = {0.0001, 0.004, 0.004};
+    for (int t = 0; t < 3; t++) {
+        gp_dem3d_params p = base();
+        p.threads = t == 2 ? 2 : 1;
+        p.scaled_radius = 0.01;
+        p.gravity[2] = 0; /* three servo walls squeeze the cloud into a packing */
+        p.skin = skin[t];
+        gp_dem3d *d;
+        gp_error e;
+        CHECK(gp_dem3d_create(&p, s, n, lo, hi, &d, &e) == GP_OK);
+        for (int w = 1; w < 6; w += 2)
+            gp_dem3d_set_servo(d, w, 200, 1.0);
+        gp_dem3d_set_radius_scale(d, 0.7);
+        CHECK(gp_dem3d_run(d, 1500, &e) == GP_OK);
+        for (int g = 1; g <= 30; g++) { /* growth: the rebuild rule's other half */
+            gp_dem3d_set_radius_scale(d, 0.7 + 0.01 * g);
+            CHECK(gp_dem3d_run(d, 20, &e) == GP_OK);
+        }
+        CHECK(gp_dem3d_run(d, 3000, &e) == GP_OK);
+        gp_dem3d_state ds;
+        gp_dem3d_get_state(d, &ds);
+        reb[t] = ds.rebuilds;
+        ncon[t] = ds.contacts;
+        out[t] = malloc(4 * n * sizeof *out[t]);
+        gp_dem3d_spheres(d, out[t]);
+        check_contacts_brute(d, out[t], n);
+        gp_dem3d_destroy(d);
+    }
+    CHECK(ncon[0] > n / 3);                /* a packing (250 contacts), not a gas */
+    CHECK(reb[0] > 5 * reb[1]);            /* the tiny skin did rebuild far more often */
+    CHECK(memcmp(out[0], out[1], 4 * n * sizeof(double)) == 0);
+    CHECK(memcmp(out[1], out[2], 4 * n * sizeof(double)) == 0);
+    CHECK(ncon[0] == ncon[1] && ncon[1] == ncon[2]);
+    for (int t = 0; t < 3; t++)
+        free(out[t]);
+    free(s);
+}
+
 static void test_solid_volume(void)
 {
     /* a sphere cut in half by a wall, and one whole */
@@ -257,6 +344,7 @@ int main(void)
     test_shear();
     test_servo();
     test_pairs_and_threads();
+    test_skin_independent();
     test_solid_volume();
     return gp_test_summary();
 }
