@@ -3,6 +3,8 @@
 # use: the DEM programs lammps (with openmpi-bin: mpirun runs the lammps-relax script on 2
 # ranks), liggghts and yade, and VTK's Python reader, which prove that the export files load,
 # node (the dashboard's script) and promtool (package prometheus: checks the /metrics text),
+# postgresql (initdb, pg_ctl, psql: the it_pg_* tests start a server of their own; the
+# package's own cluster is not used),
 # and for the dashboard's browser test chromium, npm and then, by `npm ci` in
 # tests/integration/browser/, puppeteer-core as pinned in its package-lock.json (tests/run.sh
 # passes --test). npm runs as the user running this script; only apt-get goes through sudo.
@@ -11,12 +13,13 @@ set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PKGS="build-essential cmake pkg-config \
-  libmicrohttpd-dev libjansson-dev libsqlite3-dev libfftw3-dev libgsl-dev \
+  libmicrohttpd-dev libjansson-dev libsqlite3-dev libpq-dev libfftw3-dev libgsl-dev \
   python3 curl wrk"
 TEST=0
 if [ "${1:-}" = "--test" ]; then
   TEST=1
-  PKGS="$PKGS lammps openmpi-bin liggghts yade python3-vtk9 nodejs prometheus chromium fonts-dejavu-core"
+  PKGS="$PKGS lammps openmpi-bin liggghts yade python3-vtk9 nodejs prometheus chromium fonts-dejavu-core \
+    postgresql"
 fi
 missing=""
 for p in $PKGS; do

@@ -361,9 +361,11 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
                               max_queued, max_queued);
     }
     if (rc != STORE_OK) return send_store_error(c, r);
+    /* read back before the workers hear of it: the answer shows the job as submitted (queued),
+     * not as a worker may already have claimed it a millisecond later */
+    json_t *job = store_get_job(id, &rc);
     workers_notify();
     gpd_log(GPD_LOG_INFO, "job %s queued", id);
-    json_t *job = store_get_job(id, &rc);
     if (!job) return send_store_error(c, r);
     char loc[64];
     snprintf(loc, sizeof loc, "/v1/jobs/%s", id);

@@ -38,7 +38,14 @@ static void usage(FILE *f)
             "  --listen HOST:PORT     address to listen on [GRAINPACK_LISTEN]\n"
             "                         (default 127.0.0.1:8080; port 0 = pick a free port;\n"
             "                         the first stdout line is 'listening on http://HOST:PORT')\n"
-            "  --db PATH              SQLite job database [GRAINPACK_DB] (default ./grainpack.db)\n"
+            "  --db PATH|URL          the job database [GRAINPACK_DB]: a file path is SQLite\n"
+            "                         (default ./grainpack.db, one daemon per file); a URL\n"
+            "                         postgresql://user@host:port/dbname is PostgreSQL, where\n"
+            "                         many daemons (on any hosts) share one queue\n"
+            "  --lease S              PostgreSQL: seconds a running job stays claimed without\n"
+            "                         its daemon renewing it (every S/3 s); a job whose lease\n"
+            "                         lapsed is taken over by another daemon [GRAINPACK_LEASE]\n"
+            "                         (default 30)\n"
             "  --workers N            worker threads running jobs [GRAINPACK_WORKERS]\n"
             "                         (default: the number of CPU cores)\n"
             "  --log-level LEVEL      error|warn|info|debug [GRAINPACK_LOG_LEVEL] (default info;\n"
@@ -71,6 +78,8 @@ static void usage(FILE *f)
             "\n"
             "Restart rule: jobs found 'running' at start-up (the daemon crashed) are queued again,\n"
             "up to %d attempts; a job interrupted %d times fails with error code 'interrupted'.\n"
+            "On PostgreSQL a job whose daemon died is taken over once its lease lapses, and the\n"
+            "same rule counts its attempts across daemons.\n"
             "SIGTERM/SIGINT requeue running jobs without counting an attempt.\n"
             "DELETE /v1/jobs/ID?purge=1 removes a finished job; GET /metrics is for Prometheus.\n",
             STORE_MAX_ATTEMPTS, STORE_MAX_ATTEMPTS);
@@ -114,7 +123,7 @@ static const char *env_or(const char *name, const char *dflt)
 /* the settings as given: the command line, else the environment, else the defaults */
 typedef struct settings {
     const char *listen, *db, *workers, *level, *threads, *maxconn, *timeout, *maxbody, *maxres,
-        *jobto, *retain, *maxq;
+        *jobto, *retain, *maxq, *lease;
 } settings;
 
 /* Reads the command line over st (the environment's values); -1 to go on, else the exit
@@ -132,6 +141,7 @@ static int read_args(int argc, char **argv, settings *st)
         {"job-timeout", required_argument, 0, 'J'},
         {"retain-days", required_argument, 0, 1002},
         {"max-queued", required_argument, 0, 1003},
+        {"lease", required_argument, 0, 1004},
         {"allow-origin", required_argument, 0, 1001},
         {"help", no_argument, 0, 'h'},               {"version", no_argument, 0, 'V'},
         {0, 0, 0, 0}};
@@ -150,6 +160,7 @@ static int read_args(int argc, char **argv, settings *st)
         case 'J': st->jobto = optarg; break;
         case 1002: st->retain = optarg; break;
         case 1003: st->maxq = optarg; break;
+        case 1004: st->lease = optarg; break;
         case 1001:
             if (gpd_allow_origins(optarg)) return 2;
             origins_flag = 1;
@@ -168,6 +179,17 @@ static int read_args(int argc, char **argv, settings *st)
     return -1;
 }
 
+/* The --db value as it may be logged: a URL's password (user:PASSWORD@host) as "***". */
+static void db_for_log(const char *db, char *out, size_t len)
+{
+    const char *scheme = strstr(db, "://"), *at = scheme ? strchr(scheme + 3, '@') : NULL;
+    const char *colon = at ? memchr(scheme + 3, ':', (size_t)(at - scheme - 3)) : NULL;
+    if (!store_is_url(db) || !colon)
+        snprintf(out, len, "%s", db);
+    else
+        snprintf(out, len, "%.*s:***%s", (int)(colon - db), db, at);
+}
+
 /* Opens the job store (its lock first, before recovery touches any job) and applies the
  * restart rule; 0, or -1 (said on stderr). */
 static int open_store(const char *db)
@@ -181,7 +203,9 @@ static int open_store(const char *db)
         return -1;
     }
     if (open_rc != 0) {
-        fprintf(stderr, "grainpackd: cannot open the job database %s\n", db);
+        char shown[512];
+        db_for_log(db, shown, sizeof shown);
+        fprintf(stderr, "grainpackd: cannot open the job database %s\n", shown);
         return -1;
     }
     int requeued = 0, failed = 0;
@@ -254,10 +278,11 @@ int main(int argc, char **argv)
                    env_or("GRAINPACK_MAX_RESULT_MB", "1024"),
                    env_or("GRAINPACK_JOB_TIMEOUT", "3600"),
                    env_or("GRAINPACK_RETAIN_DAYS", "0"),
-                   env_or("GRAINPACK_MAX_QUEUED", "10000")};
+                   env_or("GRAINPACK_MAX_QUEUED", "10000"),
+                   env_or("GRAINPACK_LEASE", "30")};
     int rc = read_args(argc, argv, &st);
     if (rc >= 0) return rc;
-    long nworkers, nthreads, maxconn, timeout, maxbody, maxres, jobto, maxq;
+    long nworkers, nthreads, maxconn, timeout, maxbody, maxres, jobto, maxq, lease;
     double retain_days;
     if (parse_long("--workers", st.workers, 1, 1024, &nworkers) ||
         parse_long("--http-threads", st.threads, 1, 256, &nthreads) ||
@@ -267,6 +292,7 @@ int main(int argc, char **argv)
         parse_long("--max-result-mb", st.maxres, 1, 1L << 20, &maxres) ||
         parse_long("--job-timeout", st.jobto, 0, 31622400, &jobto) ||
         parse_long("--max-queued", st.maxq, 1, 1000000000, &maxq) ||
+        parse_long("--lease", st.lease, 1, 86400, &lease) ||
         parse_days("--retain-days", st.retain, &retain_days))
         return 2;
     int level = gpd_log_parse_level(st.level);
@@ -285,6 +311,7 @@ int main(int argc, char **argv)
     pthread_sigmask(SIG_BLOCK, &set, NULL);
     signal(SIGPIPE, SIG_IGN);
 
+    store_set_lease((double)lease);
     if (open_store(st.db)) return 1;
     gpd_http_config cfg = {.threads = (unsigned)nthreads,
                            .max_connections = (unsigned)maxconn,
@@ -296,8 +323,10 @@ int main(int argc, char **argv)
     if (start(&cfg, nworkers, jobto, retain_days)) return 1;
     printf("listening on http://%s:%d\n", cfg.host, cfg.port);
     fflush(stdout);
-    gpd_log(GPD_LOG_INFO, "grainpackd %s: http://%s:%d, db %s, %ld workers, %ld http threads",
-            GPD_VERSION, cfg.host, cfg.port, st.db, nworkers, nthreads);
+    char shown[512];
+    db_for_log(st.db, shown, sizeof shown);
+    gpd_log(GPD_LOG_INFO, "grainpackd %s: http://%s:%d, db %s (%s), %ld workers, %ld http threads",
+            GPD_VERSION, cfg.host, cfg.port, shown, store_backend_name(), nworkers, nthreads);
     if (retain_days > 0)
         gpd_log(GPD_LOG_INFO, "retention: finished jobs are purged %g days after they finished",
                 retain_days);

@@ -274,7 +274,8 @@ char *metrics_render(size_t *len)
     render_http(&b);
     long long bytes = 0;
     head(&b, "grainpack_database_bytes", "gauge",
-         "Size of the job database on disk: its pages and its write-ahead log.");
+         "Size of the job database on disk: SQLite's pages and write-ahead log, or "
+         "PostgreSQL's pg_database_size.");
     if (store_size(&bytes) == 0) gpd_buf_printf(&b, "grainpack_database_bytes %lld\n", bytes);
     if (b.oom) {
         free(b.buf);

@@ -1,342 +1,143 @@
-/* store.c -- SQLite job store (see store.h for the table and the restart rule). */
-#define _GNU_SOURCE /* F_OFD_SETLK: the database lock (store_open) */
-#include "store.h"
+/* store.c -- the job store's dispatch to its back end (store_impl.h) and what the back ends
+ * share: the last failed write, result summaries, values as byte sources. */
+#include "store_impl.h"
 
-#include <errno.h>
-#include <fcntl.h>
-#include <limits.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/file.h>
-#include <sys/stat.h>
-#include <time.h>
-#include <unistd.h>
-
-#include <sqlite3.h>
 
 #include "json_scan.h"
 
-/* ------------------------------------------------------------------ connections */
+/* chosen by store_open (before any thread) and kept to the end: reads need no lock */
+static const store_backend *be = &store_sqlite;
+static double lease_s = STORE_LEASE_DEFAULT_S;
+static void (*cancel_hook)(const char *id) = NULL;
 
-static int auto_vacuum = 0; /* the database gives space back (set by store_open) */
-
-/* The one integer a query answers (its first column of its first row); -1 when it fails. */
-static long query_long(sqlite3 *db, const char *sql)
+int store_is_url(const char *target)
 {
-    sqlite3_stmt *st = NULL;
-    long v = -1;
-    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW)
-        v = (long)sqlite3_column_int64(st, 0);
-    sqlite3_finalize(st);
-    return v;
+    return !strncmp(target, "postgresql://", 13) || !strncmp(target, "postgres://", 11);
 }
 
-static char *db_path = NULL;
-static pthread_key_t conn_key;
-static int closed = 0; /* guarded by path_mu */
-static pthread_mutex_t path_mu = PTHREAD_MUTEX_INITIALIZER;
-static int lock_fd = -1; /* holds the database lock from store_open to store_close */
-
-/* Testing hooks (environment, read once by store_open; never needed in production): lower
- * SQLite's length limit (GRAINPACK_TEST_SQLITE_MAX_LENGTH, bytes: a result over it is
- * SQLITE_TOOBIG) or the database's page count (GRAINPACK_TEST_SQLITE_MAX_PAGES: a write past it
- * is SQLITE_FULL, as on a full disk) on every connection, so that the integration tests can
- * drive the failure paths of the store. 0 = not set. */
-static long test_max_length = 0, test_max_pages = 0;
-
-/* A thread's connection and its prepared statements, cached by SQL text address (every SQL
- * string here is a literal), so that a status poll costs one sqlite3_step. */
-#define STMT_CACHE 40
-typedef struct conn_t {
-    sqlite3 *db;
-    int n;
-    const char *sql[STMT_CACHE];
-    sqlite3_stmt *st[STMT_CACHE];
-} conn_t;
-
-static void conn_destroy(void *p)
+void store_set_lease(double seconds)
 {
-    conn_t *c = p;
-    if (!c) return;
-    for (int i = 0; i < c->n; i++) sqlite3_finalize(c->st[i]);
-    sqlite3_close_v2(c->db);
-    free(c);
+    lease_s = seconds > 0 ? seconds : STORE_LEASE_DEFAULT_S;
 }
 
-#define STORE_JOURNAL_LIMIT "67108864" /* 64 MB */
-
-static const char *SCHEMA_SQL =
-    "CREATE TABLE IF NOT EXISTS jobs("
-    " seq INTEGER PRIMARY KEY AUTOINCREMENT,"
-    " id TEXT NOT NULL UNIQUE,"
-    " kind TEXT NOT NULL,"
-    " spec TEXT NOT NULL,"
-    " status TEXT NOT NULL,"
-    " progress TEXT,"
-    " created_at TEXT NOT NULL,"
-    " started_at TEXT,"
-    " finished_at TEXT,"
-    " error TEXT,"
-    " result TEXT,"
-    " attempts INTEGER NOT NULL DEFAULT 0);"
-    "CREATE INDEX IF NOT EXISTS jobs_status_seq ON jobs(status, seq);"
-    /* GET /metrics counts jobs by kind and status every scrape: a covering index; the
-     * retention sweep finds finished jobs by age (queued and running ones have none) */
-    "CREATE INDEX IF NOT EXISTS jobs_kind_status ON jobs(kind, status);"
-    "CREATE INDEX IF NOT EXISTS jobs_finished_at ON jobs(finished_at)"
-    " WHERE finished_at IS NOT NULL;"
-    /* the export pack of a succeeded job (core/export/gp_export.h), keyed by the job's seq so that
-     * it can be read with incremental blob I/O */
-    "CREATE TABLE IF NOT EXISTS exports(seq INTEGER PRIMARY KEY, pack BLOB NOT NULL);"
-    /* the summary of a succeeded job's result (store_get_summary), committed with it; a
-     * table of its own so that databases written before it need no migration */
-    "CREATE TABLE IF NOT EXISTS summaries(seq INTEGER PRIMARY KEY, summary TEXT NOT NULL,"
-    " arrays TEXT);";
-
-/* The jobs' brief (kind.h), a column added after the table: a database made before it gets it
- * here, and its jobs their briefs from store_fill_briefs. 0, or -1 (logged). */
-static int add_brief_column(sqlite3 *db)
+double store_lease(void)
 {
-    if (query_long(db, "SELECT count(*) FROM pragma_table_info('jobs') WHERE name='brief'") > 0)
-        return 0;
-    char *em = NULL;
-    if (sqlite3_exec(db, "ALTER TABLE jobs ADD COLUMN brief TEXT", NULL, NULL, &em) == SQLITE_OK)
-        return 0;
-    gpd_log(GPD_LOG_ERROR, "cannot add the brief column to the jobs table: %s", em ? em : "?");
-    sqlite3_free(em);
-    return -1;
+    return lease_s;
 }
 
-/* a copy of the database's path; NULL once the store is closed (or out of memory) */
-static char *path_copy(void)
+void store_on_cancel(void (*fn)(const char *id))
 {
-    pthread_mutex_lock(&path_mu);
-    char *path = (closed || !db_path) ? NULL : strdup(db_path);
-    pthread_mutex_unlock(&path_mu);
-    return path;
+    __atomic_store_n(&cancel_hook, fn, __ATOMIC_RELEASE);
 }
 
-static sqlite3 *conn_open(void)
+void store_cancel_seen(const char *id)
 {
-    char *path = path_copy();
-    if (!path) return NULL;
-    sqlite3 *db = NULL;
-    int rc = sqlite3_open_v2(path, &db,
-                             SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
-                             NULL);
-    free(path);
-    if (rc != SQLITE_OK) {
-        gpd_log(GPD_LOG_ERROR, "sqlite open: %s", db ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
-        sqlite3_close_v2(db);
-        return NULL;
-    }
-    sqlite3_busy_timeout(db, 5000);
-    char *em = NULL;
-    /* journal_size_limit: a WAL that a big result grew to hundreds of MB is cut back to this
-     * once a checkpoint has reset it (store_reclaim truncates it to nothing) */
-    if (sqlite3_exec(db,
-                     "PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON; "
-                     "PRAGMA journal_size_limit=" STORE_JOURNAL_LIMIT ";",
-                     NULL, NULL, &em) != SQLITE_OK) {
-        gpd_log(GPD_LOG_ERROR, "sqlite pragma: %s", em ? em : "?");
-        sqlite3_free(em);
-        sqlite3_close_v2(db);
-        return NULL;
-    }
-    if (test_max_length > 0) sqlite3_limit(db, SQLITE_LIMIT_LENGTH, (int)test_max_length);
-    if (test_max_pages > 0) {
-        char pragma[64];
-        snprintf(pragma, sizeof pragma, "PRAGMA max_page_count=%ld", test_max_pages);
-        sqlite3_exec(db, pragma, NULL, NULL, NULL);
-    }
-    return db;
+    void (*fn)(const char *) = __atomic_load_n(&cancel_hook, __ATOMIC_ACQUIRE);
+    if (fn) fn(id);
 }
 
-static conn_t *conn_t_get(void)
+const char *store_backend_name(void)
 {
-    conn_t *c = pthread_getspecific(conn_key);
-    if (c) return c;
-    sqlite3 *db = conn_open();
-    if (!db) return NULL;
-    c = calloc(1, sizeof *c);
-    if (!c) {
-        sqlite3_close_v2(db);
-        return NULL;
-    }
-    c->db = db;
-    pthread_setspecific(conn_key, c);
-    return c;
+    return be->name;
 }
 
-static sqlite3 *conn(void)
+int store_open(const char *target)
 {
-    conn_t *c = conn_t_get();
-    return c ? c->db : NULL;
+    be = store_is_url(target) ? &store_pg : &store_sqlite;
+    return be->open(target);
 }
 
-static long env_long(const char *name)
+void store_close(void) { be->close(); }
+void store_thread_done(void) { be->thread_done(); }
+int store_recover(int *requeued, int *failed) { return be->recover(requeued, failed); }
+
+store_rc store_insert(const char *kind, const char *spec_json, const char *brief_json,
+                      long max_queued, char id_out[33])
 {
-    const char *v = getenv(name);
-    long n = v ? strtol(v, NULL, 10) : 0;
-    return n > 0 ? n : 0;
+    return be->insert(kind, spec_json, brief_json, max_queued, id_out);
 }
 
-/* The database lock: an open-file-description write lock (F_OFD_SETLK) on one byte of the
- * database file itself, far from the bytes SQLite locks (its lock page starts at 1 GiB, 512
- * bytes). Being on the file's inode it holds whatever path names the file (a symlink, a hard
- * link, "./x" and "x"); being an OFD lock it is not dropped when SQLite closes one of its own
- * descriptors of the file, as a classic POSIX lock would be; it goes when the daemon closes
- * the store or dies (kill -9 included). Where OFD locks are missing, flock() on the same file.
- * Returns 0 when taken, 1 when another process holds it, -1 on an error (logged). */
-#define STORE_LOCK_OFFSET (0x40000000LL + 0x10000LL)
-static int lock_take(const char *path)
+int store_fill_briefs(store_brief_fn make) { return be->fill_briefs(make); }
+json_t *store_get_job(const char *id, store_rc *rc) { return be->get_job(id, rc); }
+
+store_rc store_get_text(const char *id, const char *column, char **text, char status[16])
 {
-    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        gpd_log(GPD_LOG_ERROR, "cannot open %s to lock it: %s", path, strerror(errno));
-        return -1;
-    }
-    int r = -1, use_flock = 1;
-#ifdef F_OFD_SETLK
-    struct flock fl;
-    memset(&fl, 0, sizeof fl);
-    fl.l_type = F_WRLCK;
-    fl.l_whence = SEEK_SET;
-    fl.l_start = (off_t)STORE_LOCK_OFFSET;
-    fl.l_len = 1;
-    use_flock = 0;
-    if (fcntl(fd, F_OFD_SETLK, &fl) == 0) {
-        r = 0;
-    } else if (errno == EAGAIN || errno == EACCES) {
-        r = 1;
-    } else if (errno == EINVAL) {
-        use_flock = 1; /* a kernel without OFD locks */
-    } else {
-        gpd_log(GPD_LOG_ERROR, "cannot lock %s: %s", path, strerror(errno));
-    }
-#endif
-    if (use_flock) {
-        if (flock(fd, LOCK_EX | LOCK_NB) == 0)
-            r = 0;
-        else if (errno == EWOULDBLOCK)
-            r = 1;
-        else
-            gpd_log(GPD_LOG_ERROR, "cannot lock %s: %s", path, strerror(errno));
-    }
-    if (r == 0)
-        lock_fd = fd;
-    else
-        close(fd);
-    return r;
+    return be->get_text(id, column, text, status);
 }
 
-int store_open(const char *path)
+json_t *store_list(const char *status, int limit, const char *after, store_rc *rc)
 {
-    static int key_made = 0; /* store_open is called once, from main, before any thread */
-    if (!key_made) {
-        if (pthread_key_create(&conn_key, conn_destroy) != 0) return -1;
-        key_made = 1;
-    }
-    test_max_length = env_long("GRAINPACK_TEST_SQLITE_MAX_LENGTH");
-    test_max_pages = env_long("GRAINPACK_TEST_SQLITE_MAX_PAGES");
-    /* the lock first: nothing may read or change the jobs of another daemon's database */
-    if (lock_fd < 0) {
-        int l = lock_take(path);
-        if (l) return l > 0 ? STORE_OPEN_LOCKED : -1;
-    }
-    pthread_mutex_lock(&path_mu);
-    free(db_path);
-    db_path = strdup(path);
-    closed = 0;
-    pthread_mutex_unlock(&path_mu);
-    if (!db_path) return -1;
-    sqlite3 *db = conn();
-    if (!db) return -1;
-    char *em = NULL;
-    /* A new database gives the space of purged jobs back (store_reclaim): auto_vacuum can only
-     * be chosen before the first table, and before WAL mode writes the file's first page.
-     * WAL is persistent in the file; set it once here. */
-    int fresh = query_long(db, "SELECT count(*) FROM sqlite_master") == 0;
-    if ((fresh && sqlite3_exec(db, "PRAGMA auto_vacuum=INCREMENTAL;", NULL, NULL, &em) !=
-                      SQLITE_OK) ||
-        sqlite3_exec(db, "PRAGMA journal_mode=WAL;", NULL, NULL, &em) != SQLITE_OK ||
-        sqlite3_exec(db, SCHEMA_SQL, NULL, NULL, &em) != SQLITE_OK) {
-        gpd_log(GPD_LOG_ERROR, "cannot initialise database %s: %s", path, em ? em : "?");
-        sqlite3_free(em);
-        return -1;
-    }
-    if (add_brief_column(db)) return -1;
-    auto_vacuum = query_long(db, "PRAGMA auto_vacuum") == 2;
-    if (!auto_vacuum)
-        gpd_log(GPD_LOG_WARN,
-                "database %s was made without auto_vacuum: the space of purged jobs is reused "
-                "but not given back to the file system until it is converted once, with the "
-                "daemon stopped: sqlite3 %s 'PRAGMA auto_vacuum=INCREMENTAL; VACUUM;' (see README)",
-                path, path);
-    return 0;
+    return be->list(status, limit, after, rc);
 }
 
-void store_thread_done(void)
+store_rc store_counts(long *queued, long *running, long *succeeded, long *failed,
+                      long *cancelled)
 {
-    conn_t *c = pthread_getspecific(conn_key);
-    if (c) {
-        conn_destroy(c);
-        pthread_setspecific(conn_key, NULL);
-    }
+    return be->counts(queued, running, succeeded, failed, cancelled);
 }
 
-void store_close(void)
+store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts)
 {
-    store_thread_done();
-    pthread_mutex_lock(&path_mu);
-    closed = 1;
-    free(db_path);
-    db_path = NULL;
-    pthread_mutex_unlock(&path_mu);
-    if (lock_fd >= 0) { /* the last: the database is released once this daemon is done */
-        close(lock_fd);
-        lock_fd = -1;
-    }
+    return be->claim(id, kind, spec_json, attempts);
 }
 
-/* ------------------------------------------------------------------ helpers */
-
-/* A prepared statement for sql (a string literal) on this thread's connection db; give it
- * back with done(). */
-static sqlite3_stmt *prep(sqlite3 *db, const char *sql)
+store_rc store_progress(const char *id, const char *progress_json)
 {
-    conn_t *c = pthread_getspecific(conn_key);
-    if (c && c->db == db)
-        for (int i = 0; i < c->n; i++)
-            if (c->sql[i] == sql) return c->st[i];
-    sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v3(db, sql, -1, SQLITE_PREPARE_PERSISTENT, &st, NULL) != SQLITE_OK) {
-        gpd_log(GPD_LOG_ERROR, "sqlite prepare: %s (%s)", sqlite3_errmsg(db), sql);
-        return NULL;
-    }
-    if (c && c->db == db && c->n < STMT_CACHE) {
-        c->sql[c->n] = sql;
-        c->st[c->n++] = st;
-    }
-    return st;
+    return be->progress(id, progress_json);
 }
 
-/* Resets a statement from prep() (finalizes it when it is not cached). */
-static void done(sqlite3_stmt *st)
+store_rc store_fail(const char *id, const char *code, const char *message)
 {
-    if (!st) return;
-    conn_t *c = pthread_getspecific(conn_key);
-    if (c)
-        for (int i = 0; i < c->n; i++)
-            if (c->st[i] == st) {
-                sqlite3_reset(st);
-                sqlite3_clear_bindings(st);
-                return;
-            }
-    sqlite3_finalize(st);
+    return be->fail(id, code, message);
 }
+
+store_rc store_requeue(const char *id) { return be->requeue(id); }
+
+store_rc store_cancel(const char *id, int *was_running, char status_out[16], char kind_out[64])
+{
+    return be->cancel(id, was_running, status_out, kind_out);
+}
+
+store_rc store_purge(const char *id, char status_out[16]) { return be->purge(id, status_out); }
+
+int store_purge_finished_before(const char *before, int max)
+{
+    return be->purge_finished_before(before, max);
+}
+
+int store_reclaim(void) { return be->reclaim(); }
+
+int store_count_by_kind(void (*fn)(void *user, const char *kind, const char *status, long n),
+                        void *user)
+{
+    return be->count_by_kind(fn, user);
+}
+
+int store_size(long long *bytes) { return be->size(bytes); }
+
+store_rc store_stream_open(const char *id, const char *what, size_t small, store_stream **out,
+                           char **text, size_t *text_len, char status[16])
+{
+    return be->stream_open(id, what, small, out, text, text_len, status);
+}
+
+uint64_t store_stream_size(const store_stream *s) { return be->stream_size(s); }
+
+int store_stream_read(store_stream *s, uint64_t off, void *dst, size_t n)
+{
+    return be->stream_read(s, off, dst, n);
+}
+
+void store_stream_close(store_stream *s)
+{
+    if (s) be->stream_close(s);
+}
+
+/* ------------------------------------------------------------------ shared */
 
 /* ---- the last failed write, for /v1/health ---- */
 static pthread_mutex_t werr_mu = PTHREAD_MUTEX_INITIALIZER;
@@ -347,7 +148,7 @@ static struct {
     char msg[256];
 } werr;
 
-static void note_write_error(const char *what, const char *msg)
+void store_note_write_error(const char *what, const char *msg)
 {
     pthread_mutex_lock(&werr_mu);
     werr.count++;
@@ -376,361 +177,28 @@ int store_last_write_error(double window_s, char *msg, size_t msg_len, char at[4
     return recent;
 }
 
-/* Returns SQLite's code: SQLITE_OK, or e.g. SQLITE_TOOBIG (the parameter is then NULL, so a
- * write must not go on). */
-static int bind_text(sqlite3_stmt *st, int i, const char *s)
+int store_is_finished(const char *status)
 {
-    if (s) return sqlite3_bind_text(st, i, s, -1, SQLITE_TRANSIENT);
-    return sqlite3_bind_null(st, i);
+    return !strcmp(status, "succeeded") || !strcmp(status, "failed") ||
+           !strcmp(status, "cancelled");
 }
 
-static int step_done(sqlite3 *db, sqlite3_stmt *st)
+const char *store_interrupted_error(void)
 {
-    int rc = sqlite3_step(st);
-    if (rc != SQLITE_DONE && rc != SQLITE_ROW) {
-        gpd_log(GPD_LOG_ERROR, "sqlite step: %s", sqlite3_errmsg(db));
-        if (!sqlite3_stmt_readonly(st)) note_write_error("a job update", sqlite3_errmsg(db));
-        return -1;
-    }
-    return 0;
+    /* STORE_MAX_ATTEMPTS spelled out: the message is part of the API (README) */
+    return "{\"code\":\"interrupted\",\"message\":\"interrupted 3 times (the daemon stopped "
+           "while the job was running); not retried\"}";
 }
 
-static json_t *json_col(sqlite3_stmt *st, int i)
+json_t *store_progress_or_queued(json_t *p)
 {
-    const unsigned char *t = sqlite3_column_text(st, i);
-    if (!t) return json_null();
-    json_t *j = json_loads((const char *)t, JSON_DECODE_ANY, NULL);
-    return j ? j : json_null();
+    if (!json_is_null(p)) return p;
+    json_decref(p);
+    return json_pack("{s:s, s:f, s:n, s:{}}", "phase", "queued", "fraction", 0.0, "eta_s",
+                     "detail");
 }
 
-static json_t *text_col(sqlite3_stmt *st, int i)
-{
-    const unsigned char *t = sqlite3_column_text(st, i);
-    return t ? json_string((const char *)t) : json_null();
-}
-
-/* The progress of a job that has ended without success (failed, cancelled): its last phase
- * and fraction, eta_s null (SQL NULL becomes JSON null) -- no time is left to wait for. */
-#define PROGRESS_ENDED                                                                         \
-    "progress=CASE WHEN json_valid(progress) THEN json_set(progress, '$.eta_s', NULL) "          \
-    "ELSE progress END"
-
-/* job object columns */
-#define JOB_COLS "id, kind, status, created_at, started_at, finished_at, progress, error, brief"
-
-static json_t *job_from_row(sqlite3_stmt *st)
-{
-    json_t *j = json_object();
-    json_object_set_new(j, "id", text_col(st, 0));
-    json_object_set_new(j, "kind", text_col(st, 1));
-    json_object_set_new(j, "status", text_col(st, 2));
-    json_object_set_new(j, "created_at", text_col(st, 3));
-    json_object_set_new(j, "started_at", text_col(st, 4));
-    json_object_set_new(j, "finished_at", text_col(st, 5));
-    json_t *p = json_col(st, 6);
-    if (json_is_null(p)) {
-        json_decref(p);
-        p = json_pack("{s:s, s:f, s:n, s:{}}", "phase", "queued", "fraction", 0.0, "eta_s",
-                      "detail");
-    }
-    json_object_set_new(j, "progress", p);
-    json_object_set_new(j, "error", json_col(st, 7));
-    json_object_set_new(j, "brief", json_col(st, 8));
-    return j;
-}
-
-/* Prepares sql (a SELECT of one job: ?1 its id, column 0 its status) and steps to the job's
- * row: STORE_OK with the status copied and *stp at the row (give it back with done()),
- * STORE_NOT_FOUND, or STORE_ERROR (logged, as what) -- *stp NULL then. */
-static store_rc job_row(sqlite3 *db, const char *sql, const char *id, const char *what,
-                        sqlite3_stmt **stp, char status[16])
-{
-    *stp = NULL;
-    sqlite3_stmt *st = prep(db, sql);
-    if (!st) return STORE_ERROR;
-    bind_text(st, 1, id);
-    int s = sqlite3_step(st);
-    if (s == SQLITE_ROW) {
-        const unsigned char *t = sqlite3_column_text(st, 0);
-        snprintf(status, 16, "%s", t ? (const char *)t : "");
-        *stp = st;
-        return STORE_OK;
-    }
-    if (s != SQLITE_DONE) gpd_log(GPD_LOG_ERROR, "sqlite %s: %s", what, sqlite3_errmsg(db));
-    done(st);
-    return s == SQLITE_DONE ? STORE_NOT_FOUND : STORE_ERROR;
-}
-
-/* ------------------------------------------------------------------ operations */
-
-int store_recover(int *requeued, int *failed)
-{
-    sqlite3 *db = conn();
-    if (!db) return -1;
-    char now[40];
-    gpd_now_rfc3339(now, sizeof now);
-    int rc = -1;
-    if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) return -1;
-    sqlite3_stmt *a = prep(db, "UPDATE jobs SET status='failed', finished_at=?1, error=?2, "
-                               PROGRESS_ENDED " WHERE status='running' AND attempts >= ?3");
-    sqlite3_stmt *b = prep(db, "UPDATE jobs SET status='queued', started_at=NULL, progress=NULL "
-                               "WHERE status='running'");
-    if (a && b) {
-        char err[256];
-        snprintf(err, sizeof err,
-                 "{\"code\":\"interrupted\",\"message\":\"interrupted %d times (the daemon "
-                 "stopped while the job was running); not retried\"}",
-                 STORE_MAX_ATTEMPTS);
-        bind_text(a, 1, now);
-        bind_text(a, 2, err);
-        sqlite3_bind_int(a, 3, STORE_MAX_ATTEMPTS);
-        if (step_done(db, a) == 0) {
-            if (failed) *failed = sqlite3_changes(db);
-            if (step_done(db, b) == 0) {
-                if (requeued) *requeued = sqlite3_changes(db);
-                rc = 0;
-            }
-        }
-    }
-    done(a);
-    done(b);
-    if (sqlite3_exec(db, rc == 0 ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK) {
-        gpd_log(GPD_LOG_ERROR, "sqlite recover %s: %s", rc == 0 ? "commit" : "rollback",
-                sqlite3_errmsg(db));
-        if (!sqlite3_get_autocommit(db)) sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL);
-        rc = -1;
-    }
-    return rc;
-}
-
-store_rc store_insert(const char *kind, const char *spec_json, const char *brief_json,
-                      long max_queued, char id_out[33])
-{
-    sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
-    if (gpd_new_id(id_out) != 0) return STORE_ERROR;
-    char now[40];
-    gpd_now_rfc3339(now, sizeof now);
-    /* the queue's cap in the same statement: two submits cannot both take the last place (the
-     * count walks the status index: 10,000 queued jobs cost well under a millisecond) */
-    sqlite3_stmt *st = prep(db, "INSERT INTO jobs(id, kind, spec, status, created_at, brief) "
-                                "SELECT ?1, ?2, ?3, 'queued', ?4, ?6 WHERE ?5 <= 0 OR "
-                                "(SELECT count(*) FROM jobs WHERE status='queued') < ?5");
-    if (!st) return STORE_ERROR;
-    int rc = -1;
-    if (bind_text(st, 1, id_out) == SQLITE_OK && bind_text(st, 2, kind) == SQLITE_OK &&
-        bind_text(st, 3, spec_json) == SQLITE_OK && bind_text(st, 4, now) == SQLITE_OK &&
-        sqlite3_bind_int64(st, 5, max_queued) == SQLITE_OK &&
-        bind_text(st, 6, brief_json) == SQLITE_OK)
-        rc = step_done(db, st);
-    else
-        gpd_log(GPD_LOG_ERROR, "sqlite insert: %s", sqlite3_errmsg(db));
-    int inserted = rc == 0 && sqlite3_changes(db) > 0;
-    done(st);
-    return rc != 0 ? STORE_ERROR : inserted ? STORE_OK : STORE_FULL;
-}
-
-json_t *store_get_job(const char *id, store_rc *rc)
-{
-    sqlite3 *db = conn();
-    *rc = STORE_ERROR;
-    if (!db) return NULL;
-    sqlite3_stmt *st = prep(db, "SELECT " JOB_COLS " FROM jobs WHERE id=?1");
-    if (!st) return NULL;
-    bind_text(st, 1, id);
-    json_t *j = NULL;
-    int s = sqlite3_step(st);
-    if (s == SQLITE_ROW) {
-        j = job_from_row(st);
-        *rc = STORE_OK;
-    } else if (s == SQLITE_DONE) {
-        *rc = STORE_NOT_FOUND;
-    } else {
-        gpd_log(GPD_LOG_ERROR, "sqlite get: %s", sqlite3_errmsg(db));
-    }
-    done(st);
-    return j;
-}
-
-store_rc store_get_text(const char *id, const char *column, char **text, char status[16])
-{
-    *text = NULL;
-    sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
-    const char *sql;
-    if (!strcmp(column, "result"))
-        sql = "SELECT status, result FROM jobs WHERE id=?1";
-    else if (!strcmp(column, "spec"))
-        sql = "SELECT status, spec FROM jobs WHERE id=?1";
-    else if (!strcmp(column, "kind"))
-        sql = "SELECT status, kind FROM jobs WHERE id=?1";
-    else
-        return STORE_ERROR;
-    char what[32];
-    snprintf(what, sizeof what, "get %s", column);
-    sqlite3_stmt *st;
-    store_rc rc = job_row(db, sql, id, what, &st, status);
-    const unsigned char *t = st ? sqlite3_column_text(st, 1) : NULL;
-    if (t) {
-        *text = strdup((const char *)t);
-        if (!*text) rc = STORE_ERROR;
-    }
-    done(st);
-    return rc;
-}
-
-json_t *store_list(const char *status, int limit, const char *after, store_rc *rc)
-{
-    *rc = STORE_ERROR;
-    sqlite3 *db = conn();
-    if (!db) return NULL;
-    sqlite3_int64 after_seq = -1;
-    if (after) {
-        sqlite3_stmt *q = prep(db, "SELECT seq FROM jobs WHERE id=?1");
-        if (!q) return NULL;
-        bind_text(q, 1, after);
-        int s = sqlite3_step(q);
-        if (s == SQLITE_ROW) after_seq = sqlite3_column_int64(q, 0);
-        done(q);
-        if (s == SQLITE_DONE) {
-            *rc = STORE_NOT_FOUND;
-            return NULL;
-        }
-        if (s != SQLITE_ROW) return NULL;
-    }
-    sqlite3_stmt *st = prep(db, "SELECT " JOB_COLS " FROM jobs "
-                                "WHERE (?1 IS NULL OR status=?1) AND (?2 < 0 OR seq < ?2) "
-                                "ORDER BY seq DESC LIMIT ?3");
-    if (!st) return NULL;
-    bind_text(st, 1, status);
-    sqlite3_bind_int64(st, 2, after_seq);
-    sqlite3_bind_int(st, 3, limit + 1);
-    json_t *jobs = json_array();
-    int n = 0, s;
-    json_t *next = json_null();
-    while ((s = sqlite3_step(st)) == SQLITE_ROW) {
-        if (n == limit) {
-            /* there is more: the cursor is the last job returned */
-            json_t *last = json_array_get(jobs, (size_t)n - 1);
-            json_decref(next);
-            next = json_incref(json_object_get(last, "id"));
-            break;
-        }
-        json_array_append_new(jobs, job_from_row(st));
-        n++;
-    }
-    done(st);
-    if (s != SQLITE_ROW && s != SQLITE_DONE) {
-        gpd_log(GPD_LOG_ERROR, "sqlite list: %s", sqlite3_errmsg(db));
-        json_decref(jobs);
-        json_decref(next);
-        return NULL;
-    }
-    *rc = STORE_OK;
-    return json_pack("{s:o, s:o}", "jobs", jobs, "next", next);
-}
-
-store_rc store_counts(long *queued, long *running, long *succeeded, long *failed,
-                      long *cancelled)
-{
-    sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
-    sqlite3_stmt *st = prep(db, "SELECT status, count(*) FROM jobs GROUP BY status");
-    if (!st) return STORE_ERROR;
-    long q = 0, r = 0, su = 0, f = 0, c = 0;
-    int s;
-    while ((s = sqlite3_step(st)) == SQLITE_ROW) {
-        const char *k = (const char *)sqlite3_column_text(st, 0);
-        long n = (long)sqlite3_column_int64(st, 1);
-        if (!k) continue;
-        if (!strcmp(k, "queued")) q = n;
-        else if (!strcmp(k, "running")) r = n;
-        else if (!strcmp(k, "succeeded")) su = n;
-        else if (!strcmp(k, "failed")) f = n;
-        else if (!strcmp(k, "cancelled")) c = n;
-    }
-    done(st);
-    if (s != SQLITE_DONE) return STORE_ERROR;
-    if (queued) *queued = q;
-    if (running) *running = r;
-    if (succeeded) *succeeded = su;
-    if (failed) *failed = f;
-    if (cancelled) *cancelled = c;
-    return STORE_OK;
-}
-
-store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts)
-{
-    *kind = NULL;
-    *spec_json = NULL;
-    sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
-    char now[40];
-    gpd_now_rfc3339(now, sizeof now);
-    /* One statement: atomic with respect to every other connection. */
-    sqlite3_stmt *st = prep(
-        db, "UPDATE jobs SET status='running', started_at=?1, finished_at=NULL, "
-            "attempts=attempts+1, "
-            "progress='{\"phase\":\"starting\",\"fraction\":0,\"eta_s\":null,\"detail\":{}}' "
-            "WHERE seq=(SELECT seq FROM jobs WHERE status='queued' ORDER BY seq LIMIT 1) "
-            "AND status='queued' RETURNING id, kind, spec, attempts");
-    if (!st) return STORE_ERROR;
-    bind_text(st, 1, now);
-    store_rc rc = STORE_ERROR;
-    int s = sqlite3_step(st);
-    if (s == SQLITE_ROW) {
-        snprintf(id, 33, "%s", (const char *)sqlite3_column_text(st, 0));
-        *kind = strdup((const char *)sqlite3_column_text(st, 1));
-        *spec_json = strdup((const char *)sqlite3_column_text(st, 2));
-        *attempts = sqlite3_column_int(st, 3);
-        s = sqlite3_step(st); /* finish the statement so that the change commits */
-        rc = (s == SQLITE_DONE && *kind && *spec_json) ? STORE_OK : STORE_ERROR;
-        if (rc != STORE_OK) {
-            free(*kind);
-            free(*spec_json);
-            *kind = *spec_json = NULL;
-        }
-    } else if (s == SQLITE_DONE) {
-        rc = STORE_NOT_FOUND;
-    }
-    if (rc == STORE_ERROR) {
-        gpd_log(GPD_LOG_ERROR, "sqlite claim: %s", sqlite3_errmsg(db));
-        note_write_error("claiming a job", sqlite3_errmsg(db));
-    }
-    done(st);
-    return rc;
-}
-
-static store_rc update_running(const char *sql, const char *id, const char *a, const char *b,
-                               const char *c)
-{
-    sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
-    sqlite3_stmt *st = prep(db, sql);
-    if (!st) return STORE_ERROR;
-    int np = sqlite3_bind_parameter_count(st);
-    int b_rc = bind_text(st, 1, id);
-    if (b_rc == SQLITE_OK && np >= 2) b_rc = bind_text(st, 2, a);
-    if (b_rc == SQLITE_OK && np >= 3) b_rc = bind_text(st, 3, b);
-    if (b_rc == SQLITE_OK && np >= 4) b_rc = bind_text(st, 4, c);
-    int rc = -1;
-    if (b_rc == SQLITE_OK)
-        rc = step_done(db, st);
-    else
-        gpd_log(GPD_LOG_ERROR, "sqlite bind: %s", sqlite3_errstr(b_rc));
-    done(st);
-    if (rc) return STORE_ERROR;
-    return sqlite3_changes(db) > 0 ? STORE_OK : STORE_CONFLICT;
-}
-
-store_rc store_progress(const char *id, const char *progress_json)
-{
-    return update_running("UPDATE jobs SET progress=?2 WHERE id=?1 AND status='running'", id,
-                          progress_json, NULL, NULL);
-}
-
-/* the arrays' spans as stored: {"grains":[off,end],...} for the members present */
-static char *spans_text(uint64_t spans[STORE_SUMMARY_NSKIP][2])
+char *store_spans_text(uint64_t spans[STORE_SUMMARY_NSKIP][2])
 {
     static const char *const skip[] = STORE_SUMMARY_SKIP;
     char *t = malloc(64 + STORE_SUMMARY_NSKIP * 64);
@@ -746,8 +214,7 @@ static char *spans_text(uint64_t spans[STORE_SUMMARY_NSKIP][2])
     return t;
 }
 
-/* reads spans_text(); 0 on success */
-static int spans_parse(const char *text, uint64_t spans[STORE_SUMMARY_NSKIP][2])
+int store_spans_parse(const char *text, uint64_t spans[STORE_SUMMARY_NSKIP][2])
 {
     static const char *const skip[] = STORE_SUMMARY_SKIP;
     json_t *j = text ? json_loads(text, 0, NULL) : NULL;
@@ -766,70 +233,6 @@ static int spans_parse(const char *text, uint64_t spans[STORE_SUMMARY_NSKIP][2])
     return 0;
 }
 
-/* Runs sql, a write of one row, with ?1 = id, ?2 = the value v of n bytes (text when is_text,
- * else a blob; bound without a copy: a result may be hundreds of MB, and it outlives the
- * statement) and ?3, ?4 = the texts a, b where the statement has them. Returns SQLite's code
- * (SQLITE_OK once done) and the rows changed in *changes. */
-static int write_value(sqlite3 *db, const char *sql, const char *id, const void *v, size_t n,
-                       int is_text, const char *a, const char *b, int *changes)
-{
-    *changes = 0;
-    sqlite3_stmt *st = prep(db, sql);
-    if (!st) return sqlite3_errcode(db);
-    int np = sqlite3_bind_parameter_count(st);
-    int rc = bind_text(st, 1, id);
-    if (rc == SQLITE_OK)
-        rc = is_text ? sqlite3_bind_text64(st, 2, v, (sqlite3_uint64)n, SQLITE_STATIC, SQLITE_UTF8)
-                     : sqlite3_bind_blob64(st, 2, v, (sqlite3_uint64)n, SQLITE_STATIC);
-    if (rc == SQLITE_OK && np >= 3) rc = bind_text(st, 3, a);
-    if (rc == SQLITE_OK && np >= 4) rc = bind_text(st, 4, b);
-    if (rc == SQLITE_OK) {
-        rc = sqlite3_step(st);
-        if (rc == SQLITE_DONE) {
-            rc = SQLITE_OK;
-            *changes = sqlite3_changes(db);
-        }
-    }
-    done(st);
-    return rc;
-}
-
-/* A value over SQLite's length limit (1e9 bytes by default) cannot be stored at all: 1 (with
- * the sizes in why), without trying (binding it would leave the column NULL); else 0. */
-static int too_big(sqlite3 *db, size_t rlen, const void *pack, size_t pack_len, gpd_err *why)
-{
-    long long lim = sqlite3_limit(db, SQLITE_LIMIT_LENGTH, -1);
-    if ((long long)rlen <= lim && !(pack && (long long)pack_len > lim)) return 0;
-    int is_pack = (long long)rlen <= lim;
-    gpd_err_set(why, 500,
-                "the %s is %zu bytes, more than the job database can store in one value "
-                "(%lld bytes)",
-                is_pack ? "export pack" : "result", is_pack ? pack_len : rlen, lim);
-    return 1;
-}
-
-/* The end of store_succeed's transaction: COMMIT when every write passed, else the reason
- * (before ROLLBACK replaces SQLite's message) in why and the log. src: the last SQLite code. */
-static store_rc succeed_end(sqlite3 *db, const char *id, store_rc rc, int src, gpd_err *why)
-{
-    if (rc == STORE_OK) {
-        src = sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
-        if (src != SQLITE_OK) rc = STORE_ERROR;
-    }
-    if (rc == STORE_ERROR) {
-        if (src == SQLITE_OK) src = sqlite3_errcode(db);
-        const char *em = sqlite3_errmsg(db);
-        int more = em && strcmp(em, sqlite3_errstr(src));
-        if ((src & 0xff) == SQLITE_TOOBIG) rc = STORE_TOOBIG;
-        gpd_err_set(why, 500, "%s%s%s", sqlite3_errstr(src), more ? ": " : "", more ? em : "");
-        gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result: %s", id, why->msg);
-        if (rc != STORE_TOOBIG) note_write_error("storing a result", why->msg);
-    }
-    if (!sqlite3_get_autocommit(db) && sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK)
-        gpd_log(GPD_LOG_ERROR, "sqlite rollback: %s", sqlite3_errmsg(db));
-    return rc;
-}
-
 store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
                        const char *brief_json, const void *pack, size_t pack_len, gpd_err *why)
 {
@@ -840,13 +243,7 @@ store_rc store_succeed(const char *id, const char *result_json, const char *prog
         gpd_err_set(why, 500, "there is no result to store");
         return STORE_ERROR;
     }
-    sqlite3 *db = conn();
-    if (!db) {
-        gpd_err_set(why, 500, "no connection to the database");
-        return STORE_ERROR;
-    }
     size_t rlen = strlen(result_json);
-    if (too_big(db, rlen, pack, pack_len, why)) return STORE_TOOBIG;
     /* the summary (the result without its per-item arrays), made before the write lock is
      * taken; a result it cannot be made of (not an object, out of memory) is stored without
      * one, and its readers fall back to scanning the result */
@@ -855,157 +252,20 @@ store_rc store_succeed(const char *id, const char *result_json, const char *prog
     size_t slen = 0;
     uint64_t spans[STORE_SUMMARY_NSKIP][2];
     char *summary = js_object_without(&rsrc, skip, &slen, spans);
-    char *arrays = summary ? spans_text(spans) : NULL;
+    char *arrays = summary ? store_spans_text(spans) : NULL;
     if (!summary || !arrays) {
         gpd_log(GPD_LOG_WARN, "job %s: no result summary (the views will scan the result)", id);
         free(summary);
         summary = NULL;
     }
-    char now[40];
-    gpd_now_rfc3339(now, sizeof now);
-    /* The result, the pack and the status change commit together: a job never shows
-     * succeeded without its files. Every SQLite code is checked: a failure anywhere rolls the
-     * whole transaction back, so the job stays running for the caller to retry or fail. */
-    int changes = 0, src = sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL);
-    store_rc rc = STORE_ERROR;
-    if (src == SQLITE_OK) {
-        src = write_value(db, "UPDATE jobs SET status='succeeded', result=?2, progress=?3, "
-                              "finished_at=?4, error=NULL WHERE id=?1 AND status='running'",
-                          id, result_json, rlen, 1, progress_json, now, &changes);
-        if (src == SQLITE_OK) rc = changes > 0 ? STORE_OK : STORE_CONFLICT;
-    }
-    if (rc == STORE_OK && brief_json) {
-        src = write_value(db, "UPDATE jobs SET brief=?2 WHERE id=?1", id, brief_json,
-                          strlen(brief_json), 1, NULL, NULL, &changes);
-        rc = src == SQLITE_OK && changes == 1 ? STORE_OK : STORE_ERROR;
-    }
-    if (rc == STORE_OK && pack) {
-        src = write_value(db, "INSERT OR REPLACE INTO exports(seq, pack) "
-                              "SELECT seq, ?2 FROM jobs WHERE id=?1",
-                          id, pack, pack_len, 0, NULL, NULL, &changes);
-        rc = src == SQLITE_OK && changes == 1 ? STORE_OK : STORE_ERROR;
-    }
-    if (rc == STORE_OK && summary) {
-        src = write_value(db, "INSERT OR REPLACE INTO summaries(seq, summary, arrays) "
-                              "SELECT seq, ?2, ?3 FROM jobs WHERE id=?1",
-                          id, summary, slen, 1, arrays, NULL, &changes);
-        rc = src == SQLITE_OK && changes == 1 ? STORE_OK : STORE_ERROR;
-    }
-    rc = succeed_end(db, id, rc, src, why);
+    store_rc rc = be->succeed(id, result_json, rlen, progress_json, brief_json, pack, pack_len,
+                              summary, slen, arrays, why);
     free(summary);
     free(arrays);
     return rc;
 }
 
-/* ------------------------------------------------------------------ streams */
-
-struct store_stream {
-    sqlite3 *db;
-    sqlite3_blob *blob;
-    uint64_t size;
-};
-
-/* Opens table.column of row seq on db; 0 on success, 1 when there is no such value. */
-static int blob_open(sqlite3 *db, const char *table, const char *column, sqlite3_int64 seq,
-                     sqlite3_blob **out)
-{
-    *out = NULL;
-    int rc = sqlite3_blob_open(db, "main", table, column, seq, 0, out);
-    if (rc == SQLITE_OK) return 0;
-    /* a NULL result or a job without a pack: "cannot open value of type null" / "no such
-     * rowid" */
-    sqlite3_blob_close(*out);
-    *out = NULL;
-    return 1;
-}
-
-/* A value of at most small bytes read whole (on this thread's connection; the blob closed at
- * once): 0 with *text; -1 on a failed read or out of memory. */
-static int read_small(sqlite3_blob *b, uint64_t size, char **text, size_t *text_len)
-{
-    char *buf = malloc(size + 1);
-    if (!buf || sqlite3_blob_read(b, buf, (int)size, 0) != SQLITE_OK) {
-        free(buf);
-        return -1;
-    }
-    buf[size] = 0;
-    *text = buf;
-    *text_len = size;
-    return 0;
-}
-
-/* A large value streamed on a private connection that lives as long as the download. */
-static store_rc open_private(const char *table, const char *column, sqlite3_int64 seq,
-                             store_stream **out)
-{
-    char *path = path_copy();
-    store_stream *ss = path ? calloc(1, sizeof *ss) : NULL;
-    int rc = ss ? sqlite3_open_v2(path, &ss->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX,
-                                  NULL)
-                : SQLITE_NOMEM;
-    free(path);
-    if (!ss) return STORE_ERROR;
-    if (rc == SQLITE_OK) {
-        sqlite3_busy_timeout(ss->db, 5000);
-        /* the blob is read front to back once: a small page cache is enough */
-        sqlite3_exec(ss->db, "PRAGMA cache_size=-256", NULL, NULL, NULL);
-    }
-    if (rc != SQLITE_OK || blob_open(ss->db, table, column, seq, &ss->blob)) {
-        gpd_log(GPD_LOG_ERROR, "sqlite stream open: %s", ss->db ? sqlite3_errmsg(ss->db) : "?");
-        store_stream_close(ss);
-        return STORE_ERROR;
-    }
-    ss->size = (uint64_t)sqlite3_blob_bytes(ss->blob);
-    *out = ss;
-    return STORE_OK;
-}
-
-store_rc store_stream_open(const char *id, const char *what, size_t small,
-                           store_stream **out, char **text, size_t *text_len, char status[16])
-{
-    *out = NULL;
-    *text = NULL;
-    *text_len = 0;
-    status[0] = 0;
-    int is_pack = !strcmp(what, "pack");
-    if (!is_pack && strcmp(what, "result")) return STORE_ERROR;
-    sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
-    sqlite3_stmt *st;
-    store_rc rc = job_row(db, "SELECT status, seq FROM jobs WHERE id=?1", id, "stream", &st,
-                          status);
-    sqlite3_int64 seq = st ? sqlite3_column_int64(st, 1) : 0;
-    done(st);
-    if (rc != STORE_OK) return rc;
-    const char *table = is_pack ? "exports" : "jobs", *column = is_pack ? "pack" : "result";
-    sqlite3_blob *b;
-    if (blob_open(db, table, column, seq, &b)) return STORE_OK; /* no value */
-    uint64_t size = (uint64_t)sqlite3_blob_bytes(b);
-    if (size <= small) rc = read_small(b, size, text, text_len) ? STORE_ERROR : STORE_OK;
-    sqlite3_blob_close(b);
-    return size <= small ? rc : open_private(table, column, seq, out);
-}
-
-uint64_t store_stream_size(const store_stream *s)
-{
-    return s->size;
-}
-
-int store_stream_read(store_stream *s, uint64_t off, void *dst, size_t n)
-{
-    if (off > s->size || n > s->size - off || n > INT_MAX) return -1;
-    return sqlite3_blob_read(s->blob, dst, (int)n, (int)off) == SQLITE_OK ? 0 : -1;
-}
-
-void store_stream_close(store_stream *s)
-{
-    if (!s) return;
-    sqlite3_blob_close(s->blob);
-    sqlite3_close_v2(s->db);
-    free(s);
-}
-
-/* ------------------------------------------------------------------ summaries */
+/* ---- values as byte sources, summaries ---- */
 
 static int stream_read(void *user, uint64_t off, void *dst, size_t n)
 {
@@ -1048,343 +308,7 @@ store_rc store_get_summary(const char *id, char **text, size_t *len,
     *text = NULL;
     if (len) *len = 0;
     status[0] = 0;
-    sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
-    sqlite3_stmt *st;
-    store_rc rc = job_row(db, "SELECT j.status, s.summary, s.arrays FROM jobs j "
-                              "LEFT JOIN summaries s ON s.seq = j.seq WHERE j.id=?1",
-                          id, "get summary", &st, status);
-    const unsigned char *t = st ? sqlite3_column_text(st, 1) : NULL;
-    uint64_t sp[STORE_SUMMARY_NSKIP][2];
-    if (t && spans_parse((const char *)sqlite3_column_text(st, 2), sp) == 0) {
-        size_t n = (size_t)sqlite3_column_bytes(st, 1);
-        *text = malloc(n + 1);
-        if (*text) {
-            memcpy(*text, t, n + 1);
-            if (len) *len = n;
-            if (spans) memcpy(spans, sp, sizeof sp);
-        } else {
-            rc = STORE_ERROR;
-        }
-    }
-    done(st);
+    store_rc rc = be->stored_summary(id, text, len, spans, status);
     if (rc != STORE_OK || *text || strcmp(status, "succeeded")) return rc;
     return summary_by_scan(id, text, len, spans);
-}
-
-/* ---- briefs of jobs stored before briefs ---- */
-
-#define BRIEF_BATCH 64 /* jobs a pass of store_fill_briefs reads, then writes in one transaction
-                        * (the LIMIT below) */
-
-typedef struct brief_row {
-    char id[33];
-    char *kind, *spec, *brief;
-    int succeeded;
-} brief_row;
-
-/* Up to BRIEF_BATCH jobs without a brief (their id, kind, spec and whether they succeeded):
- * how many, or -1. */
-static int brief_rows(sqlite3 *db, brief_row *rows)
-{
-    sqlite3_stmt *st = prep(db, "SELECT id, kind, spec, status FROM jobs WHERE brief IS NULL "
-                                "ORDER BY seq LIMIT 64");
-    if (!st) return -1;
-    int n = 0, s = SQLITE_DONE;
-    while (n < BRIEF_BATCH && (s = sqlite3_step(st)) == SQLITE_ROW) {
-        brief_row *r = &rows[n++];
-        snprintf(r->id, sizeof r->id, "%s", (const char *)sqlite3_column_text(st, 0));
-        r->kind = strdup((const char *)sqlite3_column_text(st, 1));
-        r->spec = strdup((const char *)sqlite3_column_text(st, 2));
-        r->succeeded = !strcmp((const char *)sqlite3_column_text(st, 3), "succeeded");
-    }
-    done(st);
-    if (n == BRIEF_BATCH || s == SQLITE_DONE) return n;
-    for (int i = 0; i < n; i++) { /* a failed read: nothing is kept */
-        free(rows[i].kind);
-        free(rows[i].spec);
-    }
-    return -1;
-}
-
-/* Writes the briefs of rows (JSON null where none could be made) in one transaction; 0, or -1. */
-static int brief_write(sqlite3 *db, brief_row *rows, int n)
-{
-    if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) return -1;
-    int rc = 0;
-    for (int i = 0; i < n && rc == 0; i++) {
-        sqlite3_stmt *u = prep(db, "UPDATE jobs SET brief=?2 WHERE id=?1");
-        if (!u || bind_text(u, 1, rows[i].id) != SQLITE_OK ||
-            bind_text(u, 2, rows[i].brief ? rows[i].brief : "null") != SQLITE_OK ||
-            step_done(db, u))
-            rc = -1;
-        done(u);
-    }
-    if (rc == 0 && sqlite3_exec(db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK) rc = -1;
-    if (!sqlite3_get_autocommit(db)) sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL);
-    return rc;
-}
-
-int store_fill_briefs(store_brief_fn make)
-{
-    sqlite3 *db = conn();
-    if (!db) return -1;
-    brief_row rows[BRIEF_BATCH];
-    int filled = 0, n;
-    while ((n = brief_rows(db, memset(rows, 0, sizeof rows))) > 0) {
-        for (int i = 0; i < n; i++) {
-            char *summary = NULL, st[16];
-            if (rows[i].succeeded) store_get_summary(rows[i].id, &summary, NULL, NULL, st);
-            if (rows[i].kind && rows[i].spec)
-                rows[i].brief = make(rows[i].kind, rows[i].spec, summary);
-            free(summary);
-        }
-        int rc = brief_write(db, rows, n);
-        for (int i = 0; i < n; i++) {
-            free(rows[i].kind);
-            free(rows[i].spec);
-            free(rows[i].brief);
-        }
-        if (rc) break;
-        filled += n;
-    }
-    /* n > 0: a batch could not be written; n < 0: not read */
-    if (n != 0)
-        gpd_log(GPD_LOG_ERROR, "filling in the briefs of older jobs: %s", sqlite3_errmsg(db));
-    return n == 0 ? filled : -1;
-}
-
-store_rc store_fail(const char *id, const char *code, const char *message)
-{
-    char now[40];
-    gpd_now_rfc3339(now, sizeof now);
-    json_t *e = json_pack("{s:s, s:s}", "code", code, "message", message ? message : "");
-    if (!e) /* a message that is not UTF-8: keep the code at least */
-        e = json_pack("{s:s, s:s}", "code", code, "message", "(message not representable)");
-    char *et = e ? json_dumps(e, JSON_COMPACT) : NULL;
-    json_decref(e);
-    if (!et) return STORE_ERROR;
-    store_rc rc = update_running("UPDATE jobs SET status='failed', error=?2, finished_at=?3, "
-                                 PROGRESS_ENDED " WHERE id=?1 AND status='running'",
-                                 id, et, now, NULL);
-    free(et);
-    return rc;
-}
-
-store_rc store_requeue(const char *id)
-{
-    return update_running("UPDATE jobs SET status='queued', started_at=NULL, progress=NULL, "
-                          "attempts=max(attempts-1, 0) WHERE id=?1 AND status='running'",
-                          id, NULL, NULL, NULL);
-}
-
-store_rc store_cancel(const char *id, int *was_running, char status_out[16], char kind_out[64])
-{
-    *was_running = 0;
-    status_out[0] = '\0';
-    if (kind_out) kind_out[0] = '\0';
-    sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
-    char now[40];
-    gpd_now_rfc3339(now, sizeof now);
-    if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) {
-        gpd_log(GPD_LOG_ERROR, "sqlite cancel begin: %s", sqlite3_errmsg(db));
-        return STORE_ERROR;
-    }
-    store_rc rc = STORE_ERROR;
-    sqlite3_stmt *q = prep(db, "SELECT status, kind FROM jobs WHERE id=?1");
-    sqlite3_stmt *u = prep(db, "UPDATE jobs SET status='cancelled', finished_at=?2, "
-                               "error='{\"code\":\"cancelled\",\"message\":\"cancelled by a "
-                               "DELETE request\"}', " PROGRESS_ENDED " WHERE id=?1");
-    if (q && u) {
-        bind_text(q, 1, id);
-        int s = sqlite3_step(q);
-        if (s == SQLITE_DONE) {
-            rc = STORE_NOT_FOUND;
-        } else if (s == SQLITE_ROW) {
-            snprintf(status_out, 16, "%s", (const char *)sqlite3_column_text(q, 0));
-            const unsigned char *k = sqlite3_column_text(q, 1);
-            if (kind_out) snprintf(kind_out, 64, "%s", k ? (const char *)k : "");
-            if (!strcmp(status_out, "queued") || !strcmp(status_out, "running")) {
-                *was_running = !strcmp(status_out, "running");
-                bind_text(u, 1, id);
-                bind_text(u, 2, now);
-                if (step_done(db, u) == 0) {
-                    rc = STORE_OK;
-                    snprintf(status_out, 16, "cancelled");
-                }
-            } else {
-                rc = STORE_CONFLICT;
-            }
-        }
-    }
-    done(q);
-    done(u);
-    if (sqlite3_exec(db, rc == STORE_OK ? "COMMIT" : "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK &&
-        rc == STORE_OK) {
-        gpd_log(GPD_LOG_ERROR, "sqlite cancel commit: %s", sqlite3_errmsg(db));
-        rc = STORE_ERROR;
-    }
-    return rc;
-}
-
-/* ------------------------------------------------------------------ operations */
-
-/* the statuses of a job that has finished: the ones a purge may remove */
-static int is_finished(const char *status)
-{
-    return !strcmp(status, "succeeded") || !strcmp(status, "failed") ||
-           !strcmp(status, "cancelled");
-}
-
-store_rc store_purge(const char *id, char status_out[16])
-{
-    status_out[0] = '\0';
-    sqlite3 *db = conn();
-    if (!db) return STORE_ERROR;
-    if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) {
-        gpd_log(GPD_LOG_ERROR, "sqlite purge begin: %s", sqlite3_errmsg(db));
-        return STORE_ERROR;
-    }
-    sqlite3_stmt *st;
-    store_rc rc = job_row(db, "SELECT status, seq FROM jobs WHERE id=?1", id, "purge", &st,
-                          status_out);
-    sqlite3_int64 seq = st ? sqlite3_column_int64(st, 1) : 0;
-    done(st);
-    if (rc == STORE_OK && !is_finished(status_out)) rc = STORE_CONFLICT;
-    /* the pack and the summary first (keyed by the job's seq), then the row with its result */
-    static const char *const del[] = {"DELETE FROM exports WHERE seq=?1",
-                                      "DELETE FROM summaries WHERE seq=?1",
-                                      "DELETE FROM jobs WHERE seq=?1"};
-    for (size_t i = 0; rc == STORE_OK && i < sizeof del / sizeof *del; i++) {
-        sqlite3_stmt *d = prep(db, del[i]);
-        if (!d) {
-            rc = STORE_ERROR;
-            break;
-        }
-        sqlite3_bind_int64(d, 1, seq);
-        if (step_done(db, d)) rc = STORE_ERROR;
-        done(d);
-    }
-    if (rc == STORE_OK && sqlite3_exec(db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK) {
-        gpd_log(GPD_LOG_ERROR, "sqlite purge commit: %s", sqlite3_errmsg(db));
-        note_write_error("purging a job", sqlite3_errmsg(db));
-        rc = STORE_ERROR;
-    }
-    if (!sqlite3_get_autocommit(db) && sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL) != SQLITE_OK)
-        gpd_log(GPD_LOG_ERROR, "sqlite purge rollback: %s", sqlite3_errmsg(db));
-    return rc;
-}
-
-int store_purge_finished_before(const char *before, int max)
-{
-    sqlite3 *db = conn();
-    if (!db || max <= 0) return db ? 0 : -1;
-    /* the candidates first (the index on finished_at: queued and running jobs are not in it),
-     * then each purged in its own transaction, so that the sweep never holds the store long */
-    sqlite3_stmt *st = prep(db, "SELECT id FROM jobs WHERE finished_at < ?1 AND status IN "
-                                "('succeeded', 'failed', 'cancelled') "
-                                "ORDER BY finished_at LIMIT ?2");
-    if (!st) return -1;
-    char(*ids)[33] = calloc((size_t)max, sizeof *ids);
-    if (!ids) {
-        done(st);
-        return -1;
-    }
-    bind_text(st, 1, before);
-    sqlite3_bind_int(st, 2, max);
-    int n = 0, s = SQLITE_DONE;
-    while (n < max && (s = sqlite3_step(st)) == SQLITE_ROW) {
-        const unsigned char *t = sqlite3_column_text(st, 0);
-        if (t) snprintf(ids[n++], 33, "%s", (const char *)t);
-    }
-    if (n < max && s != SQLITE_DONE) {
-        gpd_log(GPD_LOG_ERROR, "sqlite retention: %s", sqlite3_errmsg(db));
-        done(st);
-        free(ids);
-        return -1;
-    }
-    done(st);
-    int purged = 0;
-    for (int i = 0; i < n; i++) {
-        char status[16];
-        /* a job may have gone meanwhile (a DELETE ?purge=1): not an error */
-        if (store_purge(ids[i], status) == STORE_OK) purged++;
-    }
-    free(ids);
-    return purged;
-}
-
-/* pages freed by one step of the incremental vacuum: 4 MB of 4 KB pages, a few milliseconds
- * of the write lock */
-#define RECLAIM_STEP_SQL "PRAGMA incremental_vacuum(1024)"
-
-int store_reclaim(void)
-{
-    sqlite3 *db = conn();
-    if (!db) return -1;
-    if (auto_vacuum) {
-        /* each step is its own write transaction: workers and submits get the lock between */
-        for (int guard = 0; guard < 1000000; guard++) {
-            long free_pages = query_long(db, "PRAGMA freelist_count");
-            if (free_pages <= 0) break;
-            char *em = NULL;
-            if (sqlite3_exec(db, RECLAIM_STEP_SQL,
-                             NULL, NULL, &em) != SQLITE_OK) {
-                gpd_log(GPD_LOG_WARN, "sqlite incremental vacuum: %s (tried again later)",
-                        em ? em : "?");
-                sqlite3_free(em);
-                return 1;
-            }
-        }
-    }
-    /* TRUNCATE: the WAL goes back to nothing and the file to its pages in use; it needs every
-     * reader on the newest snapshot, so with no busy handler a download in progress makes it
-     * answer SQLITE_BUSY at once (after a passive checkpoint) instead of waiting for it */
-    sqlite3_busy_timeout(db, 0);
-    int rc = sqlite3_wal_checkpoint_v2(db, "main", SQLITE_CHECKPOINT_TRUNCATE, NULL, NULL);
-    sqlite3_busy_timeout(db, 5000);
-    if (rc == SQLITE_OK) return 0;
-    if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) return 1;
-    gpd_log(GPD_LOG_WARN, "sqlite checkpoint: %s", sqlite3_errmsg(db));
-    return -1;
-}
-
-int store_count_by_kind(void (*fn)(void *user, const char *kind, const char *status, long n),
-                        void *user)
-{
-    sqlite3 *db = conn();
-    if (!db) return -1;
-    sqlite3_stmt *st = prep(db, "SELECT kind, status, count(*) FROM jobs GROUP BY kind, status");
-    if (!st) return -1;
-    int s;
-    while ((s = sqlite3_step(st)) == SQLITE_ROW) {
-        const unsigned char *k = sqlite3_column_text(st, 0), *t = sqlite3_column_text(st, 1);
-        if (k && t) fn(user, (const char *)k, (const char *)t, (long)sqlite3_column_int64(st, 2));
-    }
-    if (s != SQLITE_DONE) gpd_log(GPD_LOG_ERROR, "sqlite count by kind: %s", sqlite3_errmsg(db));
-    done(st);
-    return s == SQLITE_DONE ? 0 : -1;
-}
-
-int store_size(long long *bytes)
-{
-    *bytes = 0;
-    sqlite3 *db = conn();
-    if (!db) return -1;
-    sqlite3_stmt *pc = prep(db, "PRAGMA page_count"), *ps = prep(db, "PRAGMA page_size");
-    long long pages = -1, size = -1;
-    if (pc && sqlite3_step(pc) == SQLITE_ROW) pages = sqlite3_column_int64(pc, 0);
-    if (ps && sqlite3_step(ps) == SQLITE_ROW) size = sqlite3_column_int64(ps, 0);
-    done(pc);
-    done(ps);
-    if (pages < 0 || size < 0) return -1;
-    *bytes = pages * size;
-    const char *file = sqlite3_db_filename(db, "main");
-    char wal[PATH_MAX + 8];
-    struct stat sb;
-    if (file && snprintf(wal, sizeof wal, "%s-wal", file) < (int)sizeof wal &&
-        stat(wal, &sb) == 0)
-        *bytes += (long long)sb.st_size;
-    return 0;
 }

@@ -1,8 +1,13 @@
-/* store.h -- the SQLite job store of grainpackd.
+/* store.h -- the job store of grainpackd: one interface, two back ends (store_impl.h), chosen
+ * by store_open from the --db value: a file path is SQLite (the embedded default, one daemon
+ * per file), a postgresql:// or postgres:// URL is PostgreSQL (many daemons, on any hosts,
+ * share one queue; store_pg.c). The jobs, their statuses and the rules below are the same on
+ * both; where PostgreSQL differs it is said under "PostgreSQL" at the end of this comment.
  *
- * One table, jobs (WAL journal, busy_timeout 5 s, synchronous=FULL; a new database is made with
- * auto_vacuum=INCREMENTAL so that purged jobs give their space back (store_reclaim), and every
- * connection sets journal_size_limit=64 MB so that the WAL shrinks after a checkpoint):
+ * SQLite: one table, jobs (WAL journal, busy_timeout 5 s, synchronous=FULL; a new database is
+ * made with auto_vacuum=INCREMENTAL so that purged jobs give their space back (store_reclaim),
+ * and every connection sets journal_size_limit=64 MB so that the WAL shrinks after a
+ * checkpoint):
  *   seq         INTEGER PRIMARY KEY AUTOINCREMENT  submission order (newest = largest)
  *   id          TEXT NOT NULL UNIQUE               32 hex digits, 128 random bits (/dev/urandom)
  *   kind        TEXT NOT NULL
@@ -33,6 +38,29 @@
  * STORE_MAX_ATTEMPTS (3) times, in which case it fails with error
  * {"code": "interrupted", "message": "interrupted 3 times ..."}. A graceful shutdown
  * (SIGTERM/SIGINT) requeues running jobs without counting the attempt.
+ *
+ * PostgreSQL (store_pg.c): the same tables (result and pack as bytea stored uncompressed, so a
+ * range is read without reading the value whole), plus jobs.owner (the daemon running the job:
+ * host/boot id/pid/random) and jobs.lease_until. A claim is one short transaction, SELECT ...
+ * FOR UPDATE SKIP LOCKED over queued jobs and running jobs whose lease lapsed (their daemon
+ * died or lost the server), oldest first; it counts an attempt, and a lapsed job already
+ * claimed STORE_MAX_ATTEMPTS times fails with "interrupted" instead -- the restart rule across
+ * hosts. A thread of the store renews this daemon's leases every lease/3 s and LISTENs on
+ * channel gp_cancel: a DELETE on any daemon NOTIFYs the job's id, and the daemon running it
+ * raises its cancel flag (store_on_cancel). Progress, success and failure are written only
+ * while the job is running under this daemon's owner id: a daemon that lost the job (taken
+ * over, cancelled) gets STORE_CONFLICT and writes nothing, so a result is written once.
+ * store_recover applies the restart rule only to jobs of this host's daemons that are dead
+ * (same host and boot, pid gone); other daemons' jobs are left to their leases. A graceful
+ * shutdown requeues only this daemon's jobs. No file lock: many daemons is the point.
+ * Connections: one per thread, like SQLite's, every statement prepared and parameterised.
+ * On PostgreSQL store_reclaim does nothing (autovacuum makes purged space reusable) and
+ * store_size is pg_database_size; store_fill_briefs has nothing to fill (every job of a
+ * PostgreSQL store had its brief at submit).
+ *
+ * Thread safety (both): every function may be called from any thread, each using its own
+ * connection; store_open, store_set_lease and store_close from the main thread only, before
+ * and after the others.
  */
 #ifndef GPD_STORE_H
 #define GPD_STORE_H
@@ -68,6 +96,19 @@ typedef enum {
  * names it and leaves SQLite's locking alone. So two daemons never share one file. */
 #define STORE_OPEN_LOCKED 1
 int store_open(const char *path);
+/* 1 when target is a PostgreSQL URL (postgresql:// or postgres://), 0 for a file path. */
+int store_is_url(const char *target);
+/* "sqlite" or "postgresql": the back end store_open chose. */
+const char *store_backend_name(void);
+
+/* The lease of a running job on PostgreSQL (--lease, seconds; default 30): set before
+ * store_open. A job whose daemon has not renewed it for this long is taken over by another. */
+#define STORE_LEASE_DEFAULT_S 30.0
+void store_set_lease(double seconds);
+double store_lease(void);
+/* fn(id) is called (from the store's own thread) when another daemon cancelled job id, which
+ * may be running here (PostgreSQL; never with SQLite, where every cancel is local). */
+void store_on_cancel(void (*fn)(const char *id));
 /* Closes the calling thread's connection, forbids new ones and releases the database lock. */
 void store_close(void);
 /* Closes the calling thread's connection (the next call opens a new one). */

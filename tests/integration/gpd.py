@@ -3,9 +3,21 @@
 Each test_*.py is run as `python3 test_x.py <path-to-grainpackd>` (ctest it_<name>). It starts
 the real daemon on 127.0.0.1 port 0 with a temporary database, reads the port from the first
 stdout line, and always stops its daemons (SIGTERM, then SIGKILL) before exiting.
+
+Back ends: by default the database is an SQLite file in the test's temporary directory. With
+GP_TEST_DB=postgresql (ctest it_pg_<name>) the same tests run against PostgreSQL: the first
+daemon of the process starts a real server of its own (PgServer: Debian's initdb + pg_ctl in a
+temporary directory, 127.0.0.1 on a free port, trust authentication, fsync off; as root it runs
+as user postgres), every database path a test names becomes a fresh database on it (CREATE
+DATABASE, one per path per test), and the daemon gets its postgresql:// URL. The server is
+stopped and removed at exit, also after a failure. A test meaningless there (the SQLite file's
+lock, size or page limit) is listed in PG_SKIP and skipped with its reason.
 """
+import atexit
+import glob
 import json
 import os
+import pwd
 import select
 import shutil
 import signal
@@ -55,6 +67,133 @@ SMALL_3D = {
 # runs the core several times slower).
 TIME_SCALE = float(os.environ.get("GPD_TEST_TIME_SCALE", "1"))
 
+DB_MODE = os.environ.get("GP_TEST_DB", "sqlite")
+PG = DB_MODE == "postgresql"
+
+# Tests that test SQLite itself and have no meaning on PostgreSQL: name -> why (printed).
+PG_SKIP = {
+    "test_second_daemon_refused": "the SQLite file lock; on PostgreSQL many daemons share a "
+                                  "queue by design (test_pg_cluster)",
+    "test_disk_full_fails_visibly": "SQLite's page cap (a testing hook) stands for a full disk",
+    "test_purge_gives_space_back": "it measures the SQLite file and its WAL on disk",
+    "test_database_before_briefs": "it migrates an SQLite file made by an older grainpackd",
+}
+
+
+def pg_bindir():
+    """The directory of initdb/pg_ctl/psql: pg_config's, else the newest Debian version."""
+    try:
+        d = subprocess.run(["pg_config", "--bindir"], capture_output=True, text=True,
+                           timeout=10).stdout.strip()
+        if d and os.path.exists(os.path.join(d, "initdb")):
+            return d
+    except OSError:
+        pass
+    found = sorted(glob.glob("/usr/lib/postgresql/*/bin/initdb"),
+                   key=lambda p: int(p.split("/")[4]) if p.split("/")[4].isdigit() else 0)
+    if not found:
+        raise RuntimeError("PostgreSQL's initdb not found (apt-get install postgresql)")
+    return os.path.dirname(found[-1])
+
+
+def free_port():
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+class PgServer:
+    """A PostgreSQL server of the tests' own: start(), url(db), create_db(name), psql(sql),
+    stop() (also at exit)."""
+
+    def __init__(self, durable=False):
+        self.durable = durable  # fsync on (benchmarks next to SQLite's synchronous=FULL)
+        self.bindir = pg_bindir()
+        self.dir = tempfile.mkdtemp(prefix="gpd-pg-")
+        self.data = os.path.join(self.dir, "data")
+        self.port = None
+        self.user = None  # run the server's programs as this user (root: postgres)
+        self.count = 0
+
+    def _cmd(self, args, **kw):
+        cmd = [os.path.join(self.bindir, args[0])] + list(args[1:])
+        if self.user:
+            cmd = ["runuser", "-u", self.user, "--"] + cmd
+        kw.setdefault("timeout", 120)
+        return subprocess.run(cmd, capture_output=True, text=True, **kw)
+
+    def start(self):
+        if os.geteuid() == 0:  # initdb refuses root
+            self.user = "postgres"
+            pw = pwd.getpwnam(self.user)
+            os.chown(self.dir, pw.pw_uid, pw.pw_gid)
+        r = self._cmd(["initdb", "-D", self.data, "-U", "postgres", "-A", "trust", "-E", "UTF8",
+                       "--locale=C", "--no-sync"])
+        if r.returncode == 0 and self.durable:
+            os.sync()
+        if r.returncode:
+            raise RuntimeError("initdb failed:\n" + r.stdout + r.stderr)
+        for attempt in range(5):  # the free port may be taken between its choice and the bind
+            self.port = free_port()
+            opts = ("-c listen_addresses=127.0.0.1 -p %d -k %s -c max_connections=400"
+                    % (self.port, self.dir))
+            if not self.durable:  # tests: the server's data is thrown away anyway
+                opts += " -c fsync=off -c synchronous_commit=off -c full_page_writes=off"
+            r = self._cmd(["pg_ctl", "-D", self.data, "-o", opts, "-l",
+                           os.path.join(self.dir, "server.log"), "-w", "-t", "60", "start"])
+            if r.returncode == 0:
+                atexit.register(self.stop)
+                return self
+        raise RuntimeError("pg_ctl start failed:\n" + r.stdout + r.stderr + self.log())
+
+    def log(self):
+        try:
+            with open(os.path.join(self.dir, "server.log")) as f:
+                return f.read()[-4000:]
+        except OSError:
+            return ""
+
+    def url(self, db):
+        return "postgresql://postgres@127.0.0.1:%d/%s" % (self.port, db)
+
+    def psql(self, sql, db="postgres", variables=None):
+        """Runs sql (from stdin, so that :'name' quotes the value of variables[name]); returns
+        the rows as text (unaligned, tuples only)."""
+        cmd = [os.path.join(self.bindir, "psql"), "-X", "-q", "-At", "-v", "ON_ERROR_STOP=1",
+               "-h", "127.0.0.1", "-p", str(self.port), "-U", "postgres", "-d", db]
+        for k, v in (variables or {}).items():
+            cmd += ["-v", "%s=%s" % (k, v)]
+        r = subprocess.run(cmd, input=sql, capture_output=True, text=True, timeout=60)
+        if r.returncode:
+            raise RuntimeError("psql failed: %s\n%s" % (sql, r.stderr))
+        return r.stdout
+
+    def create_db(self, prefix="gp"):
+        self.count += 1
+        name = "%s_%d_%d" % (prefix, os.getpid(), self.count)
+        self.psql("CREATE DATABASE %s" % name)  # a name made here: no user data
+        return name
+
+    def stop(self):
+        if self.port and os.path.isdir(self.data):
+            self._cmd(["pg_ctl", "-D", self.data, "-m", "immediate", "-w", "stop"], timeout=60)
+        shutil.rmtree(self.dir, ignore_errors=True)
+        self.port = None
+
+
+_pg = None
+
+
+def pg_server():
+    """The process's PostgreSQL server, started on first use."""
+    global _pg
+    if _pg is None:
+        _pg = PgServer().start()
+    return _pg
+
+
 VIEWS_2D = ["packing", "cells", "size", "orientation", "descriptors"]
 FINAL = ("succeeded", "failed", "cancelled")
 JOB_KEYS = {"id", "kind", "status", "created_at", "started_at", "finished_at", "progress", "error",
@@ -78,10 +217,11 @@ class Daemon:
         self.proc = None
         self.url = None
         self.log_path = db + "." + tag + ".log"
+        self.db_arg = db  # what --db gets: the path, or (GP_TEST_DB=postgresql) a URL
 
     def start(self, timeout=20):
         self.log = open(self.log_path, "ab")
-        cmd = [self.binary, "--listen", self.listen, "--db", self.db,
+        cmd = [self.binary, "--listen", self.listen, "--db", self.db_arg,
                "--workers", str(self.workers)] + self.extra
         self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.log, env=self.env)
         deadline = time.time() + timeout
@@ -211,18 +351,48 @@ class Daemon:
 
 
 class Env:
-    """A temp dir holding the database; cleans up daemons and files."""
+    """A temp dir holding the database; cleans up daemons and files. On PostgreSQL each
+    database path stands for a database of its own on the process's server."""
 
     def __init__(self, binary):
         self.binary = os.path.abspath(binary)
         self.dir = tempfile.mkdtemp(prefix="gpd-it-")
         self.db = os.path.join(self.dir, "jobs.db")
         self.daemons = []
+        self.pg_dbs = {}  # path -> database name
+
+    def db_url(self, path=None):
+        """The --db value for a database path: the path, or its PostgreSQL URL."""
+        path = path or self.db
+        if not PG:
+            return path
+        if path not in self.pg_dbs:
+            self.pg_dbs[path] = pg_server().create_db()
+        return pg_server().url(self.pg_dbs[path])
 
     def daemon(self, **kw):
-        d = Daemon(self.binary, kw.pop("db", self.db), tag="d%d" % len(self.daemons), **kw)
+        path = kw.pop("db", self.db)
+        d = Daemon(self.binary, path, tag="d%d" % len(self.daemons), **kw)
+        d.db_arg = self.db_url(path)
         self.daemons.append(d)
         return d.start()
+
+    def execute(self, sql, params=(), path=None):
+        """Runs one statement on the jobs database with ? placeholders (test set-up, e.g.
+        backdating jobs): sqlite3 on the file, psql on PostgreSQL."""
+        if not PG:
+            import sqlite3
+            con = sqlite3.connect(path or self.db)
+            con.execute(sql, params)
+            con.commit()
+            con.close()
+            return None
+        parts = sql.split("?")
+        assert len(parts) == len(params) + 1, sql
+        text = parts[0] + "".join(":'p%d'%s" % (i, p) for i, p in enumerate(parts[1:]))
+        self.db_url(path)
+        return pg_server().psql(text + ";\n", self.pg_dbs[path or self.db],
+                                {"p%d" % i: v for i, v in enumerate(params)})
 
     def close(self, keep=False):
         for d in self.daemons:
@@ -272,6 +442,9 @@ def main(tests):
     failed = 0
     t_all = time.time()
     for t in tests:
+        if PG and t.__name__ in PG_SKIP:
+            print("SKIP %-40s on PostgreSQL: %s" % (t.__name__, PG_SKIP[t.__name__]), flush=True)
+            continue
         env = Env(binary)
         t0 = time.time()
         try:
@@ -285,5 +458,9 @@ def main(tests):
             for d in env.daemons:
                 print("---- daemon log %s ----\n%s" % (d.log_path, d.read_log()))
             env.close()
-    print("%d passed, %d failed (%.1fs)" % (len(tests) - failed, failed, time.time() - t_all))
+    skipped = sum(1 for t in tests if PG and t.__name__ in PG_SKIP)
+    print("%d passed, %d failed, %d skipped (%s, %.1fs)" % (
+        len(tests) - failed - skipped, failed, skipped, DB_MODE, time.time() - t_all))
+    if _pg is not None:
+        _pg.stop()
     sys.exit(1 if failed else 0)

@@ -119,12 +119,9 @@ def test_retention(env):
         return time.strftime("%Y-%m-%dT%H:%M:%S", time.gmtime(t)) + ".000Z"
 
     ages = {ids[0]: 10, ids[1]: 6, ids[2]: 4, cancelled: 8}
-    con = sqlite3.connect(env.db)
-    for jid, days in ages.items():
-        con.execute("UPDATE jobs SET created_at=?, finished_at=? WHERE id=?",
+    for jid, days in ages.items():  # (SQLite or PostgreSQL: gpd.Env.execute)
+        env.execute("UPDATE jobs SET created_at=?, finished_at=? WHERE id=?",
                     (stamp(days + 0.01), stamp(days), jid))
-    con.commit()
-    con.close()
     d = env.daemon(workers=1, extra=("--retain-days", "5"))
     queued = d.submit(TINY)  # new and unfinished: never a candidate
     gone = {ids[0], ids[1], cancelled}
