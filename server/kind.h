@@ -21,6 +21,7 @@
 #include "gp_progress.h"
 #include "gp_spec.h"
 #include "progress.h"
+#include "result_json.h"
 #include "svg.h"
 
 /* A view of the SVG renderer: ?view=name draws it. */
@@ -68,10 +69,12 @@ typedef struct gpd_kind {
     int (*plan)(const void *spec, const json_t *spec_json, gpd_phase *out, int max);
     /* The expected seconds of the "result" phase for this specimen (its size now known) */
     double (*result_cost)(const void *specimen);
-    /* The result JSON (result_json.h), stopping early when *cancel comes up (the tree returned
-     * is then partial); NULL on out of memory */
+    /* Writes the result JSON into w as it reads the specimen (result_json.h; the writer stops
+     * by itself when its cancel flag comes up, and says so), and returns its head: the result
+     * without its per-item arrays (kind, seed, stats, timings, ...: what the brief and the
+     * metrics read), a new object; NULL on out of memory */
     json_t *(*result)(const void *specimen, const void *spec, const json_t *spec_json,
-                      const volatile int *cancel);
+                      gpd_jw *w);
     /* The export pack (core/export): 0 with a malloc'ed *pack, 1 when the spec asked for no
      * output a pack is made of (*pack left NULL), -1 with err */
     int (*pack)(const void *specimen, const void *spec, void **pack, size_t *len,

@@ -83,25 +83,6 @@ static json_t *hist_json(const gp_hist *h)
                      gpd_jreals(h->target, h->nclasses), "achieved", gpd_jreals(h->achieved, h->nclasses));
 }
 
-static json_t *point(gp_vec2 p)
-{
-    return json_pack("[o, o]", gpd_jreal(p.x), gpd_jreal(p.y));
-}
-
-static json_t *ring(const gp_vec2 *p, size_t n)
-{
-    json_t *a = json_array();
-    for (size_t i = 0; i < n; i++) json_array_append_new(a, point(p[i]));
-    return a;
-}
-
-static json_t *descriptors(const gp_descriptors *d)
-{
-    return json_pack("{s:o, s:o, s:o, s:o}", "elongation", gpd_jreal(d->elongation), "roundness",
-                     gpd_jreal(d->roundness), "circularity", gpd_jreal(d->circularity),
-                     "regularity", gpd_jreal(d->regularity));
-}
-
 /* the measure's name: the core's string, else the spec's kind */
 static const char *imc_measure(const gp_specimen2d *s, gp_imc_error_kind k)
 {
@@ -339,44 +320,87 @@ static json_t *stats_2d(const gp_specimen2d *s, const gp_spec2d *spec)
     return st;
 }
 
-static json_t *grain_json(size_t i, const gp_grain2d *g, unsigned out)
+/* [x, y] */
+static void point_w(gpd_jw *w, gp_vec2 p)
 {
-    json_t *gj = json_object();
-    json_object_set_new(gj, "id", json_integer((json_int_t)i));
-    json_object_set_new(gj, "cell", json_integer((json_int_t)g->cell));
-    json_object_set_new(gj, "contour", ring(g->contour, g->ncontour));
-    json_object_set_new(gj, "area", gpd_jreal(g->area));
-    json_object_set_new(gj, "orientation_deg", gpd_jreal(g->orientation_deg));
-    json_object_set_new(gj, "cell_fraction", gpd_jreal(g->cell_fraction));
-    if (out & GP_OUT2_DESCRIPTORS)
-        json_object_set_new(gj, "descriptors", descriptors(&g->descriptors));
-    if (out & GP_OUT2_ODEC) {
-        json_t *da = json_array();
-        for (size_t k = 0; k < g->ndiscs && g->discs; k++)
-            json_array_append_new(da, json_pack("[o, o, o]", gpd_jreal(g->discs[3 * k]),
-                                                gpd_jreal(g->discs[3 * k + 1]),
-                                                gpd_jreal(g->discs[3 * k + 2])));
-        json_object_set_new(gj, "discs", da);
+    gpd_jw_begin_array(w);
+    gpd_jw_real(w, p.x);
+    gpd_jw_real(w, p.y);
+    gpd_jw_end_array(w);
+}
+
+static void ring_w(gpd_jw *w, const gp_vec2 *p, size_t n)
+{
+    gpd_jw_begin_array(w);
+    for (size_t i = 0; i < n; i++) point_w(w, p[i]);
+    gpd_jw_end_array(w);
+}
+
+static void real_member(gpd_jw *w, const char *key, double x)
+{
+    gpd_jw_key(w, key);
+    gpd_jw_real(w, x);
+}
+
+/* a grain: {"id", "cell", "contour", "area", "orientation_deg", "cell_fraction",
+ * "descriptors" (output descriptors), "discs" (output odec)} */
+static void grain_w(gpd_jw *w, size_t i, const gp_grain2d *g, unsigned out)
+{
+    gpd_jw_begin_object(w);
+    gpd_jw_key(w, "id");
+    gpd_jw_integer(w, (long long)i);
+    gpd_jw_key(w, "cell");
+    gpd_jw_integer(w, (long long)g->cell);
+    gpd_jw_key(w, "contour");
+    ring_w(w, g->contour, g->ncontour);
+    real_member(w, "area", g->area);
+    real_member(w, "orientation_deg", g->orientation_deg);
+    real_member(w, "cell_fraction", g->cell_fraction);
+    if (out & GP_OUT2_DESCRIPTORS) {
+        gpd_jw_key(w, "descriptors");
+        gpd_jw_begin_object(w);
+        real_member(w, "elongation", g->descriptors.elongation);
+        real_member(w, "roundness", g->descriptors.roundness);
+        real_member(w, "circularity", g->descriptors.circularity);
+        real_member(w, "regularity", g->descriptors.regularity);
+        gpd_jw_end_object(w);
     }
-    return gj;
+    if (out & GP_OUT2_ODEC) {
+        gpd_jw_key(w, "discs");
+        gpd_jw_begin_array(w);
+        for (size_t k = 0; k < g->ndiscs && g->discs; k++) {
+            gpd_jw_begin_array(w);
+            for (int c = 0; c < 3; c++) gpd_jw_real(w, g->discs[3 * k + c]);
+            gpd_jw_end_array(w);
+        }
+        gpd_jw_end_array(w);
+    }
+    gpd_jw_end_object(w);
 }
 
-static json_t *cell_json(size_t i, const gp_cell2d *cl)
+/* a cell: {"id", "seed", "polygons", "area", "orientation_deg"} */
+static void cell_w(gpd_jw *w, size_t i, const gp_cell2d *cl)
 {
-    json_t *polys = json_array();
+    gpd_jw_begin_object(w);
+    gpd_jw_key(w, "id");
+    gpd_jw_integer(w, (long long)i);
+    gpd_jw_key(w, "seed");
+    point_w(w, cl->seed);
+    gpd_jw_key(w, "polygons");
+    gpd_jw_begin_array(w);
     for (size_t k = 0; k < cl->npolygons; k++)
-        json_array_append_new(polys, ring(cl->polygons[k].pts, cl->polygons[k].n));
-    return json_pack("{s:I, s:o, s:o, s:o, s:o}", "id", (json_int_t)i, "seed", point(cl->seed),
-                     "polygons", polys, "area", gpd_jreal(cl->area), "orientation_deg",
-                     gpd_jreal(cl->orientation_deg));
+        ring_w(w, cl->polygons[k].pts, cl->polygons[k].n);
+    gpd_jw_end_array(w);
+    real_member(w, "area", cl->area);
+    real_member(w, "orientation_deg", cl->orientation_deg);
+    gpd_jw_end_object(w);
 }
 
-json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_t *spec_json,
-                      const volatile int *cancel)
+/* the result without its arrays: kind, seed, outputs, container, stats, warnings, timings */
+static json_t *head_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_t *spec_json)
 {
     json_t *r = gpd_result_new(KIND_NAME, spec->seed, spec_json);
     if (!r) return NULL;
-    unsigned out = spec->outputs;
     json_t *c = json_object_get(spec_json, "container");
     if (c) json_object_set(r, "container", c);
     json_object_set_new(r, "stats", stats_2d(s, spec));
@@ -391,24 +415,47 @@ json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_
     json_object_set_new(tm, "descriptors", gpd_jreal(s->t_descriptors));
     json_object_set_new(tm, "total", gpd_jreal(s->t_total));
     json_object_set_new(r, "timings", tm);
-    /* the arrays are filled in place: a cancelled tree goes back partial, dropped with r */
+    return r;
+}
+
+json_t *gpd_result_2d_write(const gp_specimen2d *s, const gp_spec2d *spec,
+                            const json_t *spec_json, gpd_jw *w)
+{
+    json_t *head = head_2d(s, spec, spec_json);
+    if (!head) return NULL;
+    unsigned out = spec->outputs;
+    gpd_jw_begin_object(w);
+    gpd_jw_members(w, head);
+    /* the arrays, written as they are read from the specimen; the writer stops by itself at
+     * the cancel flag (a grain is ~300 numbers at 128 contour points) */
     if (out & (GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS)) {
-        json_t *ga = json_array();
-        json_object_set_new(r, "grains", ga);
-        for (size_t i = 0; i < s->ngrains; i++) {
-            /* a grain is ~70 us at 128 contour points, ~2 ms at 4096 */
-            if (i % 16 == 0 && gpd_cancel_raised(cancel)) return r;
-            json_array_append_new(ga, grain_json(i, &s->grains[i], out));
-        }
+        gpd_jw_key(w, "grains");
+        gpd_jw_begin_array(w);
+        for (size_t i = 0; i < s->ngrains && w->state == GPD_JW_OK; i++)
+            grain_w(w, i, &s->grains[i], out);
+        gpd_jw_end_array(w);
     }
     if ((out & GP_OUT2_CELLS) && s->cells) {
-        json_t *ca = json_array();
-        json_object_set_new(r, "cells", ca);
-        for (size_t i = 0; i < s->ncells; i++) {
-            if (i % 256 == 0 && gpd_cancel_raised(cancel)) return r;
-            json_array_append_new(ca, cell_json(i, &s->cells[i]));
-        }
+        gpd_jw_key(w, "cells");
+        gpd_jw_begin_array(w);
+        for (size_t i = 0; i < s->ncells && w->state == GPD_JW_OK; i++)
+            cell_w(w, i, &s->cells[i]);
+        gpd_jw_end_array(w);
     }
+    gpd_jw_end_object(w);
+    return head;
+}
+
+json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_t *spec_json,
+                      const volatile int *cancel)
+{
+    gpd_jw w;
+    gpd_jw_init(&w, cancel);
+    json_decref(gpd_result_2d_write(s, spec, spec_json, &w));
+    char *text = gpd_jw_take(&w, NULL);
+    json_error_t e;
+    json_t *r = text ? json_loads(text, 0, &e) : NULL;
+    free(text);
     return r;
 }
 
@@ -557,9 +604,9 @@ static double result_cost(const void *specimen)
 }
 
 static json_t *result(const void *specimen, const void *spec, const json_t *spec_json,
-                      const volatile int *cancel)
+                      gpd_jw *w)
 {
-    return gpd_result_2d(specimen, spec, spec_json, cancel);
+    return gpd_result_2d_write(specimen, spec, spec_json, w);
 }
 
 /* exports need the ODEC discs; without them there is no pack and GET .../export answers 409

@@ -8,10 +8,17 @@
 #include <jansson.h>
 
 #include "gp_specimen2d.h"
+#include "result_json.h"
 
-/* The result of s (a new reference; NULL on out of memory), returning early as soon as *cancel
- * (may be NULL) comes up: the tree is then partial (the caller sees the flag). spec_json is the
- * effective spec (the echoed container and outputs). */
+/* Writes the result of s into w (result_json.h: it stops by itself at w's cancel flag) and
+ * returns its head: the result without its arrays "grains" and "cells" (a new object; NULL on
+ * out of memory, nothing written). spec_json is the effective spec (the echoed container and
+ * outputs). */
+json_t *gpd_result_2d_write(const gp_specimen2d *s, const gp_spec2d *spec,
+                            const json_t *spec_json, gpd_jw *w);
+
+/* The result of s as a tree (a new reference), for the tests: the text gpd_result_2d_write
+ * writes, parsed back; NULL on out of memory or when *cancel (may be NULL) came up. */
 json_t *gpd_result_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_t *spec_json,
                       const volatile int *cancel);
 

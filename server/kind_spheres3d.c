@@ -79,52 +79,79 @@ static json_t *stats_3d(const gp_stats3d *t, unsigned out)
     return st;
 }
 
-static json_t *contact_json(const gp_contact3d *c)
+static void vec3_w(gpd_jw *w, const double *v)
 {
-    return json_pack("{s:I, s:I, s:o, s:o, s:o}", "i", (json_int_t)c->i, "j", (json_int_t)c->j,
-                     "normal", vec3(c->normal), "overlap", gpd_jreal(c->overlap), "force",
-                     vec3(c->force));
+    gpd_jw_begin_array(w);
+    for (int k = 0; k < 3; k++) gpd_jw_real(w, v[k]);
+    gpd_jw_end_array(w);
 }
 
-static json_t *result(const void *specimen, const void *spec_, const json_t *spec_json,
-                      const volatile int *cancel)
+/* a contact: {"i", "j", "normal", "overlap", "force"} */
+static void contact_w(gpd_jw *w, const gp_contact3d *c)
 {
-    const gp_specimen3d *s = specimen;
-    const gp_spec3d *spec = spec_;
+    gpd_jw_begin_object(w);
+    gpd_jw_key(w, "i");
+    gpd_jw_integer(w, (long long)c->i);
+    gpd_jw_key(w, "j");
+    gpd_jw_integer(w, (long long)c->j);
+    gpd_jw_key(w, "normal");
+    vec3_w(w, c->normal);
+    gpd_jw_key(w, "overlap");
+    gpd_jw_real(w, c->overlap);
+    gpd_jw_key(w, "force");
+    vec3_w(w, c->force);
+    gpd_jw_end_object(w);
+}
+
+/* the result without its arrays: kind, seed, outputs, box, sample_box, tiling, stats, timings */
+static json_t *head_3d(const gp_specimen3d *s, const gp_spec3d *spec, const json_t *spec_json)
+{
     json_t *r = gpd_result_new(KIND_NAME, spec->seed, spec_json);
     if (!r) return NULL;
-    unsigned out = spec->outputs;
     json_object_set_new(r, "box", vec3(s->box));
     json_object_set_new(r, "sample_box", vec3(s->sample_box));
     json_object_set_new(r, "tiling", json_pack("[i, i, i]", spec->tiling[0], spec->tiling[1],
                                                spec->tiling[2]));
-    json_object_set_new(r, "stats", stats_3d(&s->stats, out));
+    json_object_set_new(r, "stats", stats_3d(&s->stats, spec->outputs));
     json_object_set_new(r, "timings",
                         json_pack("{s:o, s:o, s:o, s:o, s:o}", "deposition",
                                   gpd_jreal(s->t_deposition), "compaction",
                                   gpd_jreal(s->t_compaction), "relaxation",
                                   gpd_jreal(s->t_relaxation), "tiling", gpd_jreal(s->t_tiling),
                                   "total", gpd_jreal(s->t_total)));
-    /* the arrays are filled in place: a cancelled tree goes back partial, dropped with r */
+    return r;
+}
+
+static json_t *result(const void *specimen, const void *spec_, const json_t *spec_json,
+                      gpd_jw *w)
+{
+    const gp_specimen3d *s = specimen;
+    const gp_spec3d *spec = spec_;
+    json_t *head = head_3d(s, spec, spec_json);
+    if (!head) return NULL;
+    unsigned out = spec->outputs;
+    gpd_jw_begin_object(w);
+    gpd_jw_members(w, head);
+    /* the arrays, written as they are read; the writer stops by itself at the cancel flag */
     if ((out & GP_OUT3_SPHERES) && s->spheres) {
-        json_t *a = json_array();
-        json_object_set_new(r, "spheres", a);
-        for (size_t i = 0; i < s->count; i++) {
-            if (i % 4096 == 0 && gpd_cancel_raised(cancel)) return r;
-            const double *q = s->spheres + 4 * i;
-            json_array_append_new(a, json_pack("[o, o, o, o]", gpd_jreal(q[0]), gpd_jreal(q[1]),
-                                               gpd_jreal(q[2]), gpd_jreal(q[3])));
+        gpd_jw_key(w, "spheres");
+        gpd_jw_begin_array(w);
+        for (size_t i = 0; i < s->count && w->state == GPD_JW_OK; i++) {
+            gpd_jw_begin_array(w);
+            for (int k = 0; k < 4; k++) gpd_jw_real(w, s->spheres[4 * i + k]);
+            gpd_jw_end_array(w);
         }
+        gpd_jw_end_array(w);
     }
     if ((out & GP_OUT3_CONTACTS) && s->contacts) {
-        json_t *a = json_array();
-        json_object_set_new(r, "contacts", a);
-        for (size_t i = 0; i < s->ncontacts; i++) {
-            if (i % 2048 == 0 && gpd_cancel_raised(cancel)) return r;
-            json_array_append_new(a, contact_json(&s->contacts[i]));
-        }
+        gpd_jw_key(w, "contacts");
+        gpd_jw_begin_array(w);
+        for (size_t i = 0; i < s->ncontacts && w->state == GPD_JW_OK; i++)
+            contact_w(w, &s->contacts[i]);
+        gpd_jw_end_array(w);
     }
-    return r;
+    gpd_jw_end_object(w);
+    return head;
 }
 
 /* ------------------------------------------------------------------ the kind */

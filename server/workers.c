@@ -51,20 +51,6 @@ static pthread_mutex_t wd_mu = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t wd_cv;
 static unsigned long wd_gen = 0; /* guarded by wd_mu */
 
-/* The reaper: a thread that frees the JSON trees of finished results. The tree of a large
- * result (a 233,000-sphere tiling with its contacts: ~10 million jansson values) takes about a
- * second to free, which a worker would otherwise spend after a cancel or before storing. */
-typedef struct reap_item {
-    struct reap_item *next;
-    json_t *tree;
-} reap_item;
-static pthread_t reap_thread;
-static int reap_running = 0;
-static int reap_quit = 0; /* guarded by reap_mu */
-static reap_item *reap_head = NULL; /* guarded by reap_mu */
-static pthread_mutex_t reap_mu = PTHREAD_MUTEX_INITIALIZER;
-static pthread_cond_t reap_cv = PTHREAD_COND_INITIALIZER;
-
 int workers_total(void) { return nslots; }
 
 void workers_set_job_timeout(long seconds) { job_timeout_s = seconds > 0 ? seconds : 0; }
@@ -114,46 +100,16 @@ store_rc workers_cancel(const char *id, char status_out[16])
     return rc;
 }
 
-/* Hands tree (taken; NULL is fine) to the reaper, or frees it here when there is none. */
-static void reap_later(json_t *tree)
+/* The store saw a cancel made by another daemon (PostgreSQL: NOTIFY gp_cancel): the job is
+ * already cancelled in the database; if it runs here, its flag goes up as for a local DELETE.
+ * Called on the store's thread, possibly while the workers stop (slots NULL then). */
+static void cancel_seen(const char *id)
 {
-    if (!tree) return;
-    reap_item *it = reap_running ? malloc(sizeof *it) : NULL;
-    if (!it) {
-        json_decref(tree);
-        return;
-    }
-    it->tree = tree;
-    pthread_mutex_lock(&reap_mu);
-    it->next = reap_head;
-    reap_head = it;
-    pthread_cond_signal(&reap_cv);
-    pthread_mutex_unlock(&reap_mu);
-}
-
-static void *reaper_main(void *arg)
-{
-    (void)arg;
-    pthread_mutex_lock(&reap_mu);
-    for (;;) {
-        while (!reap_head && !reap_quit) pthread_cond_wait(&reap_cv, &reap_mu);
-        reap_item *list = reap_head;
-        reap_head = NULL;
-        if (!list) break; /* quitting, nothing left */
-        pthread_mutex_unlock(&reap_mu);
-        while (list) {
-            reap_item *it = list;
-            list = it->next;
-            json_decref(it->tree);
-            free(it);
-        }
-#ifdef __GLIBC__
-        malloc_trim(0); /* as after a job (worker_main): an idle daemon is small again */
-#endif
-        pthread_mutex_lock(&reap_mu);
-    }
-    pthread_mutex_unlock(&reap_mu);
-    return NULL;
+    pthread_mutex_lock(&reg_mu);
+    for (int i = 0; slots && i < nslots; i++)
+        if (!strcmp(slots[i].id, id) && raise_cancel(&slots[i], REASON_DELETE))
+            gpd_log(GPD_LOG_INFO, "job %s cancelled by another daemon; stopping it", id);
+    pthread_mutex_unlock(&reg_mu);
 }
 
 /* ------------------------------------------------------------------ progress */
@@ -451,27 +407,21 @@ static void store_result(run_ctx *ctx, const char *text, const char *prog, const
     /* STORE_CONFLICT: cancelled by a DELETE meanwhile */
 }
 
-/* Stores a result (takes r) and the export pack (takes pack, may be NULL) together with status
- * succeeded and the "done" progress (takes detail, NULL = {}). Reals get 17 significant digits:
- * the geometry reads back bit for bit, as in the exports. The writing stops at the cancel flag
- * (a 133 MB result takes ~5 s to write); a result written in full is stored even when a
- * shutdown came meanwhile (a second or so), not after a DELETE (the job is cancelled). */
-static void finish_succeeded(run_ctx *ctx, json_t *r, json_t *detail, void *pack,
-                             size_t pack_len)
+/* Stores a result (its text, taken; head: its small members, taken) and the export pack
+ * (takes pack, may be NULL) together with status succeeded and the "done" progress (takes
+ * detail, NULL = {}). The text was written to the end (finish_built); it is stored even when a
+ * shutdown came meanwhile, not after a DELETE (the job is cancelled). */
+static void finish_succeeded(run_ctx *ctx, char *text, json_t *head, json_t *detail,
+                             void *pack, size_t pack_len)
 {
-    char *text = r ? gpd_dumps_c(r, JSON_COMPACT | JSON_REAL_PRECISION(17), &ctx->s->cancel)
-                   : NULL;
     result_phase_stop(ctx); /* what follows writes the job's final state */
-    /* the timings (a few numbers) outlive the tree, for the metrics */
-    json_t *timings = r ? json_deep_copy(json_object_get(r, "timings")) : NULL;
     /* the brief with what was achieved, from the result's stats (NULL: the submit's is kept) */
-    json_t *bj = r ? ctx->kind->brief(ctx->spec_json, json_object_get(r, "stats")) : NULL;
+    json_t *bj = ctx->kind->brief(ctx->spec_json, json_object_get(head, "stats"));
     char *brief = bj ? json_dumps(bj, JSON_COMPACT) : NULL;
     json_decref(bj);
-    reap_later(r);
     int reason = __atomic_load_n(&ctx->s->reason, __ATOMIC_RELAXED);
     int stopped = __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED) &&
-                  (!text || reason == REASON_DELETE);
+                  reason == REASON_DELETE;
     char *prog = NULL;
     if (!stopped) {
         prog = progress_text("done", 1.0, 0.0, detail); /* takes detail */
@@ -481,24 +431,22 @@ static void finish_succeeded(run_ctx *ctx, json_t *r, json_t *detail, void *pack
         /* the limit passed while the result was being built */
         finish_timeout(ctx, "result");
     } else if (stopped) {
-        /* cancelled (DELETE: already marked) or shutdown before the result was written:
-         * requeued */
-        finish_not_ok(ctx, GP_ERR_CANCELLED, NULL, NULL);
-    } else if (!text || !prog) {
+        finish_not_ok(ctx, GP_ERR_CANCELLED, NULL, NULL); /* a DELETE already marked it */
+    } else if (!prog) {
         finish_failed(ctx->id, ctx->kind->name, ctx->t0, "internal",
                       "out of memory while serialising the result");
     } else {
-        store_result(ctx, text, prog, brief, pack, pack_len, timings);
+        store_result(ctx, text, prog, brief, pack, pack_len, json_object_get(head, "timings"));
     }
     free(brief);
-    json_decref(timings);
+    json_decref(head);
     json_decref(detail);
     free(text);
     free(prog);
     free(pack);
 }
 
-/* The result tree could not be built: cancelled meanwhile, or out of memory. */
+/* The result could not be written: cancelled meanwhile, or out of memory. */
 static void result_not_built(run_ctx *ctx)
 {
     if (__atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED))
@@ -516,16 +464,25 @@ static void unavailable(const char *id, const char *kind)
 }
 
 /* A built specimen (taken) becomes the result, the export pack and the final "done" detail of
- * the job, stored together; a result that could not be built is dropped (cancelled, or out of
- * memory). */
+ * the job, stored together; a result that could not be written is dropped (cancelled, or out
+ * of memory). The result's text is written straight from the specimen (result_json.h): the
+ * worker holds the specimen, the text and the pack at once, never a tree of the specimen. */
 static void finish_built(run_ctx *ctx, const void *spec, const json_t *spec_json, void *out)
 {
     const gpd_kind *k = ctx->kind;
     result_phase_start(ctx, out);
-    json_t *r = k->result(out, spec, spec_json, &ctx->s->cancel);
-    if (!r || __atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED)) { /* (r: partial) */
+    gpd_jw w;
+    gpd_jw_init(&w, &ctx->s->cancel);
+    /* a testing hook: GRAINPACK_TEST_RESULT_PAUSE_MS slows the writing (a pause at each look
+     * at the flag), so that the tests can cancel a job in its result phase */
+    const char *pause = getenv("GRAINPACK_TEST_RESULT_PAUSE_MS");
+    w.pause_s = pause ? atof(pause) / 1e3 : 0;
+    json_t *head = k->result(out, spec, spec_json, &w);
+    char *text = head ? gpd_jw_take(&w, NULL) : NULL;
+    gpd_jw_free(&w);
+    if (!text) { /* cancelled (the writer stopped at the flag) or out of memory */
         result_phase_stop(ctx);
-        reap_later(r);
+        json_decref(head);
         k->destroy(out);
         result_not_built(ctx);
         return;
@@ -537,7 +494,12 @@ static void finish_built(run_ctx *ctx, const void *spec, const json_t *spec_json
         gpd_log(GPD_LOG_WARN, "job %s: no export pack: %s", ctx->id, perr.message);
     json_t *detail = k->done_detail ? k->done_detail(ctx->id, out) : NULL;
     k->destroy(out);
-    finish_succeeded(ctx, r, detail, pack, pack_len);
+#ifdef __GLIBC__
+    /* the specimen's heap back before the store copies the text (100,000 grains: ~350 MB,
+     * which glibc would otherwise keep resident through the write) */
+    malloc_trim(0);
+#endif
+    finish_succeeded(ctx, text, head, detail, pack, pack_len);
 }
 
 /* Runs a job of kind k: its spec parsed for the core, the specimen built on this thread. */
@@ -632,8 +594,8 @@ static void *worker_main(void *arg)
             free(kind);
             free(spec);
 #ifdef __GLIBC__
-            /* a big job leaves hundreds of MB of freed heap (its JSON tree) that glibc keeps
-             * resident; hand it back so that an idle daemon is small again */
+            /* a big job leaves hundreds of MB of freed heap (its specimen, its result text)
+             * that glibc keeps resident; hand it back so that an idle daemon is small again */
             malloc_trim(0);
 #endif
             pthread_mutex_lock(&reg_mu);
@@ -718,11 +680,7 @@ int workers_start(int n)
     slots = calloc((size_t)n, sizeof *slots);
     if (!slots) return -1;
     nslots = n;
-    reap_quit = 0;
-    if (pthread_create(&reap_thread, NULL, reaper_main, NULL) == 0)
-        reap_running = 1;
-    else /* not fatal: the workers then free their trees themselves */
-        gpd_log(GPD_LOG_WARN, "cannot start the reaper thread; results are freed by the workers");
+    store_on_cancel(cancel_seen);
     if (job_timeout_s > 0) {
         if (pthread_create(&wd_thread, NULL, watchdog_main, NULL) != 0) {
             gpd_log(GPD_LOG_ERROR, "cannot start the job-timeout watchdog");
@@ -757,18 +715,13 @@ void workers_stop(void)
         wd_running = 0;
     }
     for (int i = 0; i < nslots; i++) pthread_join(slots[i].thread, NULL);
-    if (reap_running) { /* frees what is left (a second at most per tree) */
-        pthread_mutex_lock(&reap_mu);
-        reap_quit = 1;
-        pthread_cond_signal(&reap_cv);
-        pthread_mutex_unlock(&reap_mu);
-        pthread_join(reap_thread, NULL);
-        reap_running = 0;
-    }
     pending_drain(1);
+    store_on_cancel(NULL);
+    pthread_mutex_lock(&reg_mu); /* cancel_seen may be running on the store's thread */
     free(slots);
     slots = NULL;
     nslots = 0;
+    pthread_mutex_unlock(&reg_mu);
     pthread_cond_destroy(&wake_cv);
     pthread_cond_destroy(&wd_cv);
 }

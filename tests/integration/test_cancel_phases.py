@@ -39,6 +39,13 @@ PHASES = [
     ("result", 2.5, dict(gpd.SMALL_3D, tiling=[16, 16, 16], outputs=["spheres", "contacts"])),
 ]
 
+# The result is written as it is read from the specimen (server/result_json.h), at ~100 MB/s:
+# even the largest results above leave their result phase within a second or two, before a
+# DELETE or a second job's phase can land there. The testing hook pauses the writing at each of
+# its looks at the cancel flag (every 4,096 numbers): the 2D result of 3 million points then
+# lasts ~20 s, and the cancel is still seen by the writer itself.
+SLOW_RESULT = {"GRAINPACK_TEST_RESULT_PAUSE_MS": "%g" % (10 * SCALE)}
+
 # a job of a few milliseconds: it runs as soon as a worker is free
 TINY = dict(gpd.SMALL_2D, particles=20, contour_points=16, outputs=["grains"])
 
@@ -69,7 +76,7 @@ def started_within(d, jid, t0, limit):
 
 
 def test_delete_in_every_phase(env):
-    d = env.daemon(workers=1)
+    d = env.daemon(workers=1, env=SLOW_RESULT)
     report = []
     for phase, into, spec in PHASES:
         jid = d.submit(spec)
@@ -136,7 +143,7 @@ def sigterm_round(env, staged, queued_spec):
     before shows its phase (so that their phases overlap whatever the build's speed), then one
     more that stays queued; SIGTERMs the daemon while every job is still in its phase, and
     checks the exit time and the requeue on restart."""
-    d = env.daemon(workers=2)
+    d = env.daemon(workers=2, env=SLOW_RESULT)
     ids = {}
     for phase, spec in staged:
         jid = d.submit(spec)
@@ -155,7 +162,7 @@ def sigterm_round(env, staged, queued_spec):
     log = d.read_log()
     for jid in ids:
         assert "job %s requeued (shutdown)" % jid in log, log
-    d2 = env.daemon(workers=2)
+    d2 = env.daemon(workers=2, env=SLOW_RESULT)
     for jid in list(ids) + [queued]:
         j = d2.job(jid)
         assert j["status"] in ("queued", "running"), j  # requeued (the running ones resume)
