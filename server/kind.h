@@ -51,9 +51,10 @@ typedef struct gpd_kind {
     /* ---- running a job (workers.c), in this order ---- */
     /* GPD_KIND_CORE_OPS: the glue to the kind's core pipeline (GPD_KIND_CORE below) */
     size_t spec_size; /* the core's spec struct */
-    /* Parses the stored spec into *spec (spec_size zeroed bytes) for the core, threads 1 (the
-     * pool is the parallelism): 0, or -1 with *p; free_spec releases what it holds either way */
-    int (*read_spec)(const json_t *json, void *spec, gp_spec_problem *p);
+    /* Parses the stored spec into *spec (spec_size zeroed bytes) for the core, to run on
+     * `threads` threads (the daemon's --job-threads; the core's result does not depend on it):
+     * 0, or -1 with *p; free_spec releases what it holds either way */
+    int (*read_spec)(const json_t *json, void *spec, int threads, gp_spec_problem *p);
     void (*free_spec)(void *spec);
     /* Builds the specimen (the core's build): *st GP_OK, or a failure with err; the specimen may
      * come back with a failure too (freed with destroy) */
@@ -104,10 +105,10 @@ typedef struct gpd_kind {
  * destroyer) to define its read_spec, free_spec, build and destroy, and puts
  * GPD_KIND_CORE_OPS(its spec type) in its gpd_kind. */
 #define GPD_KIND_CORE(SPEC, READ, FREE, SPECIMEN, BUILD, DESTROY)                              \
-    static int read_spec(const json_t *json, void *spec, gp_spec_problem *p)                  \
+    static int read_spec(const json_t *json, void *spec, int threads, gp_spec_problem *p)     \
     {                                                                                          \
         int rc = READ(json, spec, p);                                                          \
-        ((SPEC *)spec)->threads = 1;                                                           \
+        ((SPEC *)spec)->threads = threads;                                                     \
         return rc;                                                                             \
     }                                                                                          \
     static void free_spec(void *spec) { FREE(spec); }                                          \

@@ -48,6 +48,10 @@ static void usage(FILE *f)
             "                         (default 30)\n"
             "  --workers N            worker threads running jobs [GRAINPACK_WORKERS]\n"
             "                         (default: the number of CPU cores)\n"
+            "  --job-threads N        threads each job runs on (the filling, ODEC and\n"
+            "                         descriptors of a 2D job, the DEM of a 3D one; results\n"
+            "                         are the same whatever N) [GRAINPACK_JOB_THREADS]\n"
+            "                         (default 0: the CPU cores over the workers, at least 1)\n"
             "  --log-level LEVEL      error|warn|info|debug [GRAINPACK_LOG_LEVEL] (default info;\n"
             "                         debug logs every request)\n"
             "  --http-threads N       HTTP thread pool size [GRAINPACK_HTTP_THREADS] (default 4)\n"
@@ -123,7 +127,7 @@ static const char *env_or(const char *name, const char *dflt)
 /* the settings as given: the command line, else the environment, else the defaults */
 typedef struct settings {
     const char *listen, *db, *workers, *level, *threads, *maxconn, *timeout, *maxbody, *maxres,
-        *jobto, *retain, *maxq, *lease;
+        *jobto, *retain, *maxq, *lease, *jthreads;
 } settings;
 
 /* Reads the command line over st (the environment's values); -1 to go on, else the exit
@@ -142,6 +146,7 @@ static int read_args(int argc, char **argv, settings *st)
         {"retain-days", required_argument, 0, 1002},
         {"max-queued", required_argument, 0, 1003},
         {"lease", required_argument, 0, 1004},
+        {"job-threads", required_argument, 0, 1005},
         {"allow-origin", required_argument, 0, 1001},
         {"help", no_argument, 0, 'h'},               {"version", no_argument, 0, 'V'},
         {0, 0, 0, 0}};
@@ -161,6 +166,7 @@ static int read_args(int argc, char **argv, settings *st)
         case 1002: st->retain = optarg; break;
         case 1003: st->maxq = optarg; break;
         case 1004: st->lease = optarg; break;
+        case 1005: st->jthreads = optarg; break;
         case 1001:
             if (gpd_allow_origins(optarg)) return 2;
             origins_flag = 1;
@@ -279,10 +285,11 @@ int main(int argc, char **argv)
                    env_or("GRAINPACK_JOB_TIMEOUT", "3600"),
                    env_or("GRAINPACK_RETAIN_DAYS", "0"),
                    env_or("GRAINPACK_MAX_QUEUED", "10000"),
-                   env_or("GRAINPACK_LEASE", "30")};
+                   env_or("GRAINPACK_LEASE", "30"),
+                   env_or("GRAINPACK_JOB_THREADS", "0")};
     int rc = read_args(argc, argv, &st);
     if (rc >= 0) return rc;
-    long nworkers, nthreads, maxconn, timeout, maxbody, maxres, jobto, maxq, lease;
+    long nworkers, nthreads, maxconn, timeout, maxbody, maxres, jobto, maxq, lease, jthreads;
     double retain_days;
     if (parse_long("--workers", st.workers, 1, 1024, &nworkers) ||
         parse_long("--http-threads", st.threads, 1, 256, &nthreads) ||
@@ -293,6 +300,7 @@ int main(int argc, char **argv)
         parse_long("--job-timeout", st.jobto, 0, 31622400, &jobto) ||
         parse_long("--max-queued", st.maxq, 1, 1000000000, &maxq) ||
         parse_long("--lease", st.lease, 1, 86400, &lease) ||
+        parse_long("--job-threads", st.jthreads, 0, 1024, &jthreads) ||
         parse_days("--retain-days", st.retain, &retain_days))
         return 2;
     int level = gpd_log_parse_level(st.level);
@@ -311,6 +319,10 @@ int main(int argc, char **argv)
     pthread_sigmask(SIG_BLOCK, &set, NULL);
     signal(SIGPIPE, SIG_IGN);
 
+    /* the cores the workers leave idle go to each job's threads (filling, ODEC, descriptors and
+     * the DEM run in parallel inside a job; the result is the same whatever their number) */
+    if (jthreads == 0) jthreads = ncpu / nworkers > 1 ? ncpu / nworkers : 1;
+    workers_set_job_threads((int)jthreads);
     store_set_lease((double)lease);
     if (open_store(st.db)) return 1;
     gpd_http_config cfg = {.threads = (unsigned)nthreads,
@@ -325,8 +337,10 @@ int main(int argc, char **argv)
     fflush(stdout);
     char shown[512];
     db_for_log(st.db, shown, sizeof shown);
-    gpd_log(GPD_LOG_INFO, "grainpackd %s: http://%s:%d, db %s (%s), %ld workers, %ld http threads",
-            GPD_VERSION, cfg.host, cfg.port, shown, store_backend_name(), nworkers, nthreads);
+    gpd_log(GPD_LOG_INFO, "grainpackd %s: http://%s:%d, db %s (%s), %ld workers of %ld thread(s), "
+            "%ld http threads",
+            GPD_VERSION, cfg.host, cfg.port, shown, store_backend_name(), nworkers, jthreads,
+            nthreads);
     if (retain_days > 0)
         gpd_log(GPD_LOG_INFO, "retention: finished jobs are purged %g days after they finished",
                 retain_days);

@@ -43,6 +43,7 @@ static unsigned long wake_gen = 0; /* guarded by wake_mu */
 static int stopping = 0;           /* atomic */
 static int busy = 0;               /* atomic */
 static long job_timeout_s = 3600;  /* set before workers_start; 0 = no limit */
+static int job_threads = 1;        /* each job's core threads; set before workers_start */
 
 /* the watchdog: raises the cancel flag of a job whose run passed its deadline */
 static pthread_t wd_thread;
@@ -54,6 +55,7 @@ static unsigned long wd_gen = 0; /* guarded by wd_mu */
 int workers_total(void) { return nslots; }
 
 void workers_set_job_timeout(long seconds) { job_timeout_s = seconds > 0 ? seconds : 0; }
+void workers_set_job_threads(int threads) { job_threads = threads > 1 ? threads : 1; }
 
 /* Raises s's cancel flag for reason r unless another reason came first; 1 when r won. */
 static int raise_cancel(slot *s, int r)
@@ -512,7 +514,7 @@ static void run_kind(slot *s, const char *id, const gpd_kind *k, const json_t *s
         finish_failed(id, k->name, 0, "internal", "out of memory while reading the spec");
         return;
     }
-    if (k->read_spec(spec_json, spec, &prob)) {
+    if (k->read_spec(spec_json, spec, job_threads, &prob)) {
         k->free_spec(spec);
         free(spec);
         finish_failed(id, k->name, 0, "invalid_spec", prob.message);

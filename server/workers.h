@@ -27,6 +27,8 @@
 
 /* The per-run time limit in seconds (0 = none; default 3600); call before workers_start. */
 void workers_set_job_timeout(long seconds);
+/* The threads each job's core build runs on (>= 1; default 1), set before workers_start. */
+void workers_set_job_threads(int threads);
 int workers_start(int n);
 /* A job was queued: wake an idle worker. */
 void workers_notify(void);

@@ -76,18 +76,32 @@ def test_submit_poll_result_svg(env):
     assert d.stop() == 0, "daemon did not exit cleanly:\n" + d.read_log()
 
 
-def test_determinism(env):
-    d = env.daemon(workers=2)
-    a = d.submit(gpd.SMALL_2D)
-    b = d.submit(gpd.SMALL_2D)
-    for jid in (a, b):
+def results_of(d, specs):
+    """The results of specs run on daemon d, without their timings."""
+    ids = [d.submit(sp) for sp in specs]
+    out = []
+    for jid in ids:
         assert d.wait(jid)["status"] == "succeeded"
-    ra = json.loads(d.request("GET", "/v1/jobs/%s/result" % a)[2])
-    rb = json.loads(d.request("GET", "/v1/jobs/%s/result" % b)[2])
-    ra.pop("timings")
-    rb.pop("timings")
-    assert ra == rb, "same spec and seed gave different results"
+        r = json.loads(d.request("GET", "/v1/jobs/%s/result" % jid)[2])
+        r.pop("timings")
+        out.append(r)
+    return out
+
+
+def test_determinism(env):
+    """The same spec and seed give the same result: twice on one daemon, and on daemons whose
+    jobs run on 1 and on 3 threads (--job-threads: the 2D filling, ODEC and descriptors, the 3D
+    DEM). SMALL_2D's grains carry ODEC discs and descriptors, SMALL_3D runs the DEM."""
+    specs = [gpd.SMALL_2D, gpd.SMALL_2D, gpd.SMALL_3D]
+    d = env.daemon(workers=2, extra=("--job-threads", "1"))
+    one = results_of(d, specs)
     assert d.stop() == 0
+    assert one[0] == one[1], "same spec and seed gave different results"
+    d = env.daemon(workers=1, extra=("--job-threads", "3"))
+    three = results_of(d, specs)
+    assert d.stop() == 0
+    assert one[0] == three[0], "the 2D result changed with the job's thread count"
+    assert one[2] == three[2], "the 3D result changed with the job's thread count"
 
 
 def test_list_pagination(env):
