@@ -23,9 +23,7 @@ import json
 import math
 import os
 import re
-import select
 import shutil
-import signal
 import subprocess
 import sys
 import tarfile
@@ -33,36 +31,11 @@ import tempfile
 import time
 import urllib.request
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_export import start, stop  # noqa: E402
+
 SPEC = {"kind": "spheres-3d", "box": [0.5, 0.5, 0.5], "porosity": 0.38, "outputs": ["spheres"]}
 THRESHOLD = 1e-4
-
-
-def start(binary, db):
-    log = open(db + ".log", "ab")
-    p = subprocess.Popen([binary, "--listen", "127.0.0.1:0", "--db", db, "--workers", "1",
-                          "--log-level", "warn"], stdout=subprocess.PIPE, stderr=log)
-    line = b""
-    deadline = time.time() + 30
-    while not line.endswith(b"\n"):
-        if time.time() > deadline or p.poll() is not None:
-            p.kill()
-            sys.exit("grainpackd did not start; see " + db + ".log")
-        r, _, _ = select.select([p.stdout], [], [], 1)
-        if r:
-            line += os.read(p.stdout.fileno(), 1)
-    m = re.match(r"listening on (http://\S+)", line.decode())
-    assert m, line
-    return p, m.group(1)
-
-
-def stop(proc):
-    if proc.poll() is None:
-        proc.send_signal(signal.SIGTERM)
-        try:
-            proc.wait(30)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
 
 
 def get(url, raw=False, body=None):
@@ -161,7 +134,7 @@ def main():
     a = ap.parse_args()
     tiling = [int(x) for x in a.tiling.split(",")]
     tmp = tempfile.mkdtemp(prefix="gp-bench-relax-")
-    proc, url = start(os.path.abspath(a.binary), os.path.join(tmp, "jobs.db"))
+    proc, url = start(os.path.abspath(a.binary), os.path.join(tmp, "jobs.db"), 1)
     try:
         spec = dict(SPEC, seed=a.seed, tiling=tiling)
         jid, summ, t_job = build(url, spec)
