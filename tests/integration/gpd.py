@@ -401,6 +401,17 @@ class Env:
             shutil.rmtree(self.dir, ignore_errors=True)
 
 
+def need(binary, package):
+    """The path of a program the test runs (LAMMPS, mpirun, ...); a clear failure when it is
+    missing: these tests never skip."""
+    path = shutil.which(binary)
+    if not path:
+        raise AssertionError(
+            "`%s` is not on PATH: install the Debian package `%s` (bash deploy/install-deps.sh "
+            "--test installs it; CI does). This test never skips." % (binary, package))
+    return path
+
+
 def check_error_body(status, body, code, pointer=None):
     """Every 4xx/5xx body is {"error": {"code", "message", "pointer"?}}."""
     assert isinstance(body, dict) and set(body) == {"error"}, body

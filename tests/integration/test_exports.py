@@ -15,7 +15,6 @@ import json
 import math
 import os
 import re
-import shutil
 import subprocess
 import sys
 import time
@@ -166,15 +165,6 @@ def shared(test):
 
 # ------------------------------------------------------------------ programs
 
-def need(binary, package):
-    path = shutil.which(binary)
-    if not path:
-        raise AssertionError(
-            "`%s` is not on PATH: install the Debian package `%s` (bash deploy/install-deps.sh "
-            "installs it; CI does). This test never skips." % (binary, package))
-    return path
-
-
 def need_vtk():
     if not (os.path.isfile(VTK_PYTHON) and os.access(VTK_PYTHON, os.X_OK)):
         raise AssertionError("%s is missing: VTK's reader runs under the system Python; install "
@@ -306,7 +296,7 @@ def test_lammps_3d(fx):
     """LAMMPS reads the 3D data file (plain and tiled): run 0 reports the result's atom count
     and a total mass of sum rho 4/3 pi r^3 (rho = the spec's 2650.5) to 1e-9 relative; the
     box is the job's box."""
-    need("lmp", "lammps")
+    gpd.need("lmp", "lammps")
     for jid in (fx.j3, fx.jt):
         run_lammps_3d(fx, "lmp", jid, "lammps", "LAMMPS 3D %s" % jid[:8])
         box = data_header_box(fx.files[jid, "lammps"])
@@ -317,7 +307,7 @@ def test_lammps_3d(fx):
 @shared
 def test_liggghts_3d(fx):
     """LIGGGHTS 3.8 reads the 3D liggghts file: same atom count and mass."""
-    need("liggghts", "liggghts")
+    gpd.need("liggghts", "liggghts")
     for jid in (fx.j3, fx.jt):
         run_lammps_3d(fx, "liggghts", jid, "liggghts", "LIGGGHTS 3D %s" % jid[:8])
 
@@ -326,7 +316,7 @@ def test_liggghts_3d(fx):
 def test_lammps_2d(fx):
     """LAMMPS reads the 2D data file with the input lines its header documents: as many rigid
     bodies as grains, as many atoms as discs, and the grains' total mass = 2650 * sum(area)."""
-    need("lmp", "lammps")
+    gpd.need("lmp", "lammps")
     for jid in (fx.j2, fx.jc):
         data = fx.files[jid, "lammps"]
         with open(data) as f:
@@ -362,7 +352,7 @@ def test_yade(fx):
     """YADE imports the yade files (ymport.text in 3D, ymport.textClumps in 2D): as many
     spheres as the result (3D) and one clump per grain made of its discs (2D), at the result's
     positions and radii exactly. One YADE run for all the files."""
-    need("yade", "yade")
+    gpd.need("yade", "yade")
     script = os.path.join(HERE, "export_check_yade.py")
     out_json = os.path.join(fx.dir, "yade.json")
     args = ["3d:" + fx.files[fx.j3, "yade"], "3d:" + fx.files[fx.jt, "yade"],

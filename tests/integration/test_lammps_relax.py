@@ -21,7 +21,6 @@ import io
 import json
 import math
 import os
-import shutil
 import subprocess
 import sys
 import tarfile
@@ -47,24 +46,15 @@ RUN_TIMEOUT = 500 * gpd.TIME_SCALE
 MEMBERS = ["lammps-relax", "lammps-relax/relax.in", "lammps-relax/spheres.data"]
 
 
-def need(binary, package):
-    path = shutil.which(binary)
-    if not path:
-        raise AssertionError(
-            "`%s` is not on PATH: install the Debian package `%s` (bash deploy/install-deps.sh "
-            "--test installs it). This test never skips." % (binary, package))
-    return path
-
-
 def mpirun_command():
     """mpirun -np 2 lmp -in relax.in, as root with OpenMPI's consent, and on a machine of one
     core allowed to put two ranks on it."""
-    cmd = [need("mpirun", "openmpi-bin"), "-np", "2"]
+    cmd = [gpd.need("mpirun", "openmpi-bin"), "-np", "2"]
     if os.geteuid() == 0:
         cmd.append("--allow-run-as-root")
     if (os.cpu_count() or 1) < 2:
         cmd.append("--oversubscribe")
-    return cmd + [need("lmp", "lammps"), "-in", "relax.in", "-var", "maxsteps", str(MAX_STEPS)]
+    return cmd + [gpd.need("lmp", "lammps"), "-in", "relax.in", "-var", "maxsteps", str(MAX_STEPS)]
 
 
 def submit_small(d):
