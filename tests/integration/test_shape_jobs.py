@@ -24,6 +24,7 @@ import os
 import random
 import re
 import sys
+import time
 
 import gpd
 
@@ -213,11 +214,19 @@ def test_descriptors(env):
     jid0, _ = run_job(d, dict(BASE, particles=60, outputs=["grains", "descriptors"]))
     _, _, svg0 = d.request("GET", "/v1/jobs/%s/svg?view=descriptors" % jid0)
     assert b'class="target"' not in svg0, svg0[:300]
-    # GET /metrics: the shape phase's durations, of the one job that had it
-    st4, _, m = d.request("GET", "/metrics")
-    assert st4 == 200
-    m = m.decode()
+    # GET /metrics: the shape phase's durations, of the one job that had it. The worker counts
+    # a job in the metrics just after its commit, which a client polling the job can see
+    # first: wait (5 s at most) for the second job's count.
     count = r'grainpack_job_duration_seconds_count\{kind="fourier-voronoi-2d",phase="%s"\} (\S+)'
+    deadline = time.time() + 5 * gpd.TIME_SCALE
+    while True:
+        st4, _, m = d.request("GET", "/metrics")
+        assert st4 == 200
+        m = m.decode()
+        total = re.search(count % "total", m)
+        if (total and float(total.group(1)) >= 2) or time.time() > deadline:
+            break
+        time.sleep(0.05)
     assert float(re.search(count % "shape", m).group(1)) == 1, m
     assert float(re.search(count % "total", m).group(1)) == 2, m
     assert d.stop() == 0, "daemon did not exit cleanly:\n" + d.read_log()
