@@ -15,8 +15,14 @@
  * achieved: cells that met F_S, the solid fraction of the refilled grains and the mean
  * shortfall of the cells that missed, and whether each grain is the specimen's bit for bit.
  *
- * Usage: bench_specimen2d [quick|fill]   ("quick" skips the 10,000-grain row, "fill" prints
- * only the second table)
+ * A third form times the per-grain phases of one specimen alone (issue #16: fill, ODEC and
+ * descriptors) next to what they produced: the solid fraction, cells meeting F_S, the mean
+ * disc count and the four mean descriptors, and 32-bit hashes of the grains' contours, discs
+ * and descriptors, so that two builds can be compared bit for bit in one line.
+ *
+ * Usage: bench_specimen2d [quick|fill|phases [N [THREADS]]]   ("quick" skips the 10,000-grain
+ * row, "fill" prints only the second table, "phases" only the third: N grains (10,000) on
+ * THREADS threads (2), the 10,000-grain row's spec)
  */
 #include <math.h>
 #include <stdint.h>
@@ -262,8 +268,67 @@ static void fill_table(void)
         fill_row(ex[i].name, &ex[i], i == 2 ? 7 : 2012);
 }
 
+/* ------------------------------------------------------------------ the per-grain phases */
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ b[i]) * 0x100000001b3ull;
+    return h;
+}
+
+static unsigned fold(uint64_t h) { return (unsigned)(h ^ (h >> 32)); }
+
+static void phases_table(size_t n, int threads)
+{
+    unsigned all = GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS;
+    row r = {"phases", n, 0.5, 1.0, 0.1, 0.05, 0.02, threads, all, GP_IMC_AD, 0};
+    gp_spec2d s;
+    setup(&r, &s);
+    gp_specimen2d *sp = NULL;
+    gp_error e;
+    if (gp_specimen2d_build(&s, NULL, NULL, NULL, &sp, &e) != GP_OK) {
+        printf("failed: %s\n", e.message);
+        return;
+    }
+    uint64_t hc = 0xcbf29ce484222325ull, hd = hc, hq = hc;
+    double m[5] = {0};
+    for (size_t i = 0; i < sp->ngrains; i++) {
+        const gp_grain2d *g = &sp->grains[i];
+        const gp_descriptors *d = &g->descriptors;
+        hc = fnv(hc, g->contour, g->ncontour * sizeof *g->contour);
+        hd = fnv(hd, g->discs, 3 * g->ndiscs * sizeof *g->discs);
+        hq = fnv(hq, d, sizeof *d);
+        m[0] += (double)g->ndiscs;
+        m[1] += d->roundness;
+        m[2] += d->circularity;
+        m[3] += d->regularity;
+        m[4] += d->elongation;
+    }
+    double k = sp->ngrains ? 1.0 / (double)sp->ngrains : 0.0;
+    printf("Per-grain phases of the 10,000-grain row's spec with %zu grains on %d thread(s) "
+           "(seconds; f+o+d = fill + odec + desc), what they made (SF, cells meeting F_S, mean "
+           "discs and descriptors) and hashes of the grains' contours, discs and descriptors\n\n",
+           n, threads);
+    printf("| grains | th | IMC s | fill s | odec s | desc s | f+o+d s | SF | met | discs | "
+           "round | circ | regul | elong | contours | discs | desc |\n");
+    printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    printf("| %zu | %d | %.2f | %.2f | %.2f | %.2f | %.2f | %.5f | %zu | %.3f | %.5f | %.5f | "
+           "%.5f | %.5f | %08x | %08x | %08x |\n",
+           sp->ngrains, threads, sp->t_imc, sp->t_fill, sp->t_odec, sp->t_descriptors,
+           sp->t_fill + sp->t_odec + sp->t_descriptors, sp->solid_fraction, sp->cells_target_met,
+           m[0] * k, m[1] * k, m[2] * k, m[3] * k, m[4] * k, fold(hc), fold(hd), fold(hq));
+    gp_specimen2d_destroy(sp);
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "phases") == 0) {
+        phases_table(argc > 2 ? (size_t)strtoul(argv[2], NULL, 10) : 10000,
+                     argc > 3 ? atoi(argv[3]) : 2);
+        return 0;
+    }
     int quick = argc > 1 && strcmp(argv[1], "quick") == 0;
     if (argc > 1 && strcmp(argv[1], "fill") == 0) {
         fill_table();

@@ -2,15 +2,23 @@
  * method. The hot objective is kept cheap (issue #16; instruction counts from callgrind on
  * Example 1's fill and refills, 7.9e9 before): the shape factor rho_i is a fixed part (modes
  * outside 2..7, once per cell) plus six modes summed on a quarter of the rays and spread to
- * the rest by the symmetry of the Fourier basis (optimised_modes_quadrant); its minimum is
- * only looked for when the spectrum could make it <= 0 (spectrum_floor); the grain's area is
+ * the rest by the symmetry of the Fourier basis (optimised_modes_quadrant); the grain's area is
  * a constant of the spectrum (see spectrum_area); the grain's support along an edge is taken
  * on the arc of rays that can hold it; the centre LP restarts from the last optimum's rows,
  * which the next evaluation mostly keeps; and the final containment check first tries the
  * cell's kernel (inside_kernel), ~10x cheaper than the general test. Fewer evaluations: a
  * simplex run also stops once it has gained less than STALL_REL in STALL_EVALS evaluations,
  * which is where cells that cannot reach F_S spent most of theirs. Together: 3.3e9
- * instructions for the same work, the same cells meeting F_S. */
+ * instructions for the same work, the same cells meeting F_S.
+ * Then (issue #16, second pass; callgrind on bench_specimen2d phases 2000 1, the fill 10.4e9
+ * -> ~5.2e9 instructions): the six phases' sin and cos inline (sincos_fast, a third of an
+ * evaluation in libm before); the quadrant sums and rays in SSE2, or AVX where the CPU has
+ * it (the same operations, so the same bits), with rho's smallest and largest taken on the
+ * way and the doubled copy lp_fit's arcs read written there too; the supports' maximum two
+ * products at a time; and Nelder-Mead on plain arrays (GSL's nmsimplex2 moves; its gsl_vector
+ * and CBLAS bookkeeping was a sixth of the fill). The libm sincos -> sincos_fast change moves
+ * the phases in the last bits, so the searches take other (equally good) paths: the solid
+ * fraction and cells meeting F_S of bench_specimen2d are unchanged. */
 #include "gp_fill.h"
 
 #include <float.h>
@@ -19,9 +27,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_multimin.h>
-#include <gsl/gsl_vector.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+/* The quadrant sums also have an AVX form, picked at run time (GP_FILL_AVX): the same
+ * products and sums in the same order per ray, four rays at a time, so the bits do not depend
+ * on the machine. No FMA: a fused multiply-add would round differently. */
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(GP_FILL_NO_AVX)
+#define GP_FILL_AVX 1
+#include <immintrin.h>
+#endif
+
 
 #define FIRST_OPT 2 /* first optimised mode */
 #define LAST_OPT 7  /* last optimised mode */
@@ -47,8 +63,6 @@
  * The stop trades the grains' alignment for speed below 45, so 45. */
 #define STALL_EVALS 45
 #define STALL_REL 1e-4
-/* rho_floor above this: rho_i > 0 for sure (its rounding is ~1e-16 per mode) */
-#define RHO_FLOOR_SURE 1e-9
 #define SUPPORT_ARC 16 /* rays either side of an edge's normal that support() scans at once */
 #define LP_TOL 1e-12 /* feasibility slack in local (unit-area) coordinates */
 #define LP_PIVOTS 64  /* dual simplex pivots before falling back to trying every vertex */
@@ -64,8 +78,9 @@ struct gp_fill_workspace {
     /* np % 4 == 0: cos(n theta_i), sin(n theta_i) of modes 2..7 on the first quadrant's
      * rays i = 0 .. np/4 (stride np/4 + 1), and four sums there (optimised_modes_quadrant) */
     double *qc, *qs, *qsum;
-    double rho_min, rho_max; /* of the last shape_factor (rho_max: set by lp_fit) */
-    double rho_floor;     /* 1 - sum_{n>=1} D_n: rho_i >= this for every phase */
+    double rho_min, rho_max; /* of the last shape_factor */
+    int avx;              /* the CPU has AVX: quadrant_avx */
+    int rho_doubled;      /* the last shape_factor also wrote rho to rho[np..2np) (lp_fit) */
     double unit_area;     /* area of the grain polygon for r0 = 1 (a constant: spectrum_area) */
     /* the cell being filled, in local coordinates: origin at the starting centre, scaled to
      * unit area, so the search sees the same numbers for a cell at 1e-6 or offset by 1e6 */
@@ -85,12 +100,6 @@ struct gp_fill_workspace {
     size_t rot;           /* the grain is turned by rot rays: phi = 2 pi rot / np */
     gp_vec2 lp_centre;    /* the centre found by the last lp_fit */
     int evals;
-    /* maximise evaluates its start before handing it to the minimiser, which evaluates it
-     * again: that second call returns this value (one use) */
-    double memo_x[NOPT + 2], memo_f;
-    size_t memo_n;
-    gsl_multimin_fminimizer *nm6, *nm8;
-    gsl_vector *x6, *x8, *step6, *step8;
 };
 
 void gp_fill_params_defaults(gp_fill_params *p)
@@ -124,12 +133,6 @@ void gp_fill_workspace_destroy(gp_fill_workspace *ws)
     free(ws->ones);
     free(ws->proj);
     free(ws->arc0);
-    if (ws->nm6) gsl_multimin_fminimizer_free(ws->nm6);
-    if (ws->nm8) gsl_multimin_fminimizer_free(ws->nm8);
-    gsl_vector_free(ws->x6);
-    gsl_vector_free(ws->x8);
-    gsl_vector_free(ws->step6);
-    gsl_vector_free(ws->step8);
     free(ws);
 }
 
@@ -168,17 +171,6 @@ static double spectrum_area(const gp_fill_params *p)
     return 0.5 * sin(2.0 * M_PI / np) * np * (1.0 + 0.5 * s);
 }
 
-/* A lower bound of rho_i = 1 + sum_n D_n cos(...) whatever the phases. Where it is clearly
- * positive every grain of the spectrum is star-shaped and shape_factor need not look for
- * the smallest rho_i. */
-static double spectrum_floor(const gp_fill_params *p)
-{
-    double s = 1.0;
-    for (size_t n = 1; n < p->nmodes; n++)
-        s -= p->D[n];
-    return s;
-}
-
 gp_fill_workspace *gp_fill_workspace_create(const gp_fill_params *p, gp_error *err)
 {
     if (check_params(p, err) != GP_OK)
@@ -195,7 +187,6 @@ gp_fill_workspace *gp_fill_workspace_create(const gp_fill_params *p, gp_error *e
     ws->nm = p->nmodes;
     ws->ntab = ws->nm > LAST_OPT + 1 ? ws->nm : LAST_OPT + 1;
     ws->unit_area = spectrum_area(p);
-    ws->rho_floor = spectrum_floor(p);
     ws->cosn = malloc(ws->ntab * ws->np * sizeof(double));
     ws->sinn = malloc(ws->ntab * ws->np * sizeof(double));
     ws->base = malloc(ws->np * sizeof(double));
@@ -204,6 +195,9 @@ gp_fill_workspace *gp_fill_workspace_create(const gp_fill_params *p, gp_error *e
     ws->rho = malloc(2 * ws->np * sizeof(double)); /* the second half: lp_fit's copy */
     if (ws->np % 4 == 0) {
         size_t q = ws->np / 4 + 1;
+#ifdef GP_FILL_AVX
+        ws->avx = __builtin_cpu_supports("avx");
+#endif
         ws->qc = malloc(NOPT * q * sizeof(double));
         ws->qs = malloc(NOPT * q * sizeof(double));
         ws->qsum = malloc(4 * q * sizeof(double));
@@ -213,14 +207,7 @@ gp_fill_workspace *gp_fill_workspace_create(const gp_fill_params *p, gp_error *e
             return NULL;
         }
     }
-    ws->nm6 = gsl_multimin_fminimizer_alloc(gsl_multimin_fminimizer_nmsimplex2, NOPT);
-    ws->nm8 = gsl_multimin_fminimizer_alloc(gsl_multimin_fminimizer_nmsimplex2, NOPT + 2);
-    ws->x6 = gsl_vector_alloc(NOPT);
-    ws->x8 = gsl_vector_alloc(NOPT + 2);
-    ws->step6 = gsl_vector_alloc(NOPT);
-    ws->step8 = gsl_vector_alloc(NOPT + 2);
-    if (!ws->cosn || !ws->sinn || !ws->base || !ws->rmax || !ws->inv_rmax || !ws->rho ||
-        !ws->nm6 || !ws->nm8 || !ws->x6 || !ws->x8 || !ws->step6 || !ws->step8) {
+    if (!ws->cosn || !ws->sinn || !ws->base || !ws->rmax || !ws->inv_rmax || !ws->rho) {
         gp_fill_workspace_destroy(ws);
         gp_error_set(err, GP_ERR_NOMEM, "fill: out of memory");
         return NULL;
@@ -254,7 +241,6 @@ gp_status gp_fill_workspace_set_spectrum(gp_fill_workspace *ws, const double *D,
         return st;
     ws->p.D = D;
     ws->unit_area = spectrum_area(&ws->p); /* the area constant is the spectrum's */
-    ws->rho_floor = spectrum_floor(&ws->p);
     return GP_OK;
 }
 
@@ -354,7 +340,31 @@ static void quadrant_sums(size_t q, const double *restrict c, const double *rest
 {
     double a2 = ca[0], a3 = ca[1], a4 = ca[2], a5 = ca[3], a6 = ca[4], a7 = ca[5];
     double b2 = sa[0], b3 = sa[1], b4 = sa[2], b5 = sa[3], b6 = sa[4], b7 = sa[5];
-    for (size_t i = 0; i < q; i++) {
+    size_t i = 0;
+#if defined(__SSE2__)
+    /* the same products and sums two rays at a time (the compiler left this loop scalar) */
+    const __m128d A2 = _mm_set1_pd(a2), A3 = _mm_set1_pd(a3), A4 = _mm_set1_pd(a4);
+    const __m128d A5 = _mm_set1_pd(a5), A6 = _mm_set1_pd(a6), A7 = _mm_set1_pd(a7);
+    const __m128d B2 = _mm_set1_pd(b2), B3 = _mm_set1_pd(b3), B4 = _mm_set1_pd(b4);
+    const __m128d B5 = _mm_set1_pd(b5), B6 = _mm_set1_pd(b6), B7 = _mm_set1_pd(b7);
+#define LD(t, k) _mm_loadu_pd((t) + (k) * q + i)
+    for (; i + 2 <= q; i += 2) {
+        __m128d ce = _mm_add_pd(_mm_add_pd(_mm_mul_pd(A2, LD(c, 0)), _mm_mul_pd(A4, LD(c, 2))),
+                                _mm_mul_pd(A6, LD(c, 4)));
+        __m128d se = _mm_add_pd(_mm_add_pd(_mm_mul_pd(B2, LD(s, 0)), _mm_mul_pd(B4, LD(s, 2))),
+                                _mm_mul_pd(B6, LD(s, 4)));
+        __m128d co = _mm_add_pd(_mm_add_pd(_mm_mul_pd(A3, LD(c, 1)), _mm_mul_pd(A5, LD(c, 3))),
+                                _mm_mul_pd(A7, LD(c, 5)));
+        __m128d so = _mm_add_pd(_mm_add_pd(_mm_mul_pd(B3, LD(s, 1)), _mm_mul_pd(B5, LD(s, 3))),
+                                _mm_mul_pd(B7, LD(s, 5)));
+        _mm_storeu_pd(out + i, _mm_add_pd(ce, se));
+        _mm_storeu_pd(out + q + i, _mm_sub_pd(ce, se));
+        _mm_storeu_pd(out + 2 * q + i, _mm_add_pd(co, so));
+        _mm_storeu_pd(out + 3 * q + i, _mm_sub_pd(co, so));
+    }
+#undef LD
+#endif
+    for (; i < q; i++) {
         double ce = a2 * c[i] + a4 * c[2 * q + i] + a6 * c[4 * q + i];
         double se = b2 * s[i] + b4 * s[2 * q + i] + b6 * s[4 * q + i];
         double co = a3 * c[q + i] + a5 * c[3 * q + i] + a7 * c[5 * q + i];
@@ -366,12 +376,50 @@ static void quadrant_sums(size_t q, const double *restrict c, const double *rest
     }
 }
 
-/* rho = base + the four rays' combinations of the quadrant sums qs (see above). */
-static void quadrant_rays(size_t Q, const double *restrict qs, const double *restrict base,
-                          double *restrict rho)
+/* rho = base + the four rays' combinations of the quadrant sums qs (see above); the smallest
+ * and largest rho_i into mm[0], mm[1] on the way (the shape factor's sign test and lp_fit's
+ * support bound), instead of two more passes over rho. rho has room for 2 np: returns 1 when
+ * it also wrote the copy rho[np + i] = rho[i] that lp_fit's arcs read (else lp_fit copies). */
+static int quadrant_rays(size_t Q, const double *restrict qs, const double *restrict base,
+                         double *restrict rho, double *mm)
 {
     size_t q = Q + 1;
     const double *A = qs, *B = qs + q, *C = qs + 2 * q, *E = qs + 3 * q;
+#if defined(__SSE2__)
+    if (Q % 2 == 0) {
+        __m128d mn = _mm_set1_pd(DBL_MAX), mx = _mm_set1_pd(-DBL_MAX);
+#define PUT(k, v)                                                                             \
+    do {                                                                                      \
+        __m128d v_ = (v);                                                                     \
+        _mm_storeu_pd(rho + (k), v_);                                                         \
+        _mm_storeu_pd(rho + 4 * Q + (k), v_);                                                 \
+        mn = _mm_min_pd(mn, v_);                                                              \
+        mx = _mm_max_pd(mx, v_);                                                              \
+    } while (0)
+        for (size_t i = 0; i < Q; i += 2) {
+            __m128d a = _mm_loadu_pd(A + i), c = _mm_loadu_pd(C + i);
+            PUT(i, _mm_add_pd(_mm_loadu_pd(base + i), _mm_add_pd(a, c)));
+            PUT(2 * Q + i, _mm_add_pd(_mm_loadu_pd(base + 2 * Q + i), _mm_sub_pd(a, c)));
+        }
+        /* rays 2Q - i and 4Q - i for i = j + 1, j + 2: descending, so the lanes swap */
+        for (size_t j = 0; j < Q; j += 2) {
+            __m128d b = _mm_loadu_pd(B + j + 1), e = _mm_loadu_pd(E + j + 1);
+            __m128d be = _mm_sub_pd(b, e), bp = _mm_add_pd(b, e);
+            be = _mm_shuffle_pd(be, be, 1);
+            bp = _mm_shuffle_pd(bp, bp, 1);
+            PUT(2 * Q - j - 2, _mm_add_pd(_mm_loadu_pd(base + 2 * Q - j - 2), be));
+            PUT(4 * Q - j - 2, _mm_add_pd(_mm_loadu_pd(base + 4 * Q - j - 2), bp));
+        }
+#undef PUT
+        double l[2], h[2];
+        _mm_storeu_pd(l, mn);
+        _mm_storeu_pd(h, mx);
+        mm[0] = l[0] < l[1] ? l[0] : l[1];
+        mm[1] = h[0] > h[1] ? h[0] : h[1];
+        return 1;
+    }
+#endif
+    double mn = DBL_MAX, mx = -DBL_MAX;
     for (size_t i = 0; i < Q; i++) {
         rho[i] = base[i] + (A[i] + C[i]);
         rho[2 * Q + i] = base[2 * Q + i] + (A[i] - C[i]);
@@ -380,13 +428,108 @@ static void quadrant_rays(size_t Q, const double *restrict qs, const double *res
         rho[2 * Q - i] = base[2 * Q - i] + (B[i] - E[i]);
         rho[4 * Q - i] = base[4 * Q - i] + (B[i] + E[i]);
     }
+    for (size_t i = 0; i < 4 * Q; i++) {
+        mn = rho[i] < mn ? rho[i] : mn;
+        mx = rho[i] > mx ? rho[i] : mx;
+    }
+    mm[0] = mn;
+    mm[1] = mx;
+    return 0;
 }
+
+#ifdef GP_FILL_AVX
+/* quadrant_sums and quadrant_rays (Q % 4 == 0) four rays at a time; see them for what */
+__attribute__((target("avx"))) static void quadrant_avx(size_t Q, const double *restrict c,
+                                                         const double *restrict s,
+                                                         const double *ca, const double *sa,
+                                                         double *restrict out,
+                                                         const double *restrict base,
+                                                         double *restrict rho, double *mm)
+{
+    size_t q = Q + 1, i = 0;
+    __m256d a[NOPT], b[NOPT];
+    for (int j = 0; j < NOPT; j++) {
+        a[j] = _mm256_set1_pd(ca[j]);
+        b[j] = _mm256_set1_pd(sa[j]);
+    }
+#define LD(t, k) _mm256_loadu_pd((t) + (k) * q + i)
+#define MUL _mm256_mul_pd
+#define ADD _mm256_add_pd
+#define SUB _mm256_sub_pd
+    for (; i + 4 <= q; i += 4) {
+        __m256d ce = ADD(ADD(MUL(a[0], LD(c, 0)), MUL(a[2], LD(c, 2))), MUL(a[4], LD(c, 4)));
+        __m256d se = ADD(ADD(MUL(b[0], LD(s, 0)), MUL(b[2], LD(s, 2))), MUL(b[4], LD(s, 4)));
+        __m256d co = ADD(ADD(MUL(a[1], LD(c, 1)), MUL(a[3], LD(c, 3))), MUL(a[5], LD(c, 5)));
+        __m256d so = ADD(ADD(MUL(b[1], LD(s, 1)), MUL(b[3], LD(s, 3))), MUL(b[5], LD(s, 5)));
+        _mm256_storeu_pd(out + i, ADD(ce, se));
+        _mm256_storeu_pd(out + q + i, SUB(ce, se));
+        _mm256_storeu_pd(out + 2 * q + i, ADD(co, so));
+        _mm256_storeu_pd(out + 3 * q + i, SUB(co, so));
+    }
+#undef LD
+    for (; i < q; i++) { /* scalar, as quadrant_sums */
+        double ce = ca[0] * c[i] + ca[2] * c[2 * q + i] + ca[4] * c[4 * q + i];
+        double se = sa[0] * s[i] + sa[2] * s[2 * q + i] + sa[4] * s[4 * q + i];
+        double co = ca[1] * c[q + i] + ca[3] * c[3 * q + i] + ca[5] * c[5 * q + i];
+        double so = sa[1] * s[q + i] + sa[3] * s[3 * q + i] + sa[5] * s[5 * q + i];
+        out[i] = ce + se;
+        out[q + i] = ce - se;
+        out[2 * q + i] = co + so;
+        out[3 * q + i] = co - so;
+    }
+    const double *A = out, *B = out + q, *C = out + 2 * q, *E = out + 3 * q;
+    __m256d mn = _mm256_set1_pd(DBL_MAX), mx = _mm256_set1_pd(-DBL_MAX);
+#define PUT(k, v)                                                                             \
+    do {                                                                                      \
+        __m256d v_ = (v);                                                                     \
+        _mm256_storeu_pd(rho + (k), v_);                                                      \
+        _mm256_storeu_pd(rho + 4 * Q + (k), v_);                                              \
+        mn = _mm256_min_pd(mn, v_);                                                           \
+        mx = _mm256_max_pd(mx, v_);                                                           \
+    } while (0)
+    for (size_t k = 0; k < Q; k += 4) {
+        __m256d av = _mm256_loadu_pd(A + k), cv = _mm256_loadu_pd(C + k);
+        PUT(k, ADD(_mm256_loadu_pd(base + k), ADD(av, cv)));
+        PUT(2 * Q + k, ADD(_mm256_loadu_pd(base + 2 * Q + k), SUB(av, cv)));
+    }
+    for (size_t j = 0; j < Q; j += 4) { /* rays 2Q - i, 4Q - i, i = j + 1 .. j + 4: reversed */
+        __m256d bv = _mm256_loadu_pd(B + j + 1), ev = _mm256_loadu_pd(E + j + 1);
+        __m256d be = SUB(bv, ev), bp = ADD(bv, ev);
+        be = _mm256_permute_pd(_mm256_permute2f128_pd(be, be, 1), 5);
+        bp = _mm256_permute_pd(_mm256_permute2f128_pd(bp, bp, 1), 5);
+        PUT(2 * Q - j - 4, ADD(_mm256_loadu_pd(base + 2 * Q - j - 4), be));
+        PUT(4 * Q - j - 4, ADD(_mm256_loadu_pd(base + 4 * Q - j - 4), bp));
+    }
+#undef PUT
+#undef MUL
+#undef ADD
+#undef SUB
+    double l[4], h[4];
+    _mm256_storeu_pd(l, mn);
+    _mm256_storeu_pd(h, mx);
+    double l01 = l[0] < l[1] ? l[0] : l[1], l23 = l[2] < l[3] ? l[2] : l[3];
+    double h01 = h[0] > h[1] ? h[0] : h[1], h23 = h[2] > h[3] ? h[2] : h[3];
+    mm[0] = l01 < l23 ? l01 : l23;
+    mm[1] = h01 > h23 ? h01 : h23;
+}
+#endif
 
 static void optimised_modes_quadrant(gp_fill_workspace *ws, const double *ca, const double *sa)
 {
     size_t Q = ws->np / 4;
-    quadrant_sums(Q + 1, ws->qc, ws->qs, ca, sa, ws->qsum);
-    quadrant_rays(Q, ws->qsum, ws->base, ws->rho);
+    double mm[2];
+#ifdef GP_FILL_AVX
+    if (ws->avx && Q % 4 == 0) {
+        quadrant_avx(Q, ws->qc, ws->qs, ca, sa, ws->qsum, ws->base, ws->rho, mm);
+        ws->rho_doubled = 1;
+    } else
+#endif
+    {
+        quadrant_sums(Q + 1, ws->qc, ws->qs, ca, sa, ws->qsum);
+        ws->rho_doubled = quadrant_rays(Q, ws->qsum, ws->base, ws->rho, mm);
+    }
+    ws->rho_min = mm[0];
+    ws->rho_max = mm[1];
 }
 
 /* The same for any np: mode by mode over all the rays. */
@@ -401,69 +544,143 @@ static void optimised_modes_all(gp_fill_workspace *ws, const double *ca, const d
         for (size_t i = 0; i < np; i++)
             rho[i] += ca[j] * cn[i] + sa[j] * sn[i];
     }
+    double mn = rho[0], mx = rho[0];
+    for (size_t i = 1; i < np; i++) {
+        mn = rho[i] < mn ? rho[i] : mn;
+        mx = rho[i] > mx ? rho[i] : mx;
+    }
+    ws->rho_min = mn;
+    ws->rho_max = mx;
+    ws->rho_doubled = 0;
 }
 
-/* rho_i for the optimised phases ph[0..5] = delta_2..delta_7 (grain frame); returns min rho,
- * or the spectrum's floor when that already shows it positive (only its sign is used). */
+/* sin and cos of x to within an ulp or two (fdlibm's kernels on [-pi/4, pi/4] after a
+ * two-part Cody-Waite reduction by pi/2, exact for |x| < 2^20 pi/2), inline: the six phases
+ * of every evaluation went through libm's sincos, 30 % of the objective's instructions
+ * (issue #16). Larger |x| (a simplex wandering far) goes to libm. */
+static inline void sincos_fast(double x, double *s, double *c)
+{
+    if (!(fabs(x) < 1e6)) {
+        *s = sin(x);
+        *c = cos(x);
+        return;
+    }
+    const double pio2_1 = 1.57079632673412561417e+00, pio2_1t = 6.07710050650619224932e-11;
+    double kd = nearbyint(x * 0.63661977236758134308);
+    long k = (long)kd;
+    double r = (x - kd * pio2_1) - kd * pio2_1t, z = r * r;
+    double sr = r + r * z * (-1.66666666666666324348e-01 +
+                 z * (8.33333333332248946124e-03 + z * (-1.98412698298579493134e-04 +
+                 z * (2.75573137070700676789e-06 + z * (-2.50507602534068634195e-08 +
+                 z * 1.58969099521155010221e-10)))));
+    double cr = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02 +
+                 z * (-1.38888888888741095749e-03 + z * (2.48015872894767294178e-05 +
+                 z * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09 +
+                 z * -1.13596475577881948265e-11)))));
+    double ss = (k & 1) ? cr : sr, cc = (k & 1) ? sr : cr;
+    *s = (k & 2) ? -ss : ss;
+    *c = ((k + 1) & 2) ? -cc : cc;
+}
+
+#if defined(__SSE2__)
+/* sincos_fast of x[0] and x[1] at once, the same operations per lane (cvtpd2dq rounds to
+ * nearest even as nearbyint does), so the same bits; 0 (nothing written) when either |x| is
+ * too large for the reduction. */
+static inline int sincos_fast2(const double *x, double *s, double *c)
+{
+    __m128d vx = _mm_loadu_pd(x);
+    __m128d ax = _mm_andnot_pd(_mm_set1_pd(-0.0), vx);
+    if (_mm_movemask_pd(_mm_cmplt_pd(ax, _mm_set1_pd(1e6))) != 3)
+        return 0;
+    __m128i k = _mm_cvtpd_epi32(_mm_mul_pd(vx, _mm_set1_pd(0.63661977236758134308)));
+    __m128d kd = _mm_cvtepi32_pd(k);
+#define P(v) _mm_set1_pd(v)
+    __m128d r = _mm_sub_pd(_mm_sub_pd(vx, _mm_mul_pd(kd, P(1.57079632673412561417e+00))),
+                           _mm_mul_pd(kd, P(6.07710050650619224932e-11)));
+    __m128d z = _mm_mul_pd(r, r);
+    __m128d ps = _mm_add_pd(P(-2.50507602534068634195e-08),
+                            _mm_mul_pd(z, P(1.58969099521155010221e-10)));
+    ps = _mm_add_pd(P(2.75573137070700676789e-06), _mm_mul_pd(z, ps));
+    ps = _mm_add_pd(P(-1.98412698298579493134e-04), _mm_mul_pd(z, ps));
+    ps = _mm_add_pd(P(8.33333333332248946124e-03), _mm_mul_pd(z, ps));
+    ps = _mm_add_pd(P(-1.66666666666666324348e-01), _mm_mul_pd(z, ps));
+    __m128d sr = _mm_add_pd(r, _mm_mul_pd(_mm_mul_pd(r, z), ps));
+    __m128d pc = _mm_add_pd(P(2.08757232129817482790e-09),
+                            _mm_mul_pd(z, P(-1.13596475577881948265e-11)));
+    pc = _mm_add_pd(P(-2.75573143513906633035e-07), _mm_mul_pd(z, pc));
+    pc = _mm_add_pd(P(2.48015872894767294178e-05), _mm_mul_pd(z, pc));
+    pc = _mm_add_pd(P(-1.38888888888741095749e-03), _mm_mul_pd(z, pc));
+    pc = _mm_add_pd(P(4.16666666666666019037e-02), _mm_mul_pd(z, pc));
+    __m128d cr = _mm_add_pd(_mm_sub_pd(P(1.0), _mm_mul_pd(P(0.5), z)),
+                            _mm_mul_pd(_mm_mul_pd(z, z), pc));
+#undef P
+    /* k of each lane in both its halves: bit 0 swaps sin and cos, bits of k and k + 1 the signs */
+    __m128i kk = _mm_shuffle_epi32(k, _MM_SHUFFLE(1, 1, 0, 0));
+    __m128i one = _mm_set1_epi32(1), bit1 = _mm_set_epi32(0, 2, 0, 2);
+    __m128d swap = _mm_castsi128_pd(_mm_cmpeq_epi32(_mm_and_si128(kk, one), one));
+    __m128d ss = _mm_or_pd(_mm_and_pd(swap, cr), _mm_andnot_pd(swap, sr));
+    __m128d cc = _mm_or_pd(_mm_and_pd(swap, sr), _mm_andnot_pd(swap, cr));
+    __m128i sgs = _mm_slli_epi64(_mm_and_si128(kk, bit1), 62);
+    __m128i sgc = _mm_slli_epi64(_mm_and_si128(_mm_add_epi32(kk, one), bit1), 62);
+    _mm_storeu_pd(s, _mm_xor_pd(ss, _mm_castsi128_pd(sgs)));
+    _mm_storeu_pd(c, _mm_xor_pd(cc, _mm_castsi128_pd(sgc)));
+    return 1;
+}
+#endif
+
+/* rho_i for the optimised phases ph[0..5] = delta_2..delta_7 (grain frame), and their smallest
+ * and largest (ws->rho_min, rho_max); returns min rho (only its sign is used). */
 static double shape_factor(gp_fill_workspace *ws, const double *ph)
 {
-    size_t np = ws->np;
-    double ca[NOPT], sa[NOPT];
-    for (int j = 0; j < NOPT; j++) {
+    double ca[NOPT], sa[NOPT], sn[NOPT], cs[NOPT];
+    int j = 0;
+#if defined(__SSE2__)
+    for (; j + 2 <= NOPT && sincos_fast2(ph + j, sn + j, cs + j); j += 2)
+        ;
+#endif
+    for (; j < NOPT; j++)
+        sincos_fast(ph[j], &sn[j], &cs[j]);
+    for (j = 0; j < NOPT; j++) {
         size_t n = FIRST_OPT + (size_t)j;
         double d = n < ws->nm ? ws->p.D[n] : 0.0;
-        ca[j] = d * cos(ph[j]);
-        sa[j] = d * sin(ph[j]);
+        ca[j] = d * cs[j];
+        sa[j] = d * sn[j];
     }
     if (ws->qc)
         optimised_modes_quadrant(ws, ca, sa);
     else
         optimised_modes_all(ws, ca, sa);
-    if (ws->rho_floor > RHO_FLOOR_SURE)
-        return ws->rho_min = ws->rho_floor;
-    const double *rho = ws->rho;
-    double mn0 = rho[0], mn1 = rho[0];
-    size_t i = 0;
-    for (; i + 2 <= np; i += 2) {
-        mn0 = rho[i] < mn0 ? rho[i] : mn0;
-        mn1 = rho[i + 1] < mn1 ? rho[i + 1] : mn1;
-    }
-    for (; i < np; i++)
-        mn0 = rho[i] < mn0 ? rho[i] : mn0;
-    return ws->rho_min = mn0 < mn1 ? mn0 : mn1;
-}
-
-/* max_i rho_i (two independent chains rather than one) */
-static double rho_max(const gp_fill_workspace *ws)
-{
-    const double *rho = ws->rho;
-    double mx0 = rho[0], mx1 = rho[0];
-    size_t i = 0;
-    for (; i + 2 <= ws->np; i += 2) {
-        mx0 = rho[i] > mx0 ? rho[i] : mx0;
-        mx1 = rho[i + 1] > mx1 ? rho[i + 1] : mx1;
-    }
-    for (; i < ws->np; i++)
-        mx0 = rho[i] > mx0 ? rho[i] : mx0;
-    return mx0 > mx1 ? mx0 : mx1;
+    return ws->rho_min;
 }
 
 /* Largest r0 allowed by the rays (cast in the cell's frame) for the current rho, turned by
  * rot rays: grain ray i lies along cell ray i + rot. */
+/* max(q, max_i a_i b_i), two products at a time: maxpd(v, m) is v > m ? v : m, the scalar
+ * test, and the maximum of the same products is the same double in any order */
+static double max_products(const double *a, const double *b, size_t n, double q)
+{
+    size_t i = 0;
+#if defined(__SSE2__)
+    __m128d m = _mm_set1_pd(q);
+    for (; i + 2 <= n; i += 2)
+        m = _mm_max_pd(_mm_mul_pd(_mm_loadu_pd(a + i), _mm_loadu_pd(b + i)), m);
+    double l[2];
+    _mm_storeu_pd(l, m);
+    q = l[0] > l[1] ? l[0] : l[1];
+#endif
+    for (; i < n; i++) {
+        double v = a[i] * b[i];
+        q = v > q ? v : q;
+    }
+    return q;
+}
+
 static double r0_rays(const gp_fill_workspace *ws)
 {
     size_t np = ws->np, split = np - ws->rot; /* rays i < split meet cell ray i + rot */
     const double *rho = ws->rho, *inv = ws->inv_rmax;
-    double q = 0.0;
-    for (size_t i = 0; i < split; i++) {
-        double v = rho[i] * inv[i + ws->rot];
-        q = v > q ? v : q;
-    }
-    for (size_t i = split; i < np; i++) {
-        double v = rho[i] * inv[i - split];
-        q = v > q ? v : q;
-    }
-    return 1.0 / q;
+    double q = max_products(rho, inv + ws->rot, split, 0.0);
+    return 1.0 / max_products(rho + split, inv, np - split, q);
 }
 
 /* ------------------------------------------------------------------ the centre LP (convex) */
@@ -505,15 +722,14 @@ static int invert3(const lp_rows *r, const size_t *B, double M[3][3])
     return 0;
 }
 
-/* Dual simplex from basis B (three rows whose dual weights, the last row of their inverse,
- * are >= 0): while the basis' vertex v violates a row, that row replaces the basis row the
+/* Dual simplex from basis B (three rows whose dual weights, the last row of their inverse M,
+ * are >= 0; have_m: M holds that inverse already): while the basis' vertex v violates a row, that row replaces the basis row the
  * ratio test picks, which keeps the weights >= 0 -- a few pivots from the last optimum.
  * 0 with the optimum in v and B; -1 if it stalls, cycles or meets a singular basis. */
-static int lp_dual(const lp_rows *r, size_t *B, double *v)
+static int lp_dual(const lp_rows *r, size_t *B, double *v, double M[3][3], int have_m)
 {
-    double M[3][3];
     for (int it = 0; it < LP_PIVOTS; it++) {
-        if (invert3(r, B, M) != 0)
+        if (!(it == 0 && have_m) && invert3(r, B, M) != 0)
             return -1;
         for (int i = 0; i < 3; i++)
             v[i] = M[i][0] * r->h[B[0]] + M[i][1] * r->h[B[1]] + M[i][2] * r->h[B[2]];
@@ -530,8 +746,9 @@ static int lp_dual(const lp_rows *r, size_t *B, double *v)
         double ratio = DBL_MAX;
         for (int i = 0; i < 3; i++) {
             double mu = M[0][i] * r->a[q] + M[1][i] * r->b[q] + M[2][i] * r->w[q];
-            if (mu > 1e-12 && fmax(M[2][i], 0.0) / mu < ratio)
-                ratio = fmax(M[2][i], 0.0) / mu, out = i;
+            double wi = M[2][i] > 0.0 ? M[2][i] : 0.0; /* fmax, without the call */
+            if (mu > 1e-12 && wi / mu < ratio)
+                ratio = wi / mu, out = i;
         }
         if (out < 0)
             return -1; /* infeasible */
@@ -578,10 +795,12 @@ static int lp_solve(gp_fill_workspace *ws, double *w, double *h, double zmax, do
     lp_rows r = {ws->nx, ws->ny, w, h, m + 5};
     double M[3][3], v[3];
     size_t *B = ws->lp_basis;
+    int have_m = 1; /* M is B's inverse: lp_dual's first pivot need not invert it again */
     if (invert3(&r, B, M) != 0 || M[2][0] < 0.0 || M[2][1] < 0.0 || M[2][2] < 0.0) {
         B[0] = m + 4, B[1] = m, B[2] = m + 2;
+        have_m = 0;
     }
-    if (lp_dual(&r, B, v) != 0 && lp_vertices(&r, B, v) != 0)
+    if (lp_dual(&r, B, v, M, have_m) != 0 && lp_vertices(&r, B, v) != 0)
         return -1;
     *x = v[0], *y = v[1], *z = v[2];
     return 0;
@@ -624,16 +843,21 @@ static double support(const gp_fill_workspace *ws, size_t k)
         return support_walk(ws, k);
     size_t j0 = ws->arc0[k], js = (j0 + np - w) % np, is = (js + np - ws->rot) % np;
     const double *pk = ws->proj + 2 * k * np, *a = ws->rho + is, *b = pk + js;
-    double s0 = a[0] * b[0], s1 = s0;
     size_t n = 2 * w + 1, t = 1;
-    for (; t + 2 <= n; t += 2) {
-        s0 = a[t] * b[t] > s0 ? a[t] * b[t] : s0;
-        s1 = a[t + 1] * b[t + 1] > s1 ? a[t + 1] * b[t + 1] : s1;
-    }
+    double s = a[0] * b[0];
+#if defined(__SSE2__)
+    /* two products at a time (maxpd; the maximum of the same products is the same double) */
+    __m128d m2 = _mm_set1_pd(s);
+    for (; t + 2 <= n; t += 2)
+        m2 = _mm_max_pd(m2, _mm_mul_pd(_mm_loadu_pd(a + t), _mm_loadu_pd(b + t)));
+    double l[2];
+    _mm_storeu_pd(l, m2);
+    s = l[0] > l[1] ? l[0] : l[1];
+#endif
     for (; t < n; t++)
-        s0 = a[t] * b[t] > s0 ? a[t] * b[t] : s0;
-    double s = s0 > s1 ? s0 : s1;
-    double edge = fmax(pk[js + np - 1], pk[js + n]); /* the rays just outside the arc */
+        s = a[t] * b[t] > s ? a[t] * b[t] : s;
+    double e0 = pk[js + np - 1], e1 = pk[js + n]; /* the rays just outside the arc */
+    double edge = e0 > e1 ? e0 : e1;
     return edge * ws->rho_max < s ? s : support_walk(ws, k);
 }
 
@@ -642,8 +866,8 @@ static double support(const gp_fill_workspace *ws, size_t k)
  * s_k being the grain's support: linear in (c, r0), so the exact optimum is a small LP. */
 static double lp_fit(gp_fill_workspace *ws)
 {
-    ws->rho_max = rho_max(ws);
-    memcpy(ws->rho + ws->np, ws->rho, ws->np * sizeof *ws->rho);
+    if (!ws->rho_doubled)
+        memcpy(ws->rho + ws->np, ws->rho, ws->np * sizeof *ws->rho);
     for (size_t k = 0; k < ws->ncell; k++)
         ws->sup[k] = support(ws, k);
     double r0, zmax = 2.0 * sqrt(ws->cell_area / ws->unit_area);
@@ -665,82 +889,185 @@ static double achievable(gp_fill_workspace *ws, const double *ph)
     return r0 * r0 * ws->unit_area / ws->cell_area;
 }
 
-/* 1 (and the memo spent) when x is the point maximise just evaluated */
-static int memo_hit(gp_fill_workspace *ws, const gsl_vector *x)
+static double objective6(gp_fill_workspace *ws, const double *x)
 {
-    size_t n = ws->memo_n;
-    ws->memo_n = 0;
-    if (n != x->size)
-        return 0;
-    for (size_t j = 0; j < n; j++)
-        if (x->data[j * x->stride] != ws->memo_x[j])
-            return 0;
-    return 1;
+    return -achievable(ws, x);
 }
 
-static double objective6(const gsl_vector *x, void *user)
+/* phases x[0..5] and centre x[6], x[7] (non-convex cells: rays from the centre) */
+static double objective8(gp_fill_workspace *ws, const double *x)
 {
-    gp_fill_workspace *ws = user;
-    if (memo_hit(ws, x))
-        return ws->memo_f;
-    double ph[NOPT];
-    for (int j = 0; j < NOPT; j++)
-        ph[j] = x->data[(size_t)j * x->stride]; /* gsl_vector_get without its range check */
-    return -achievable(ws, ph);
-}
-
-static double objective8(const gsl_vector *x, void *user)
-{
-    gp_fill_workspace *ws = user;
-    if (memo_hit(ws, x))
-        return ws->memo_f;
-    double ph[NOPT];
-    for (int j = 0; j < NOPT; j++)
-        ph[j] = gsl_vector_get(x, (size_t)j);
-    gp_vec2 c = {gsl_vector_get(x, NOPT), gsl_vector_get(x, NOPT + 1)};
+    gp_vec2 c = {x[NOPT], x[NOPT + 1]};
     if (!gp_poly_contains(ws->cell, ws->ncell, c) || cast_rays(ws, c) != 0) {
         ws->evals++;
         return 0.0;
     }
-    return -achievable(ws, ph);
+    return -achievable(ws, x);
+}
+
+/* ------------------------------------------------------------------ Nelder-Mead */
+
+/* GSL's nmsimplex2 (the moves, coefficients, incremental centre and size of its simplex2.c)
+ * on plain arrays: through gsl_vector, gsl_matrix and CBLAS calls its bookkeeping cost a sixth
+ * of the fill's instructions (issue #16), more than the shape factor's sums. The objective is
+ * always finite here (0 where the phases are not admissible), so GSL's non-finite branches
+ * are left out. */
+enum { NM_MAX = NOPT + 2 };
+typedef double (*nm_fn)(gp_fill_workspace *ws, const double *x);
+
+typedef struct nm_simplex {
+    size_t n;                          /* dimension; n + 1 vertices */
+    double x[NM_MAX + 1][NM_MAX], y[NM_MAX + 1];
+    double c[NM_MAX];                  /* centre of the n + 1 vertices */
+    double S2;                         /* mean squared distance of the vertices to c */
+    size_t lo;                         /* the best vertex after the last step */
+} nm_simplex;
+
+static double nm_centre_size(nm_simplex *s)
+{
+    size_t n = s->n, P = n + 1;
+    for (size_t j = 0; j < n; j++) {
+        double t = 0.0;
+        for (size_t i = 0; i < P; i++)
+            t += s->x[i][j];
+        s->c[j] = t * (1.0 / (double)P);
+    }
+    double ss = 0.0;
+    for (size_t i = 0; i < P; i++)
+        for (size_t j = 0; j < n; j++)
+            ss += (s->x[i][j] - s->c[j]) * (s->x[i][j] - s->c[j]);
+    s->S2 = ss / (double)P;
+    return sqrt(s->S2);
+}
+
+/* x0 (value f0, already known) and x0 + step_i e_i */
+static void nm_set(nm_simplex *s, gp_fill_workspace *ws, nm_fn f, const double *x0, double f0,
+                   const double *step, size_t n)
+{
+    s->n = n;
+    memcpy(s->x[0], x0, n * sizeof *x0);
+    s->y[0] = f0;
+    for (size_t i = 0; i < n; i++) {
+        memcpy(s->x[i + 1], x0, n * sizeof *x0);
+        s->x[i + 1][i] = x0[i] + step[i];
+        s->y[i + 1] = f(ws, s->x[i + 1]);
+    }
+    nm_centre_size(s);
+    s->lo = 0;
+}
+
+/* xc = the corner `hi` moved through the centre of the others by coeff (-1 reflection, -2
+ * expansion, 0.5 contraction); returns f(xc) */
+static double nm_corner(const nm_simplex *s, gp_fill_workspace *ws, nm_fn f, size_t hi,
+                        double coeff, double *xc)
+{
+    double P = (double)(s->n + 1);
+    double alpha = (1.0 - coeff) * P / (P - 1.0), beta = (P * coeff - 1.0) / (P - 1.0);
+    for (size_t j = 0; j < s->n; j++)
+        xc[j] = alpha * s->c[j] + beta * s->x[hi][j];
+    return f(ws, xc);
+}
+
+/* vertex i := x (value v), the centre and size updated as GSL does */
+static void nm_update(nm_simplex *s, size_t i, const double *x, double v)
+{
+    size_t n = s->n;
+    double P = (double)(n + 1), d2 = 0.0, xmcd = 0.0;
+    for (size_t j = 0; j < n; j++) {
+        double delta = x[j] - s->x[i][j];
+        d2 += delta * delta;
+        xmcd += (s->x[i][j] - s->c[j]) * delta;
+    }
+    s->S2 += (2.0 / P) * xmcd + ((P - 1.0) / P) * (d2 / P);
+    for (size_t j = 0; j < n; j++) {
+        s->c[j] += (x[j] - s->x[i][j]) / P;
+        s->x[i][j] = x[j];
+    }
+    s->y[i] = v;
+}
+
+/* every vertex halfway to the best one */
+static void nm_shrink(nm_simplex *s, gp_fill_workspace *ws, nm_fn f, size_t best)
+{
+    for (size_t i = 0; i <= s->n; i++) {
+        if (i == best)
+            continue;
+        for (size_t j = 0; j < s->n; j++)
+            s->x[i][j] = 0.5 * (s->x[i][j] + s->x[best][j]);
+        s->y[i] = f(ws, s->x[i]);
+    }
+    nm_centre_size(s);
+}
+
+/* One step; returns the simplex size. */
+static double nm_step(nm_simplex *s, gp_fill_workspace *ws, nm_fn f)
+{
+    size_t P = s->n + 1, hi = 0, lo = 0;
+    double dhi = s->y[0], ds_hi = s->y[0], dlo = s->y[0];
+    for (size_t i = 1; i < P; i++) {
+        double v = s->y[i];
+        if (v < dlo)
+            dlo = v, lo = i;
+        else if (v > dhi)
+            ds_hi = dhi, dhi = v, hi = i;
+        else if (v > ds_hi)
+            ds_hi = v;
+    }
+    double xc[NM_MAX], xc2[NM_MAX];
+    double v = nm_corner(s, ws, f, hi, -1.0, xc);
+    if (v < s->y[lo]) {
+        double v2 = nm_corner(s, ws, f, hi, -2.0, xc2);
+        if (v2 < s->y[lo])
+            nm_update(s, hi, xc2, v2);
+        else
+            nm_update(s, hi, xc, v);
+    } else if (v > ds_hi) {
+        if (v <= dhi)
+            nm_update(s, hi, xc, v);
+        double v2 = nm_corner(s, ws, f, hi, 0.5, xc2);
+        if (v2 <= dhi)
+            nm_update(s, hi, xc2, v2);
+        else
+            nm_shrink(s, ws, f, lo);
+    } else {
+        nm_update(s, hi, xc, v);
+    }
+    s->lo = 0;
+    for (size_t i = 1; i < P; i++)
+        if (s->y[i] < s->y[s->lo])
+            s->lo = i;
+    return s->S2 > 0.0 ? sqrt(s->S2) : nm_centre_size(s);
 }
 
 /* Runs Nelder-Mead from x until the fraction reaches target, the simplex collapses, the best
  * stalls (STALL_EVALS) or `budget` evaluations are spent; leaves the best point in x and
  * returns its fraction. */
-static double maximise(gp_fill_workspace *ws, gsl_multimin_fminimizer *m,
-                       gsl_multimin_function *f, gsl_vector *x, const gsl_vector *step,
+static double maximise(gp_fill_workspace *ws, nm_fn f, double *x, const double *step, size_t n,
                        double target, int budget)
 {
-    double f0 = -f->f(x, f->params);
+    double f0 = -f(ws, x);
     if (f0 >= target)
         return f0;
-    for (size_t j = 0; j < x->size; j++)
-        ws->memo_x[j] = gsl_vector_get(x, j);
-    ws->memo_f = -f0;
-    ws->memo_n = x->size;
-    gsl_multimin_fminimizer_set(m, f, x, step);
-    ws->memo_n = 0;
+    nm_simplex s;
+    nm_set(&s, ws, f, x, -f0, step, n);
     budget += ws->evals;
     double last = f0;
     int since = ws->evals;
     while (ws->evals < budget) {
-        if (gsl_multimin_fminimizer_iterate(m) != GSL_SUCCESS)
+        double size = nm_step(&s, ws, f);
+        double fbest = -s.y[s.lo];
+        if (fbest >= target || size < 1e-4)
             break;
-        if (-m->fval >= target)
-            break;
-        if (gsl_multimin_test_size(gsl_multimin_fminimizer_size(m), 1e-4) == GSL_SUCCESS)
-            break;
-        if (-m->fval > last * (1.0 + STALL_REL)) {
-            last = -m->fval;
+        if (fbest > last * (1.0 + STALL_REL)) {
+            last = fbest;
             since = ws->evals;
         } else if (ws->evals - since >= STALL_EVALS) {
             break;
         }
     }
-    double best = -m->fval;
+    double best = -s.y[s.lo];
     if (best > f0) {
-        gsl_vector_memcpy(x, m->x);
+        memcpy(x, s.x[s.lo], n * sizeof *x);
         return best;
     }
     return f0;
@@ -750,17 +1077,16 @@ static double maximise(gp_fill_workspace *ws, gsl_multimin_fminimizer *m,
  * best point up to `restarts` times while that improves. */
 static double polish(gp_fill_workspace *ws, double *ph, double target, int budget, int restarts)
 {
-    gsl_multimin_function f6 = {objective6, NOPT, ws};
     double best = -1.0;
     for (int round = 0; round <= restarts && best < target; round++) {
+        double x[NOPT], step[NOPT];
         for (int j = 0; j < NOPT; j++) {
-            gsl_vector_set(ws->x6, (size_t)j, ph[j]);
-            gsl_vector_set(ws->step6, (size_t)j, round == 0 ? 0.6 : 0.3);
+            x[j] = ph[j];
+            step[j] = round == 0 ? 0.6 : 0.3;
         }
-        double f = maximise(ws, ws->nm6, &f6, ws->x6, ws->step6, target, budget);
+        double f = maximise(ws, objective6, x, step, NOPT, target, budget);
         if (f > best)
-            for (int j = 0; j < NOPT; j++)
-                ph[j] = gsl_vector_get(ws->x6, (size_t)j);
+            memcpy(ph, x, sizeof x);
         int improved = f > best * (1.0 + 1e-4);
         best = f > best ? f : best;
         if (!improved)
@@ -872,25 +1198,23 @@ static double search_rays(gp_fill_workspace *ws, const double *dft, candidate *b
     ws->rot = 0;
     ws->use_lp = 0;
     best->f = polish(ws, best->ph, target, ws->p.max_evals, 0);
-    gsl_multimin_function f8 = {objective8, NOPT + 2, ws};
     for (int round = 0; round <= FILL_RESTARTS && best->f < target && ws->p.optimise_centre;
          round++) {
+        double x[NOPT + 2], step[NOPT + 2];
         for (int j = 0; j < NOPT; j++) {
-            gsl_vector_set(ws->x8, (size_t)j, best->ph[j]);
-            gsl_vector_set(ws->step8, (size_t)j, 0.3);
+            x[j] = best->ph[j];
+            step[j] = 0.3;
         }
-        gsl_vector_set(ws->x8, NOPT, c->x);
-        gsl_vector_set(ws->x8, NOPT + 1, c->y);
-        gsl_vector_set(ws->step8, NOPT, 0.05);
-        gsl_vector_set(ws->step8, NOPT + 1, 0.05);
-        double f = maximise(ws, ws->nm8, &f8, ws->x8, ws->step8, target, ws->p.max_evals);
+        x[NOPT] = c->x;
+        x[NOPT + 1] = c->y;
+        step[NOPT] = step[NOPT + 1] = 0.05;
+        double f = maximise(ws, objective8, x, step, NOPT + 2, target, ws->p.max_evals);
         if (!(f > best->f * (1.0 + 1e-4)))
             break;
         best->f = f;
-        for (int j = 0; j < NOPT; j++)
-            best->ph[j] = gsl_vector_get(ws->x8, (size_t)j);
-        c->x = gsl_vector_get(ws->x8, NOPT);
-        c->y = gsl_vector_get(ws->x8, NOPT + 1);
+        memcpy(best->ph, x, sizeof best->ph);
+        c->x = x[NOPT];
+        c->y = x[NOPT + 1];
     }
     return best->f;
 }

@@ -18,12 +18,13 @@
  *   its vertices are, i.e. iff n_k . c + r0 s_k <= h_k for every edge (normal n_k, offset
  *   h_k), s_k the grain's support along n_k: linear in (c, r0). So the best centre and r0 for
  *   a shape are a 3-variable LP, solved exactly at every evaluation.
- * The search, GSL's Nelder-Mead over the phases: (A) the paper's, from the phases of the DFT
- * of the cell's contour seen from its centroid, with mode 2's axis on the cell's orientation
- * (its minimum-caliper axis), so that the grain takes the cell's orientation; centre fixed
- * there; most cells reach F_S here. Then in convex cells: (B) the same with the
- * best centre for each shape; (C) the random modes turned under the cell-aligned modes
- * 2..7 (phi); (D) for cells close to F_S, three random starts seeded from the caller's phases.
+ * The search, Nelder-Mead over the phases (GSL's nmsimplex2 moves, on plain arrays): (A) the
+ * paper's, from the phases of the DFT of the cell's contour seen from its centroid, with mode
+ * 2's axis on the cell's orientation (its minimum-caliper axis), so that the grain takes the
+ * cell's orientation; centre fixed there; most cells reach F_S here. Then in convex cells:
+ * (B) the same with the best centre for each shape; (C) the random modes turned under the
+ * cell-aligned modes 2..7 (phi); (D) for cells close to F_S, three random starts seeded from
+ * the caller's phases.
  * Each simplex run ends at F_S, at its budget, or once its best has stalled (grown by less
  * than 1e-4 in 45 evaluations): most of the work went to cells that cannot reach F_S, whose
  * runs crawl to a collapsed simplex (issue #16: a fifth fewer evaluations, the same cells
@@ -62,7 +63,7 @@ typedef struct gp_fill_params {
 
 void gp_fill_params_defaults(gp_fill_params *p);
 
-/* Per-thread workspace: trigonometric tables, buffers and the GSL minimiser. */
+/* Per-thread workspace: trigonometric tables and buffers. */
 typedef struct gp_fill_workspace gp_fill_workspace;
 
 gp_fill_workspace *gp_fill_workspace_create(const gp_fill_params *p, gp_error *err);

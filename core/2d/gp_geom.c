@@ -52,7 +52,21 @@ static inline int vlt(gp_vec2 a, gp_vec2 b) { return a.x < b.x || (a.x == b.x &&
 static void bbox_of(const gp_vec2 *p, size_t n, double *x0, double *y0, double *x1, double *y1)
 {
     double a = p[0].x, b = p[0].y, c = p[0].x, d = p[0].y;
-    for (size_t i = 1; i < n; i++) {
+    size_t i = 1;
+#if defined(__SSE2__)
+    /* (x, y) at once; minpd(v, m) is v < m ? v : m, the test below, NaN skipped alike */
+    __m128d lo = _mm_loadu_pd(&p[0].x), hi = lo;
+    for (; i < n; i++) {
+        __m128d v = _mm_loadu_pd(&p[i].x);
+        lo = _mm_min_pd(v, lo);
+        hi = _mm_max_pd(v, hi);
+    }
+    double l[2], h[2];
+    _mm_storeu_pd(l, lo);
+    _mm_storeu_pd(h, hi);
+    a = l[0], b = l[1], c = h[0], d = h[1];
+#endif
+    for (; i < n; i++) {
         if (p[i].x < a) a = p[i].x;
         if (p[i].x > c) c = p[i].x;
         if (p[i].y < b) b = p[i].y;
@@ -296,6 +310,55 @@ static int point_class(const gp_vec2 *p, size_t n, gp_vec2 q, double tol)
     return c ? 1 : -1;
 }
 
+/* point_class(p, n, q, tol) >= 0 for tol >= 0, n >= 2: an edge matters to it only when q lies
+ * in its bounding box widened by tol or its ends straddle q's line; two edges at a time are
+ * screened for that (most are neither) and only those go through point_class's own tests, in
+ * the same order. A few times faster (ODEC checks every disc centre, issue #16). */
+static int contains_screened(const gp_vec2 *p, size_t n, gp_vec2 q, double tol)
+{
+#if defined(__SSE2__)
+    const double tol2 = tol * tol;
+    const __m128d qx = _mm_set1_pd(q.x), qy = _mm_set1_pd(q.y), vt = _mm_set1_pd(tol);
+    int c = 0;
+    for (size_t i = 0; i < n; i += 2) {
+        /* edges j -> i and i -> i + 1 (j = i - 1 cyclic; the second absent when i + 1 == n) */
+        size_t j = i ? i - 1 : n - 1, k = i + 1 < n ? i + 1 : 0;
+        __m128d pa = _mm_loadu_pd(&p[j].x), pb = _mm_loadu_pd(&p[i].x);
+        __m128d pc = _mm_loadu_pd(&p[k].x);
+        __m128d ax = _mm_unpacklo_pd(pa, pb), ay = _mm_unpackhi_pd(pa, pb);
+        __m128d bx = _mm_unpacklo_pd(pb, pc), by = _mm_unpackhi_pd(pb, pc);
+        __m128d near = _mm_and_pd(
+            _mm_and_pd(_mm_cmpge_pd(qx, _mm_sub_pd(_mm_min_pd(ax, bx), vt)),
+                       _mm_cmple_pd(qx, _mm_add_pd(_mm_max_pd(ax, bx), vt))),
+            _mm_and_pd(_mm_cmpge_pd(qy, _mm_sub_pd(_mm_min_pd(ay, by), vt)),
+                       _mm_cmple_pd(qy, _mm_add_pd(_mm_max_pd(ay, by), vt))));
+        __m128d strad = _mm_xor_pd(_mm_cmpgt_pd(ay, qy), _mm_cmpgt_pd(by, qy));
+        int mask = _mm_movemask_pd(_mm_or_pd(near, strad)) & (i + 1 < n ? 3 : 1);
+        for (int e = 0; e < 2; e++) {
+            if (!(mask >> e & 1)) continue;
+            gp_vec2 a = e ? p[i] : p[j], b = e ? p[k] : p[i];
+            /* point_class's body for edge a -> b */
+            if (q.x >= dmin(a.x, b.x) - tol && q.x <= dmax(a.x, b.x) + tol &&
+                q.y >= dmin(a.y, b.y) - tol && q.y <= dmax(a.y, b.y) + tol &&
+                seg_dist2(q.x, q.y, a.x, a.y, b.x, b.y) <= tol2)
+                return 0;
+            if ((a.y > q.y) != (b.y > q.y)) {
+                int o = orient(a, b, q);
+                if (o == 0) return 0;
+                if ((o > 0) == (b.y > a.y)) c ^= 1;
+            } else if (a.y == q.y && b.y == q.y) {
+                if ((a.x <= q.x && q.x <= b.x) || (b.x <= q.x && q.x <= a.x)) return 0;
+            } else if (veq(a, q)) {
+                return 0;
+            }
+        }
+    }
+    return c ? 1 : -1;
+#else
+    return point_class(p, n, q, tol);
+#endif
+}
+
 int gp_poly_contains(const gp_vec2 *p, size_t n, gp_vec2 q)
 {
     if (!p || n == 0 || !finite2(q)) return 0;
@@ -307,7 +370,7 @@ int gp_poly_contains(const gp_vec2 *p, size_t n, gp_vec2 q)
     if (q.x < x0 - tol || q.x > x1 + tol || q.y < y0 - tol || q.y > y1 + tol) return 0;
     /* a point exactly on a horizontal edge or on a vertex is within tol of that edge, so
      * point_class's exact boundary cases add nothing here */
-    return point_class(p, n, q, tol) >= 0;
+    return (n >= 2 ? contains_screened(p, n, q, tol) : point_class(p, n, q, tol)) >= 0;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -461,6 +524,28 @@ size_t gp_convex_hull(const gp_vec2 *p, size_t n, gp_vec2 *h)
     return k;
 }
 
+/* Graham's scan needs no sort here: a polygon star-shaped about an interior point lists its
+ * vertices by angle about that point already, and one stack pass from a strict hull vertex
+ * (the lowest-then-leftmost) in counter-clockwise order keeps exactly the strict left turns
+ * (Graham 1972; the "three coins" pass). */
+size_t gp_convex_hull_star(const gp_vec2 *p, size_t n, gp_vec2 *h)
+{
+    if (!p || !h || n == 0) return 0;
+    if (n < 3 || !all_finite(p, n)) return gp_convex_hull(p, n, h);
+    size_t s = 0;
+    for (size_t i = 1; i < n; i++)
+        if (p[i].y < p[s].y || (p[i].y == p[s].y && p[i].x < p[s].x)) s = i;
+    int ccw = gp_poly_signed_area(p, n) > 0.0;
+    size_t m = 0;
+    for (size_t k = 0; k < n; k++) {
+        gp_vec2 q = p[ccw ? (s + k) % n : (s + n - k) % n];
+        while (m >= 2 && orient(h[m - 2], h[m - 1], q) <= 0) m--;
+        h[m++] = q;
+    }
+    while (m >= 3 && orient(h[m - 2], h[m - 1], h[0]) <= 0) m--;
+    return m;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 /* minimum enclosing circle                                                                    */
 
@@ -574,6 +659,7 @@ static inline double clamp01(double t)
 typedef struct {
     double x, y, h, d, max;
     size_t e1; /* nearest edge of the centre: where the children start their scan */
+    size_t coff, clen; /* the edges that can be nearest in the cell (mic_src); clen 0: all */
 } mic_cell;
 
 /* The polygon relative to the reference vertex, stored twice over (2n edges) so that a scan of
@@ -659,6 +745,56 @@ static double mic_sdist(const mic_poly *P, double px, double py, size_t s, doubl
     for (int k = 0; k < MIC_K; k++) near[k] = mk[k] < INFINITY ? (ik[k] + s) % n : (size_t)-1;
     double d = sqrt(mk[0]);
     return inside ? d : -d;
+}
+
+/* mic_sdist over the edges of list L only, the sign given (it is known from the parent cell):
+ * the same distance formula, the same nearest-K list and early exit. */
+static double mic_sdist_list(const mic_poly *P, const size_t *L, size_t m, double px, double py,
+                             double sign, double thr2, size_t near[MIC_K])
+{
+    double mk[MIC_K];
+    size_t ik[MIC_K];
+    for (int k = 0; k < MIC_K; k++) {
+        mk[k] = INFINITY;
+        ik[k] = (size_t)-1;
+    }
+    for (size_t q = 0; q < m; q++) {
+        size_t i = L[q];
+        double wx = px - P->x[i], wy = py - P->y[i], ddx = P->dx[i], ddy = P->dy[i];
+        double t = clamp01((wx * ddx + wy * ddy) * P->il[i]);
+        double ex = wx - t * ddx, ey = wy - t * ddy, d2 = ex * ex + ey * ey;
+        if (d2 < mk[MIC_K - 1]) {
+            int j = MIC_K - 1;
+            for (; j > 0 && d2 < mk[j - 1]; j--) {
+                mk[j] = mk[j - 1];
+                ik[j] = ik[j - 1];
+            }
+            mk[j] = d2;
+            ik[j] = i;
+        }
+        if (mk[0] <= thr2) return -INFINITY;
+    }
+    for (int k = 0; k < MIC_K; k++) near[k] = ik[k];
+    return sign * sqrt(mk[0]);
+}
+
+/* Where a cell's children are evaluated from: the popped parent's centre (cx, cy), signed
+ * distance cd and the list L (len) of the edges that can be nearest anywhere in it. */
+typedef struct {
+    const size_t *L;
+    size_t len;
+    double cx, cy, cd;
+} mic_src;
+
+/* The signed distance at (x, y) inside src's cell (src NULL: a full scan from edge `start`).
+ * A point closer to the parent's centre than |cd| is on the same side of the boundary, so
+ * only the listed edges need a look; otherwise the full scan counts crossings. */
+static double mic_eval(const mic_poly *P, const mic_src *src, double x, double y, size_t start,
+                       double thr2, size_t near[MIC_K])
+{
+    if (src && fabs(src->cd) > hypot(x - src->cx, y - src->cy))
+        return mic_sdist_list(P, src->L, src->len, x, y, src->cd > 0.0 ? 1.0 : -1.0, thr2, near);
+    return mic_sdist(P, x, y, start, thr2, near);
 }
 
 /* distance from (px, py) to edge e (relative coordinates) */
@@ -791,6 +927,24 @@ static int heap_push(mic_heap *H, mic_cell c)
     return 0;
 }
 
+/* the candidate edge lists of the popped cells, appended (offsets stay valid as it grows) */
+typedef struct {
+    size_t *a;
+    size_t n, cap;
+} mic_arena;
+
+static int mic_arena_grow(mic_arena *A, size_t more)
+{
+    if (A->n + more <= A->cap) return 0;
+    size_t nc = A->cap ? 2 * A->cap : 1024;
+    while (nc < A->n + more) nc *= 2;
+    size_t *na = realloc(A->a, nc * sizeof *na);
+    if (!na) return -1;
+    A->a = na;
+    A->cap = nc;
+    return 0;
+}
+
 static mic_cell heap_pop(mic_heap *H)
 {
     mic_cell top = H->a[0], last = H->a[--H->n];
@@ -816,15 +970,16 @@ static size_t mic_start(const mic_poly *P, size_t e)
 /* Evaluates the cell centred at (x, y) with half-side h, updating *best with its centre and
  * with its LP probe point. Returns 1 when the cell must be kept (its bound exceeds best + tol);
  * 0 when it provably cannot hold a point better than best + tol. */
-static int mic_make(const mic_poly *P, double x, double y, double h, size_t start, double tol,
-                    mic_cell *best, mic_cell *c)
+static int mic_make(const mic_poly *P, const mic_src *src, double x, double y, double h,
+                    size_t start, double tol, mic_cell *best, mic_cell *c)
 {
     c->x = x;
     c->y = y;
     c->h = h;
     double thr = dmin(best->d, best->d + tol - h * MIC_SQRT2);
     size_t near[MIC_K];
-    c->d = mic_sdist(P, x, y, mic_start(P, start), thr > 0.0 ? thr * thr : -1.0, near);
+    c->coff = c->clen = 0;
+    c->d = mic_eval(P, src, x, y, mic_start(P, start), thr > 0.0 ? thr * thr : -1.0, near);
     if (c->d == -INFINITY) return 0;
     c->e1 = near[0];
     c->max = c->d + h * MIC_SQRT2;
@@ -841,7 +996,8 @@ static int mic_make(const mic_poly *P, double x, double y, double h, size_t star
         q.x = qx;
         q.y = qy;
         q.h = 0.0;
-        q.d = mic_sdist(P, qx, qy, mic_start(P, near[0]), thq > 0.0 ? thq * thq : -1.0, nq);
+        q.coff = q.clen = 0;
+        q.d = mic_eval(P, src, qx, qy, mic_start(P, near[0]), thq > 0.0 ? thq * thq : -1.0, nq);
         if (q.d > best->d) {
             q.e1 = nq[0];
             q.max = q.d;
@@ -879,9 +1035,8 @@ gp_status gp_max_inscribed_circle(const gp_vec2 *p, size_t n, double tol, gp_vec
         X[i] = X[i + n] = p[i].x - o.x;
         Y[i] = Y[i + n] = p[i].y - o.y;
     }
-    X[n2] = X[0];
-    Y[n2] = Y[0];
-    double x0 = X[0], x1 = X[0], y0 = Y[0], y1 = Y[0];
+    X[n2] = Y[n2] = 0.0; /* vertex 0 is the origin: X[0] = Y[0] = 0 exactly */
+    double x0 = 0.0, x1 = 0.0, y0 = 0.0, y1 = 0.0;
     for (size_t i = 0; i < n; i++) {
         DX[i] = DX[i + n] = X[i + 1] - X[i];
         DY[i] = DY[i + n] = Y[i + 1] - Y[i];
@@ -909,17 +1064,18 @@ gp_status gp_max_inscribed_circle(const gp_vec2 *p, size_t n, double tol, gp_vec
     best.d = -INFINITY;
     best.x = best.y = 0.0;
     best.e1 = 0;
-    mic_make(&P, 0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0, 0, tol, &best, &c);
+    mic_make(&P, NULL, 0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0, 0, tol, &best, &c);
     gp_vec2 cen;
     if (gp_poly_centroid(p, n, &cen, NULL) == GP_OK)
-        mic_make(&P, cen.x - o.x, cen.y - o.y, 0.0, best.e1, tol, &best, &c);
+        mic_make(&P, NULL, cen.x - o.x, cen.y - o.y, 0.0, best.e1, tol, &best, &c);
 
     gp_status st = GP_OK;
     mic_heap H = {NULL, 0, 0};
+    mic_arena A = {NULL, 0, 0};
     for (size_t ix = 0; ix < nx && st == GP_OK; ix++)
         for (size_t iy = 0; iy < ny && st == GP_OK; iy++)
-            if (mic_make(&P, x0 + ((double)ix + 0.5) * cell, y0 + ((double)iy + 0.5) * cell, hh,
-                         best.e1, tol, &best, &c) &&
+            if (mic_make(&P, NULL, x0 + ((double)ix + 0.5) * cell,
+                         y0 + ((double)iy + 0.5) * cell, hh, best.e1, tol, &best, &c) &&
                 heap_push(&H, c))
                 st = GP_ERR_NOMEM;
     size_t evals = 0;
@@ -927,15 +1083,33 @@ gp_status gp_max_inscribed_circle(const gp_vec2 *p, size_t n, double tol, gp_vec
     while (st == GP_OK && H.n > 0) {
         mic_cell pc = heap_pop(&H);
         if (pc.max - best.d <= tol) break; /* max-heap: no remaining cell can do better */
+        /* the edges that can be nearest to a point of the cell: within |d| + 2 h sqrt 2 of
+         * its centre (a point x of it has d(x) <= |d| + h sqrt 2, and an edge farther than
+         * that from the centre is farther than d(x) from x); the children look at only those */
+        size_t have = pc.clen ? pc.clen : n, off = A.n;
+        if (mic_arena_grow(&A, have) != 0) {
+            st = GP_ERR_NOMEM;
+            break;
+        }
+        double lim = fabs(pc.d) + 2.0 * pc.h * MIC_SQRT2;
+        for (size_t q = 0; q < have; q++) {
+            size_t e = pc.clen ? A.a[pc.coff + q] : q;
+            if (mic_edist(&P, e, pc.x, pc.y) <= lim) A.a[A.n++] = e;
+        }
+        mic_src src = {A.a + off, A.n - off, pc.x, pc.y, pc.d};
         double h2 = 0.5 * pc.h;
-        for (int k = 0; k < 4 && st == GP_OK; k++)
-            if (mic_make(&P, pc.x + ((k & 1) ? h2 : -h2), pc.y + ((k & 2) ? h2 : -h2), h2, pc.e1,
-                         tol, &best, &c) &&
-                heap_push(&H, c))
-                st = GP_ERR_NOMEM;
+        for (int k = 0; k < 4 && st == GP_OK; k++) {
+            if (!mic_make(&P, &src, pc.x + ((k & 1) ? h2 : -h2), pc.y + ((k & 2) ? h2 : -h2), h2,
+                          pc.e1, tol, &best, &c))
+                continue;
+            c.coff = off;
+            c.clen = A.n - off; /* >= 1: the nearest edge, at |d| <= lim, is listed */
+            if (heap_push(&H, c)) st = GP_ERR_NOMEM;
+        }
         if ((evals += 4) > max_evals) st = GP_ERR_NOT_CONVERGED;
     }
     free(H.a);
+    free(A.a);
     free(buf);
     center->x = o.x + best.x;
     center->y = o.y + best.y;

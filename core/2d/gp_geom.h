@@ -108,4 +108,12 @@ size_t gp_min_caliper_edge(const gp_vec2 *h, size_t m, double eps2, int squared)
  * the angle_rad of gp_min_caliper). */
 double gp_axis_angle(double ex, double ey);
 
+/* gp_convex_hull's hull (the same vertices, order and start) of a polygon star-shaped about an
+ * interior point (every ray from it meets the
+ * boundary once: a Fourier grain's points about its centre), either orientation, in O(n)
+ * with one stack pass and no sort; h needs capacity n. For other polygons the result is
+ * undefined (a polygon, but maybe not the hull); non-finite input falls back to
+ * gp_convex_hull. */
+size_t gp_convex_hull_star(const gp_vec2 *p, size_t n, gp_vec2 *h);
+
 #endif /* GP_GEOM_H */

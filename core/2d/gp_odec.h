@@ -27,7 +27,11 @@
  * <= (r_min - sqrt(r_min^2 - spacing r_min / 2)) R_eq (0.0067 R_eq with the defaults).
  * gp_odec_measure() measures what is achieved.
  *
- * Cost: O(m^2) for m nodes (m = n for a 128-point Fourier contour with default parameters).
+ * Cost: O(m^2) for m nodes (m ~ 1.1-2 n for a 128-point Fourier contour with default
+ * parameters), but lazily: step 3 takes the nodes from a queue of cheap upper bounds of their
+ * tangent radii (a subset of the nodes), and a node gets its exact radius only when it comes
+ * first uncovered -- 27 of ~180 per grain in bench_specimen2d's specimen; the discs are those
+ * of sorting every exact radius.
  * Thread safe: no state besides the arguments.
  */
 #ifndef GP_ODEC_H

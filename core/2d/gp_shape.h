@@ -94,8 +94,9 @@ gp_status gp_shape_describe_ex(const gp_vec2 *contour, size_t n, const gp_odec_p
 double gp_shape_regularity(double perimeter, double perimeter_convex, int *capped);
 
 /* Evaluates curve at np angles theta_i = 2 pi i / np into pts (counter-clockwise) by direct
- * summation (no FFT; O(np nmodes)). GP_ERR_NOT_STAR if some r_i <= 0; GP_ERR_INVALID for bad
- * arguments (np >= 3, r0 > 0, finite D and delta). */
+ * summation (no FFT; O(np nmodes), a quarter of it by the basis' symmetry when np % 4 == 0).
+ * GP_ERR_NOT_STAR if some r_i <= 0; GP_ERR_INVALID for bad arguments (np >= 3, r0 > 0,
+ * finite D and delta). */
 gp_status gp_shape_curve_points(const gp_shape_curve *curve, size_t np, gp_vec2 *pts,
                                 gp_error *err);
 

@@ -207,6 +207,44 @@ static void test_hull(void)
     CHECK(gp_convex_hull(withnan, 5, h) == 3);
 }
 
+/* gp_convex_hull_star against gp_convex_hull (the monotone chain with a sort, an independent
+ * algorithm): the same vertices in the same order on random star-shaped polygons (sorted
+ * angles, random radii; some with radii on a coarse grid or points on the edges of a square,
+ * so collinear runs occur; both orientations; some far from the origin), and the fallback. */
+static int hull_star_same(const gp_vec2 *p, size_t n, int reverse)
+{
+    gp_vec2 q[200], h1[200], h2[200];
+    for (size_t i = 0; i < n; i++) q[i] = reverse ? p[n - 1 - i] : p[i];
+    size_t m1 = gp_convex_hull(q, n, h1), m2 = gp_convex_hull_star(q, n, h2);
+    return m1 >= 3 && m1 == m2 && memcmp(h1, h2, m1 * sizeof *h1) == 0;
+}
+
+static void test_hull_star(void)
+{
+    uint64_t keep = rs; /* its own draws: the later tests see the stream they always saw */
+    int bad = 0, trials = 0;
+    gp_vec2 p[200];
+    for (int trial = 0; trial < 600; trial++) {
+        size_t n = 3 + (size_t)(urand() * 190);
+        double off = trial % 3 == 0 ? 1e6 : 0.0, th[200];
+        for (size_t i = 0; i < n; i++) th[i] = 2.0 * PI * ((double)i + 0.9 * urand()) / (double)n;
+        for (size_t i = 0; i < n; i++) {
+            double r = trial % 4 == 1 ? 1.0 + floor(urand() * 3) : 0.2 + urand();
+            if (trial % 4 == 2) { /* on the square's edges: many collinear */
+                double c = cos(th[i]), sn = sin(th[i]), k = fmax(fabs(c), fabs(sn));
+                r = 1.0 / k;
+            }
+            p[i] = (gp_vec2){off + r * cos(th[i]), off + r * sin(th[i])};
+        }
+        bad += !hull_star_same(p, n, trial & 1);
+        trials++;
+    }
+    CHECK(trials == 600 && bad == 0);
+    gp_vec2 nan[5] = {{0, 0}, {2, 0}, {NAN, 1}, {2, 2}, {0, 2}}, h[5];
+    CHECK(gp_convex_hull_star(nan, 5, h) == 4 && h[0].x == 0 && h[0].y == 0 && h[2].x == 2);
+    rs = keep;
+}
+
 /* brute-force smallest enclosing circle: the smallest among all pair/triple circles that
  * contain every point */
 static double brute_mec(const gp_vec2 *p, size_t n)
@@ -675,6 +713,30 @@ static void test_contains(void)
         if (!gp_poly_contains(st, 100, st[i]) || !gp_poly_contains(st, 100, m)) bad++;
     }
     CHECK(bad == 0);
+    /* an odd vertex count (the screen takes edges two at a time), a triangle, a notch at the
+     * last edge: random points, vertices and midpoints */
+    gp_vec2 odd[99], tri[3] = {{0, 0}, {1, 0}, {0.3, 0.8}};
+    for (size_t i = 0; i < 99; i++) {
+        double t = 2 * PI * (double)i / 99.0, rr = i == 98 ? 0.3 : 1.0 + 0.4 * sin(7 * t);
+        odd[i] = (gp_vec2){rr * cos(t), rr * sin(t)};
+    }
+    int checked = 0;
+    uint64_t keep = rs; /* its own draws (as test_hull_star) */
+    for (int k = 0; k < 20000; k++) {
+        gp_vec2 q = {urand() * 3.2 - 1.6, urand() * 3.2 - 1.6}, r = {urand(), urand()};
+        if (gp_poly_boundary_distance(odd, 99, q) >= 1e-9) {
+            bad += gp_poly_contains(odd, 99, q) != naive_contains(odd, 99, q);
+            checked++;
+        }
+        if (gp_poly_boundary_distance(tri, 3, r) >= 1e-9)
+            bad += gp_poly_contains(tri, 3, r) != naive_contains(tri, 3, r);
+    }
+    for (size_t i = 0; i < 99; i++) {
+        gp_vec2 m = {0.5 * (odd[i].x + odd[(i + 1) % 99].x), 0.5 * (odd[i].y + odd[(i + 1) % 99].y)};
+        bad += !gp_poly_contains(odd, 99, odd[i]) + !gp_poly_contains(odd, 99, m);
+    }
+    CHECK(bad == 0 && checked > 15000);
+    rs = keep;
     CHECK_NEAR(gp_segment_distance((gp_vec2){0, 1}, (gp_vec2){-1, 0}, (gp_vec2){1, 0}), 1.0, 0);
     CHECK_NEAR(gp_segment_distance((gp_vec2){3, 4}, (gp_vec2){-1, 0}, (gp_vec2){0, 0}), 5.0, 1e-15);
     CHECK_NEAR(gp_segment_distance((gp_vec2){3, 4}, (gp_vec2){0, 0}, (gp_vec2){0, 0}), 5.0, 1e-15);
@@ -814,6 +876,7 @@ int main(void)
     test_area_perimeter_centroid();
     test_orient();
     test_hull();
+    test_hull_star();
     test_mec();
     test_mic();
     test_caliper();
