@@ -10,7 +10,9 @@
  * stops) and the ratio of the 100k rate to the 1k rate: the rate is timed between the first
  * progress report (step 4096) and the end, so that neither the initial tessellation nor the
  * O(N) set-up of the objective counts; the error reached is printed beside it.
- * Usage: bench_imc [max_steps] [speed_steps]   (max_steps 0 skips the fidelity table) */
+ * Usage: bench_imc [max_steps] [speed_steps] [N]   (max_steps 0 skips the fidelity table; N: only
+ * that rate row -- for callgrind: the instructions per step are the difference of two runs of
+ * different speed_steps over their difference, the set-up cancelling out) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -139,10 +141,15 @@ int main(int argc, char **argv)
 {
     long max_steps = argc > 1 ? atol(argv[1]) : 1000000;
     long speed_steps = argc > 2 ? atol(argv[2]) : 100000;
+    size_t only_n = argc > 3 ? (size_t)atol(argv[3]) : 0;
     shape square = {"square", SQ, 4, NULL, NULL, 0};
     const gp_vec2 *holes[1] = {HOLE};
     size_t nh[1] = {4};
     shape lshape = {"L with hole", LSH, 6, holes, nh, 1};
+    if (only_n > 0) {
+        speed(only_n, speed_steps);
+        return 0;
+    }
     if (max_steps == 0) goto rates;
     printf("KS/crit: the cells' KS distance over its 5 %% critical value (<= 1 passes); COV err: achieved vs target\n\n");
     printf("| container    |     N |  COV |    a | obj | stop        |    steps | seconds |   steps/s |  error | KS/crit | COV err  | orient KS/crit |\n");

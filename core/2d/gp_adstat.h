@@ -5,14 +5,31 @@
  *     A^2 = -N - (1/N) sum_i (2i - 1) [ln u_(i) + ln(1 - u_(N+1-i))]
  *         = -N - (1/N) [ 2 R - G + (2N + 1) H ],
  * with g = ln u, h = ln(1 - u), w = g - h, G = sum g, H = sum h and R = sum_i i w_(i) (i the
- * rank). R is linear in the ranks, so it composes over a binary search tree: a subtree with
- * count c, sum of w  W and rank-weighted sum R (ranks local to the subtree) joins its left
- * part L, its root x and its right part Q as
- *     R = R_L + (c_L + 1) w_x + R_Q + (c_L + 1) W_Q.
- * The tree is a treap keyed by (u, id) -- ties broken by the element's id -- whose priorities
- * are a fixed hash of the id, so its shape, and hence every floating-point sum in it, is a
- * function of the set of (id, key, g, h) alone: setting an element back to an earlier value restores
- * A^2 bit for bit (the IMC's rollback), and no sum drifts however long the run.
+ * rank). Inserting w at rank r adds r w to R plus the w-sum of the elements above it (each
+ * moves up one rank); removing subtracts the same. So R, G and H are running totals, and all
+ * the structure has to answer is "how many elements lie below (key, id), and what is the w-sum
+ * of those above": an order-statistic query.
+ *
+ * Exactness. g and h are taken in fixed point (integer multiples of 2^-46, ~1.4e-14, clamped
+ * to [-65535, 65535], NaN to the lower end) and every sum is a 128-bit integer. Integer sums
+ * do not depend on the order they were formed in: A^2, the what-if below and every internal
+ * sum are functions of the set of (id, key, g, h) alone, whatever the history -- setting an
+ * element back restores A^2 bit for bit (the IMC's rollback), nothing drifts however long the
+ * run, and the what-if equals the A^2 after the change bit for bit. A^2 is then rounded once:
+ * it is the exact statistic of the rounded logs, within N * 1.4e-14 of that of the given ones.
+ * The clamp is a tail far beyond any cell that matters (ln F = -65535); such an element
+ * counts as at the limit. Ties of key are broken by the element's id, which is harmless only
+ * where tied keys have equal g and h.
+ *
+ * Structure (gp_adstat.c): the elements in (key, id) order in blocks of at most 64 (keys, ids,
+ * fixed w's, and chunk prefix sums of the w's), a directory of the blocks' first keys, and a
+ * Fenwick tree of the blocks' counts and w-sums: a query is two short binary searches in
+ * contiguous arrays and a Fenwick prefix -- a few cache lines, where a pointer tree walks
+ * ~log2 N nodes spread over the heap. Blocks split when full and merge with a neighbour when
+ * the two hold <= 40, so there are at most 2N / 41 + 1 of them; the pool for that is
+ * allocated at create (calloc: untouched pages cost nothing) and nothing is allocated after.
+ * The sum of extras is kept in a segment tree of fixed shape over ids (a function of the set
+ * as well, in floating point).
  *
  * The caller passes g and h with u, computed where they are accurate (ln F and ln(1 - F) from
  * the law, gp_law_log_cdf_sf), so that values deep in a tail keep their weight.
@@ -21,6 +38,8 @@
  * point of A^2 in each u_(i)).
  *
  * Ownership: one object per statistic; not thread-safe (one writer). No global state.
+ * Memory: about 90 bytes per element of capacity (per-id record 32, extras' tree 16-32, blocks
+ * ~30 at their usual fill; the treap before took 136).
  */
 #ifndef GP_ADSTAT_H
 #define GP_ADSTAT_H
@@ -31,7 +50,8 @@
 
 typedef struct gp_adstat gp_adstat;
 
-/* Room for elements with ids 0..capacity-1, none present. */
+/* Room for elements with ids 0..capacity-1, none present; capacity <= 2^29 (GP_ERR_INVALID
+ * above: the 128-bit sums are sized for it). */
 gp_adstat *gp_adstat_create(size_t capacity, gp_error *err);
 void gp_adstat_destroy(gp_adstat *s);
 
@@ -56,15 +76,21 @@ double gp_adstat_sum_extra(const gp_adstat *s);
 
 /* What A^2 and the sum of extras would be if the k distinct present elements ids[] took the
  * keys, logs and extras given -- without changing the set. O(k log n + k^2): each element's
- * count below and w-sum above are read from the tree as it is, and the pairs among the k old
- * and the k new values are corrected directly. Equals gp_adstat_a2 after the change up to
- * rounding (the sums are formed in another order). This is how a move is judged before it is
- * made: most moves are refused, and refusing one then costs no change to the tree.
- * k <= GP_ADSTAT_IF_MAX, else NAN. */
+ * count below and w-sum above are read from the structure as it is, and the pairs among the k
+ * old and the k new values are corrected directly. A^2 equals gp_adstat_a2 after the change bit
+ * for bit (the same integers); the sum of extras up to rounding (another order). This is how a
+ * move is judged before it is made: most moves are refused, and refusing one then costs no
+ * change to the structure. k <= GP_ADSTAT_IF_MAX and every id present, else NAN. */
 #define GP_ADSTAT_IF_MAX 64
 double gp_adstat_a2_if(const gp_adstat *s, size_t k, const size_t *ids, const double *key,
                        const double *g, const double *h, const double *extra,
                        double *sum_extra);
+
+/* Recomputes every count and sum from the elements (exactly: they are integers) and checks the
+ * structure's invariants (order, block sizes and balance, directory, chunk sums, Fenwick tree,
+ * the extras' tree). 0 when all hold, else the number of the first failed check. O(n + capacity);
+ * for tests. */
+int gp_adstat_check(const gp_adstat *s);
 
 /* The least A^2 that n values can have. */
 double gp_adstat_floor(size_t n);

@@ -2,21 +2,25 @@
  *
  * Hot path per step: one gp_voronoi_try_move (about 9 cells recomputed from the neighbour
  * lists), then for each changed cell: its histogram classes (O(log k) + O(1), integer counts,
- * kept for every kind because the report shows them), and for AD its two order-statistic trees
- * (O(log N) each, gp_adstat.h). Both are exact functions of the cells, so a rollback restores
- * the error bit for bit and nothing drifts. No allocation per step.
+ * kept for every kind because the report shows them), and for AD its two order statistics
+ * (O(log N) each, gp_adstat.h, exact integer sums). Both are exact functions of the cells, so
+ * a rollback restores the error bit for bit and nothing drifts. No allocation per step.
  *
  * Profile (callgrind, bench_imc's speed case: unit square, COV 0.8, seed 1; instructions per
- * step over the first 10,000 steps of a run, of which 11 % are accepted at N = 1,000 and 42 %
- * at N = 100,000):                   N = 1,000             N = 100,000
- *     grid candidates (before)       139k (voronoi 109k)   169k (voronoi 103k)
- *     neighbour lists (now)           72k (voronoi  42k)   107k (voronoi  42k)
- * Now at N = 1,000: the tessellation 42k (clipping and the moved seed's search ~23k, making the
- * cells canonical with their areas and orientations ~19k), the AD trees' what-if
- * (gp_adstat_a2_if) 17k, the cells' CDF values and logs 7.5k, committing accepted moves to the
- * trees (gp_adstat_set) 4k. The tessellation's share is flat in N; what grows is the trees':
- * what-if 27k and commits 29k at N = 100,000 (O(log N) walks of a 100k-node treap, which also
- * miss the cache: perf puts 45 % of the time at N = 100,000 in the what-if's rank queries).
+ * step over the first 10,000 steps of a run -- `bench_imc 0 S N` for S = 0 and 10,000 --, of
+ * which 11 % are accepted at N = 1,000 and 42 % at N = 100,000):
+ *                                          N = 1,000            N = 100,000
+ *     grid candidates                      139k (voronoi 109k)  169k (voronoi 103k)
+ *     neighbour lists, AD on a treap        72k (voronoi  42k)  107k (voronoi  42k)
+ *     AD on sorted blocks (now)             68k (voronoi  42k)   82k (voronoi  41k)
+ * Now, N = 1,000 / 100,000: the tessellation 42k / 41k (clipping and the moved seed's search
+ * ~23k, canonical cells with their areas and orientations ~18k), the what-if of the two
+ * statistics (gp_adstat_a2_if) 15k / 18k (treap: 17k / 27k), the cells' CDF values and logs
+ * 7.4k, committing accepted moves (gp_adstat_set) 1.9k / 12.6k (treap: 3.6k / 29k; 2 x 9
+ * cells an accepted step, ~1,600 instructions each at N = 100,000). What still grows with N is
+ * the commits, by the acceptance rate as much as by N, and the cache misses: the treap's
+ * pointer walks (perf: 45 % of the time at N = 100,000 in its rank queries) are now binary
+ * searches in contiguous blocks of 64.
  */
 #include "gp_imc.h"
 
@@ -25,7 +29,6 @@
 #include <string.h>
 
 #include "gp_adstat.h"
-#include "gp_alloc.h"
 #include "gp_clock.h"
 #include "gp_rng.h"
 
@@ -195,7 +198,7 @@ double gp_imc_reachable_threshold(const gp_imc_params *p, size_t n)
 }
 
 /* ------------------------------------------------------------------------------------------ */
-/* the state of a run: classes (all kinds) and the AD trees                                   */
+/* the state of a run: classes (all kinds) and the AD statistics                              */
 
 typedef struct imc_state {
     int kind;
@@ -212,9 +215,12 @@ typedef struct imc_state {
     int *cs, *ct;
     unsigned char *clss, *clst;
     double tscale;             /* classes per radian */
-    /* AD: one tree per law, and per cell its current key and logs */
+    /* AD: one statistic per law, and per cell its current keys and logs (together: a cell's
+     * are one cache line, not six) */
     gp_adstat *ads, *adt;
-    double *sk, *sg, *sh, *tk, *tg, *th;
+    struct ad_val {
+        double sk, sg, sh, tk, tg, th;
+    } *adv;
 } imc_state;
 
 static void state_free(imc_state *S)
@@ -229,12 +235,7 @@ static void state_free(imc_state *S)
     free(S->clst);
     gp_adstat_destroy(S->ads);
     gp_adstat_destroy(S->adt);
-    free(S->sk);
-    free(S->sg);
-    free(S->sh);
-    free(S->tk);
-    free(S->tg);
-    free(S->th);
+    free(S->adv);
 }
 
 static inline int size_class(const imc_state *s, double a)
@@ -280,7 +281,7 @@ static void cell_eval(const imc_state *S, const gp_voronoi *v, size_t i, cell_va
     c->th = log1p(-u);
 }
 
-/* Makes cell i's recorded contribution c (histogram counts, AD trees, per-cell arrays). */
+/* Makes cell i's recorded contribution c (histogram counts, AD statistics, per-cell arrays). */
 static void cell_put(imc_state *S, size_t i, const cell_val *c)
 {
     S->cs[S->clss[i]]--;
@@ -292,12 +293,7 @@ static void cell_put(imc_state *S, size_t i, const cell_val *c)
     if (S->kind != GP_IMC_ERROR_AD) return;
     gp_adstat_set(S->ads, i, c->sk, c->sg, c->sh, c->sk * c->sk);
     gp_adstat_set(S->adt, i, c->tk, c->tg, c->th, 0.0);
-    S->sk[i] = c->sk;
-    S->sg[i] = c->sg;
-    S->sh[i] = c->sh;
-    S->tk[i] = c->tk;
-    S->tg[i] = c->tg;
-    S->th[i] = c->th;
+    S->adv[i] = (struct ad_val){c->sk, c->sg, c->sh, c->tk, c->tg, c->th};
 }
 
 /* cell i's recorded contribution */
@@ -306,12 +302,13 @@ static void cell_get(const imc_state *S, size_t i, cell_val *c)
     c->cs = S->clss[i];
     c->ct = S->clst[i];
     if (S->kind != GP_IMC_ERROR_AD) return;
-    c->sk = S->sk[i];
-    c->sg = S->sg[i];
-    c->sh = S->sh[i];
-    c->tk = S->tk[i];
-    c->tg = S->tg[i];
-    c->th = S->th[i];
+    const struct ad_val *a = &S->adv[i];
+    c->sk = a->sk;
+    c->sg = a->sg;
+    c->sh = a->sh;
+    c->tk = a->tk;
+    c->tg = a->tg;
+    c->th = a->th;
 }
 
 static void hist_errors(const imc_state *s, int kind, double *es, double *et)
@@ -392,7 +389,7 @@ static int not_worse(const objective *n, const objective *o)
     return n->descent < o->descent || (n->descent == o->descent && n->tie <= o->tie);
 }
 
-/* Classes, targets and the AD trees for the tessellation v; returns the E1-E3 floor. */
+/* Classes, targets and the AD statistics for the tessellation v; returns the E1-E3 floor. */
 static int cancel_raised(const volatile int *cancel);
 
 static gp_status state_init(imc_state *S, const gp_imc_params *p, const gp_law *law,
@@ -419,9 +416,8 @@ static gp_status state_init(imc_state *S, const gp_imc_params *p, const gp_law *
     if (ok && S->kind == GP_IMC_ERROR_AD) {
         S->ads = gp_adstat_create(n, err);
         S->adt = gp_adstat_create(n, err);
-        double **const scratch[] = {&S->sk, &S->sg, &S->sh, &S->tk, &S->tg, &S->th};
-        int scratch_ok = gp_alloc_doubles(n, scratch, 6, NULL) == GP_OK;
-        ok = S->ads && S->adt && scratch_ok;
+        S->adv = malloc(n * sizeof *S->adv);
+        ok = S->ads && S->adt && S->adv;
         S->ad_floor = gp_adstat_floor(n);
         S->mu = gp_law_mean(law);
         S->cov_q = quantile_cov(law, n, S->mu);
@@ -437,7 +433,7 @@ static gp_status state_init(imc_state *S, const gp_imc_params *p, const gp_law *
     S->tscale = S->kt / GP_IMC_PI;
     S->cs[0] = S->ct[0] = (int)n; /* every cell starts in class 0; cell_put moves it */
     for (size_t i = 0; i < n; i++) {
-        /* about 9 us a cell at 10^6 (the AD trees): seconds in all, so poll the flag */
+        /* about 9 us a cell at 10^6 (the AD statistics): seconds in all, so poll the flag */
         if ((i + 1) % 4096 == 0 && cancel_raised(cancel))
             return gp_error_set(err, GP_ERR_CANCELLED, "imc: cancelled while evaluating the cells");
         cell_val c;
@@ -631,7 +627,7 @@ static int propose_ad(const gp_voronoi *v, gp_rng *rng, size_t n, step_buf *b, c
 }
 
 /* The objective the run would have with the changed cells' new contributions nv[], judged
- * without changing the AD trees (gp_adstat_a2_if). */
+ * without changing the AD statistics (gp_adstat_a2_if). */
 static objective evaluate_ad_if(const imc_state *S, const uint32_t *ch, size_t nch, const cell_val *nv,
                                 step_buf *b)
 {
@@ -668,11 +664,12 @@ static int try_step(imc_state *S, gp_voronoi *v, step_buf *b, size_t i, gp_vec2 
             return -1;
         }
     }
+    /* AD judges the move before changing anything: no undo to keep */
+    int judged = S->kind == GP_IMC_ERROR_AD && nch <= GP_ADSTAT_IF_MAX;
     for (size_t k = 0; k < nch; k++) {
-        cell_get(S, ch[k], &b->undo[k]);
+        if (!judged) cell_get(S, ch[k], &b->undo[k]);
         cell_eval(S, v, ch[k], &b->nv[k]);
     }
-    int judged = S->kind == GP_IMC_ERROR_AD && nch <= GP_ADSTAT_IF_MAX;
     objective nw;
     if (judged) {
         nw = evaluate_ad_if(S, ch, nch, b->nv, b);
@@ -683,7 +680,7 @@ static int try_step(imc_state *S, gp_voronoi *v, step_buf *b, size_t i, gp_vec2 
     if (not_worse(&nw, cur)) {
         for (size_t k = 0; judged && k < nch; k++) cell_put(S, ch[k], &b->nv[k]);
         gp_voronoi_commit(v);
-        *cur = judged ? evaluate(S) : nw; /* the exact value of the trees as they now are */
+        *cur = judged ? evaluate(S) : nw; /* the what-if rounds the extras sum */
         return 1;
     }
     for (size_t k = nch; !judged && k-- > 0;) cell_put(S, ch[k], &b->undo[k]);

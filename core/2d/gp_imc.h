@@ -30,8 +30,9 @@
  * (-3.5 % is the COV of the best sample of 500 from the COV 1.2 law.) A plain A^2 at 0.02
  * left COV 1.2 at N = 500 6-11 % low, hence the COV term; the paper's moves alone needed 77k
  * steps where the mixed moves below need 8k (COV 0.2, N = 500).
- * Incremental: A^2 is linear in the ranks, so it is kept exactly by an order-statistic tree
- * (gp_adstat.h) in O(log N) per changed cell; a rolled-back move restores it bit for bit.
+ * Incremental: A^2 is linear in the ranks, so it is kept exactly (integer sums of fixed-point
+ * logs) by an order-statistic structure (gp_adstat.h) in O(log N) per changed cell; a
+ * rolled-back move restores it bit for bit, and a move is judged by the exact A^2 it would give.
  *
  * The paper's histogram errors stay selectable (error_kind 1-3), with h and H the achieved and
  * target normalised histograms:

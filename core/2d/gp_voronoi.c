@@ -1828,10 +1828,11 @@ static gp_status build_grid(gp_voronoi *v, const volatile int *cancel)
 static int dup_check(const gp_voronoi *v, gp_vec2 p, uint32_t self, uint32_t *other)
 {
     const double t = 1e-12 * v->L;
-    int32_t bx = bin_x(v, p.x), by = bin_y(v, p.y);
-    for (int32_t yy = by - 1; yy <= by + 1; yy++)
-        for (int32_t xx = bx - 1; xx <= bx + 1; xx++) {
-            if (xx < 0 || yy < 0 || xx >= v->nbx || yy >= v->nby) continue;
+    /* only the bins the box p +- t reaches (bin_x is monotone): one bin but at a bin's edge,
+     * where the 3 x 3 around p read ~18 seeds scattered in memory */
+    int32_t x0 = bin_x(v, p.x - t), x1 = bin_x(v, p.x + t), y0 = bin_y(v, p.y - t), y1 = bin_y(v, p.y + t);
+    for (int32_t yy = y0; yy <= y1; yy++)
+        for (int32_t xx = x0; xx <= x1; xx++) {
             vbin *b = &v->bins[yy * v->nbx + xx];
             const int32_t *it = bin_items(b);
             for (int32_t q = 0; q < b->cnt; q++) {

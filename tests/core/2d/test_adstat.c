@@ -1,6 +1,8 @@
 /* test_adstat.c -- the incremental Anderson-Darling statistic (gp_adstat.h) against a
- * brute-force A^2 recomputed from the sorted values after every kind of change, bit-exact
- * restores, history independence, the floor and ties. */
+ * brute-force A^2 recomputed from the sorted values after every kind of change, the structure's
+ * own recount (gp_adstat_check) through splits and merges of its blocks, bit-exact restores,
+ * history independence, the what-if equal bit for bit to the change, clamping, the floor and
+ * ties. */
 #include "gp_adstat.h"
 #include "gp_test.h"
 
@@ -64,6 +66,7 @@ static void check_against(const gp_adstat *s, const mirror *m)
             sx += m->x[i];
         }
     CHECK(gp_adstat_count(s) == n);
+    CHECK(gp_adstat_check(s) == 0);
     double a2 = gp_adstat_a2(s), b = a2_brute(u, n);
     /* relative to A^2, or to the size of the sum it is cancelled from when A^2 is small */
     CHECK_NEAR(a2, b, 1e-9 * fabs(b) + 1e-12 * (double)n);
@@ -116,7 +119,7 @@ static void test_random_sets(void)
     /* by hand: one value u has A^2 = -1 - ln u - ln(1 - u) */
     gp_adstat *s = gp_adstat_create(5, NULL);
     gp_adstat_set(s, 3, 0.2, log(0.2), log(0.8), 7.0);
-    CHECK_NEAR(gp_adstat_a2(s), -1 - log(0.2) - log(0.8), 1e-15);
+    CHECK_NEAR(gp_adstat_a2(s), -1 - log(0.2) - log(0.8), 3e-14); /* g, h in units of 2^-46 */
     CHECK(gp_adstat_sum_extra(s) == 7.0);
     gp_adstat_destroy(s);
 }
@@ -298,7 +301,8 @@ static void test_a2_if(void)
         CHECK(gp_adstat_a2(s) == before);
         for (size_t i = 0; i < k; i++) put(s, &m, ids[i], key[i], x[i]);
         double after = gp_adstat_a2(s);
-        CHECK_NEAR(judged, after, 1e-9 * fabs(after) + 1e-10);
+        /* both are the same exact integer rounded once */
+        CHECK(same_bits(judged, after));
         CHECK_NEAR(sx, gp_adstat_sum_extra(s), 1e-9);
         check_against(s, &m);
     }
@@ -309,10 +313,97 @@ static void test_a2_if(void)
     gp_adstat_destroy(s);
 }
 
+/* Block splits and merges: sorted runs in both directions (every insert into the same block),
+ * thinning out every other element and whole runs (merges), small moves that stay in their
+ * block and jumps that leave it; the structure recounts itself (gp_adstat_check) and A^2 is
+ * checked against the brute force along the way, down to empty and up again. */
+static void test_structure(void)
+{
+    const size_t n = 3000;
+    mirror m = {n, calloc(n, sizeof(double)), calloc(n, sizeof(double)), calloc(n, sizeof(int))};
+    gp_adstat *s = gp_adstat_create(n, NULL);
+    int ok = 1;
+    for (int round = 0; round < 2; round++) {
+        for (size_t i = 0; i < n / 2; i++) { /* ascending, then descending keys */
+            size_t id = round ? n / 2 - 1 - i : i;
+            put(s, &m, id, (0.5 + (double)i) / (double)n, 1.0);
+            if (i % 101 == 0) ok &= gp_adstat_check(s) == 0;
+        }
+        for (size_t i = n / 2; i < n; i++) put(s, &m, i, 1.0 - (0.5 + (double)(i - n / 2)) / (double)n, 2.0);
+        check_against(s, &m);
+        for (size_t id = 0; id < n; id += 2) { /* every other: blocks thin out and merge */
+            gp_adstat_remove(s, id);
+            m.on[id] = 0;
+            if (id % 202 == 0) ok &= gp_adstat_check(s) == 0;
+        }
+        check_against(s, &m);
+        for (size_t t = 0; t < 4000; t++) { /* small moves (mostly in the block) and jumps */
+            size_t id = below(n);
+            double u = m.on[id] && t % 4 ? m.u[id] + 1e-4 * (unif() - 0.5) : unif();
+            put(s, &m, id, fmin(fmax(u, 1e-6), 1 - 1e-6), unif());
+            if (t % 97 == 0) check_against(s, &m);
+        }
+        for (size_t id = 0; id < n; id++) /* a run of ids, then the rest, down to empty */
+            if (id < n / 3 || id % 3 == 0) {
+                gp_adstat_remove(s, id);
+                m.on[id] = 0;
+            }
+        check_against(s, &m);
+        for (size_t id = 0; id < n; id++) {
+            gp_adstat_remove(s, id);
+            m.on[id] = 0;
+            if (id % 307 == 0) ok &= gp_adstat_check(s) == 0;
+        }
+        check_against(s, &m);
+        CHECK(gp_adstat_count(s) == 0 && gp_adstat_a2(s) == 0.0);
+    }
+    CHECK(ok);
+    gp_adstat_destroy(s);
+    free(m.u);
+    free(m.x);
+    free(m.on);
+}
+
+/* g and h are taken to multiples of 2^-46 and clamped to [-65535, 65535] (NaN to the lower
+ * end): a value deeper in a tail than that counts as at the limit, and A^2 stays finite */
+static void test_clamp(void)
+{
+    gp_adstat *s = gp_adstat_create(3, NULL), *t = gp_adstat_create(3, NULL);
+    gp_adstat_set(s, 0, 0.5, log(0.5), log(0.5), 0);
+    gp_adstat_set(t, 0, 0.5, log(0.5), log(0.5), 0);
+    gp_adstat_set(s, 1, 1e-300, -1e6, -1e-300, 0);
+    gp_adstat_set(t, 1, 1e-300, -65535.0, 0.0, 0);
+    CHECK(same_bits(gp_adstat_a2(s), gp_adstat_a2(t)));
+    /* two values: u_(1) = tiny (g = -65535, h = 0) and 0.5: A^2 = -2 - (1/2)[(g_1 + h_2) + 3 (g_2 + h_1)] */
+    CHECK_NEAR(gp_adstat_a2(s), -2 - 0.5 * ((-65535.0 + log(0.5)) + 3 * (log(0.5) + 0.0)), 1e-9);
+    gp_adstat_set(s, 2, 0.9, NAN, log(0.1), 0);
+    gp_adstat_set(t, 2, 0.9, -65535.0, log(0.1), 0);
+    CHECK(same_bits(gp_adstat_a2(s), gp_adstat_a2(t)) && isfinite(gp_adstat_a2(s)));
+    CHECK(gp_adstat_check(s) == 0 && gp_adstat_check(t) == 0);
+    /* a change below the resolution 2^-46 leaves A^2 as it was; one above it does not (g on
+     * the grid, so that the small change cannot round across a half) */
+    gp_adstat *r = gp_adstat_create(1, NULL);
+    gp_adstat_set(r, 0, 0.5, -0.75, -0.5, 0);
+    double a2 = gp_adstat_a2(r);
+    CHECK(a2 == -1 + 0.75 + 0.5);
+    gp_adstat_set(r, 0, 0.5, -0.75 + 0x1p-49, -0.5, 0);
+    CHECK(same_bits(gp_adstat_a2(r), a2));
+    gp_adstat_set(r, 0, 0.5, -0.75 + 0x1p-44, -0.5, 0);
+    CHECK(gp_adstat_a2(r) == a2 - 0x1p-44);
+    gp_adstat_destroy(r);
+    /* the 128-bit sums are sized for 2^29 elements: more is refused */
+    gp_error e;
+    CHECK(gp_adstat_create(((size_t)1 << 29) + 1, &e) == NULL && e.code == GP_ERR_INVALID);
+    gp_adstat_destroy(s);
+    gp_adstat_destroy(t);
+}
+
 int main(void)
 {
     test_a2_if();
     test_random_sets();
+    test_structure();
+    test_clamp();
     test_bit_exact();
     test_floor();
     test_ties();
