@@ -10,7 +10,9 @@ Starts grainpackd (one worker, a temporary database) and runs, one job at a time
               outputs grains, odec, descriptors)
   10k         10,000 grains (size COV 0.5; outputs grains, odec, descriptors)
   100k        100,000 grains (outputs odec)
-  mz12-after  Example 1 again, submitted the moment the job above (100k) has succeeded
+  mz12-after  Example 1 again, submitted once the job above (100k) has succeeded and a second
+              later its result was fetched (as every row's: the table's result columns) -- the
+              daemon's checkpoint of that job's commit is then due or running
   1M          (with --million) 1,000,000 grains (outputs odec)
 and prints one table, a row a job:
   s        seconds from submit to status succeeded, as a client sees it;
@@ -19,6 +21,9 @@ and prints one table, a row a job:
            phase (writing the text, the export pack, storing); HWM: VmHWM so far;
   idle MB  VmRSS once the job is stored (the freed heap handed back or not);
   result   MB of GET /result (10^6 bytes, streamed and counted, not kept) and bytes a grain;
+  sha256   the first 12 hex digits of the SHA-256 of GET /result with the value of its "timings"
+           member (seconds, the one part that varies run to run) written as null: the same spec
+           and seed give the same bytes whatever build or store wrote them (compare two runs);
   error    what the specimen achieved, from GET /summary: solid fraction target -> achieved,
            the IMC error over its threshold, and the fit report's KS distances over their 5 %
            critical values for cell areas, grain areas and cell orientations (<= 1 passes).
@@ -26,6 +31,7 @@ A job the daemon refuses or fails shows its error instead. Linux only (/proc); P
 library only (bench_export.py's helpers).
 """
 import argparse
+import hashlib
 import os
 import shutil
 import sys
@@ -35,7 +41,7 @@ import time
 import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_export import call, download, start, stop  # noqa: E402
+from bench_export import call, start, stop  # noqa: E402
 
 SQUARE = {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "holes": []}
 MZ12 = {"kind": "fourier-voronoi-2d", "seed": 2012, "container": SQUARE, "particles": 500,
@@ -93,9 +99,41 @@ def run_job(base, pid, spec):
     return out
 
 
+TIMINGS = b'"timings":{'
+
+
+def download_sha(url):
+    """GET url in 1 MB pieces, counted and hashed, not kept: (status, bytes, sha256 hex of the
+    text with the "timings" object -- flat, near the head -- replaced by null)."""
+    n, h = 0, hashlib.sha256()
+    head = b""  # the text until the timings object has been passed (a few KB)
+    with urllib.request.urlopen(url, timeout=600) as r:
+        status = r.status
+        while True:
+            b = r.read(1 << 20)
+            if not b:
+                break
+            n += len(b)
+            if head is None:
+                h.update(b)
+                continue
+            head += b
+            i = head.find(TIMINGS)
+            j = head.find(b"}", i) if i >= 0 else -1
+            if j >= 0:
+                h.update(head[:i] + b'"timings":null' + head[j + 1:])
+                head = None
+            elif len(head) > (16 << 20):  # no timings: the text as it is
+                h.update(head)
+                head = None
+    if head:
+        h.update(head)
+    return status, n, h.hexdigest()
+
+
 def describe(base, jid, n):
-    """Result size and the error columns, from /result (counted) and /summary."""
-    st, nbytes = download(base + "/v1/jobs/%s/result" % jid)
+    """Result size and hash and the error columns, from /result and /summary."""
+    st, nbytes, sha = download_sha(base + "/v1/jobs/%s/result" % jid)
     st, summ = call(base + "/v1/jobs/%s/summary" % jid)
     stats = summ.get("stats", {}) if isinstance(summ, dict) else {}
     fit = stats.get("fit", {})
@@ -108,7 +146,7 @@ def describe(base, jid, n):
     sf = stats.get("solid_fraction", {})
     imc = stats.get("imc_error", {})
     sfa = sf.get("achieved")
-    return {"mb": nbytes / 1e6, "per": nbytes / n,
+    return {"mb": nbytes / 1e6, "per": nbytes / n, "sha": sha[:12],
             "sf": "%.2f -> %s" % (sf.get("target", float("nan")),
                                   "%.4f" % sfa if sfa is not None else "-"),
             "imc": "%.3g/%.3g" % (imc.get("achieved", float("nan")), imc.get("target", float("nan"))),
@@ -149,12 +187,14 @@ def main():
     load = os.getloadavg()
     print("2D specimens through the API (1 worker; load average %.2f %.2f %.2f; %d CPUs)"
           % (load[0], load[1], load[2], os.cpu_count()))
-    print("| %-36s | %7s | %8s | %8s | %7s | %7s | %8s | %6s | %-13s | %-13s | %5s | %5s | %5s |"
-          % ("job", "s", "peak MB", "of which", "HWM MB", "idle MB", "result", "B/grain",
-             "SF tgt -> ach", "IMC err/thr", "cell", "grain", "orient"))
-    print("| %-36s | %7s | %8s | %8s | %7s | %7s | %8s | %6s | %-13s | %-13s | %5s | %5s | %5s |"
-          % ("", "", "build", "result", "", "", "MB", "", "", "", "KS/c", "KS/c", "KS/c"))
-    print("|" + "|".join("-" * w for w in (38, 9, 10, 10, 9, 9, 10, 8, 15, 15, 7, 7, 7)) + "|")
+    fmt = ("| %-36s | %7s | %8s | %8s | %7s | %7s | %8s | %6s | %-12s | %-13s | %-13s | %5s "
+           "| %5s | %5s |")
+    print(fmt % ("job", "s", "peak MB", "of which", "HWM MB", "idle MB", "result", "B/grain",
+                 "sha256", "SF tgt -> ach", "IMC err/thr", "cell", "grain", "orient"))
+    print(fmt % ("", "", "build", "result", "", "", "MB", "", "of /result", "", "", "KS/c",
+                 "KS/c", "KS/c"))
+    print("|" + "|".join("-" * w for w in (38, 9, 10, 10, 9, 9, 10, 8, 14, 15, 15, 7, 7, 7))
+          + "|")
     for name, r in table:
         if "error" in r and "s" not in r:
             print("| %-36s | refused: %s" % (name, r["error"]))
@@ -164,8 +204,9 @@ def main():
         if "error" in r:
             print(head + " failed: %s" % r["error"])
         else:
-            print(head + " %8.1f | %6.0f | %-13s | %-13s | %5s | %5s | %5s |" % (
-                r["mb"], r["per"], r["sf"], r["imc"], r["cell"], r["grain"], r["orient"]))
+            print(head + " %8.1f | %6.0f | %-12s | %-13s | %-13s | %5s | %5s | %5s |" % (
+                r["mb"], r["per"], r["sha"], r["sf"], r["imc"], r["cell"], r["grain"],
+                r["orient"]))
 
 
 if __name__ == "__main__":

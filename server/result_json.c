@@ -1,11 +1,15 @@
 /* result_json.c -- the pieces every result writer uses, and the streaming writer (see
  * result_json.h). */
+#define _GNU_SOURCE /* O_TMPFILE, mkostemp */
 #include "result_json.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 json_t *gpd_jreal(double x)
 {
@@ -42,33 +46,158 @@ void gpd_jw_init(gpd_jw *w, const volatile int *cancel)
 {
     memset(w, 0, sizeof *w);
     w->cancel = cancel;
+    w->fd = -1;
+    w->flush_at = SIZE_MAX;
+}
+
+int gpd_jw_spill(gpd_jw *w, const char *dir, size_t at)
+{
+    free(w->spill_dir);
+    w->spill_dir = dir ? strdup(dir) : NULL;
+    if (w->fd < 0) w->flush_at = w->spill_dir ? (at ? at : GPD_JW_SPILL_AT) : SIZE_MAX;
+    return dir && !w->spill_dir ? -1 : 0;
 }
 
 void gpd_jw_free(gpd_jw *w)
 {
     free(w->b.buf);
+    if (w->fd >= 0) close(w->fd);
+    free(w->spill_dir);
     gpd_jw_init(w, w->cancel);
 }
 
-char *gpd_jw_take(gpd_jw *w, size_t *len)
+/* ---- spilling into a temporary file ---- */
+
+/* An unlinked temporary file in dir: O_TMPFILE where the file system has it, else a named one
+ * unlinked at once; -1 (errno set) when neither can be made. */
+static int temp_file(const char *dir)
 {
-    if (w->state != GPD_JW_OK || w->depth != 0 || w->after_key || !w->b.buf) {
+#ifdef O_TMPFILE
+    int fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    if (fd >= 0) return fd;
+#endif
+    size_t n = strlen(dir) + 32;
+    char *path = malloc(n);
+    if (!path) return -1;
+    snprintf(path, n, "%s/.grainpack-result-XXXXXX", dir);
+    int tfd = mkostemp(path, O_CLOEXEC);
+    if (tfd >= 0) unlink(path);
+    free(path);
+    return tfd;
+}
+
+static int write_all(int fd, const char *p, size_t n)
+{
+    while (n > 0) {
+        ssize_t k = write(fd, p, n);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) {
+            if (k == 0) errno = EIO;
+            return -1;
+        }
+        p += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+/* Moves the buffered text to the file, made when the text first passes the threshold; a file
+ * that cannot be made leaves the text in memory, a write that fails stops the writer. */
+static void spill(gpd_jw *w)
+{
+    int first = w->fd < 0;
+    if (first) {
+        w->fd = temp_file(w->spill_dir);
+        if (w->fd < 0) {
+            gpd_log(GPD_LOG_WARN, "cannot make a temporary file for a result in %s (%s); it "
+                                  "stays in memory", w->spill_dir, strerror(errno));
+            w->flush_at = SIZE_MAX;
+            return;
+        }
+        w->flush_at = GPD_JW_CHUNK;
+    }
+    if (write_all(w->fd, w->b.buf, w->b.len)) {
+        w->err = errno;
+        w->state = GPD_JW_IO;
+        return;
+    }
+    w->spilled += w->b.len;
+    w->b.len = 0;
+    if (first) { /* the buffer grew to the threshold; a chunk's worth is all it needs now */
+        free(w->b.buf);
+        w->b.buf = NULL;
+        w->b.cap = 0;
+    }
+}
+
+/* n bytes of fd from offset 0, in memory (NUL-terminated); NULL on a failed read or out of
+ * memory */
+static char *read_back(int fd, uint64_t n)
+{
+    char *t = n < SIZE_MAX ? malloc((size_t)n + 1) : NULL;
+    for (uint64_t off = 0; t && off < n;) {
+        ssize_t k = pread(fd, t + off, (size_t)(n - off), (off_t)off);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) {
+            free(t);
+            return NULL;
+        }
+        off += (uint64_t)k;
+    }
+    if (t) t[n] = 0;
+    return t;
+}
+
+int gpd_jw_finish(gpd_jw *w, char **mem, int *fd, uint64_t *len)
+{
+    *mem = NULL;
+    *fd = -1;
+    *len = 0;
+    if (w->fd >= 0 && w->state == GPD_JW_OK && w->b.len) spill(w); /* the last piece */
+    if (w->state != GPD_JW_OK || w->depth != 0 || w->after_key || (!w->b.buf && w->fd < 0)) {
+        int rc = w->state == GPD_JW_IO && w->err > 0 ? w->err : -1;
         gpd_jw_free(w);
-        return NULL;
+        return rc;
+    }
+    if (w->fd >= 0) {
+        *fd = w->fd;
+        *len = w->spilled;
+        w->fd = -1;
+        gpd_jw_free(w);
+        return 0;
     }
     char *text = w->b.buf;
     size_t n = w->b.len;
     char *fit = realloc(text, n + 1); /* the doubling's slack back (up to half of it) */
     w->b.buf = NULL;
     gpd_jw_free(w);
-    if (len) *len = n;
-    return fit ? fit : text;
+    *mem = fit ? fit : text;
+    *len = n;
+    return 0;
 }
 
-/* appends n bytes; out of memory stops the writer */
+char *gpd_jw_take(gpd_jw *w, size_t *len)
+{
+    char *mem;
+    int fd;
+    uint64_t n;
+    if (gpd_jw_finish(w, &mem, &fd, &n) != 0) return NULL;
+    if (fd >= 0) {
+        mem = read_back(fd, n);
+        close(fd);
+        if (!mem) return NULL;
+    }
+    if (len) *len = (size_t)n;
+    return mem;
+}
+
+/* appends n bytes; out of memory stops the writer; past flush_at the text goes to the file */
 static void put(gpd_jw *w, const char *s, size_t n)
 {
-    if (gpd_buf_add(&w->b, s, n)) w->state = GPD_JW_OOM;
+    if (gpd_buf_add(&w->b, s, n))
+        w->state = GPD_JW_OOM;
+    else if (w->b.len >= w->flush_at)
+        spill(w);
 }
 
 /* A value counts a piece; every GPD_JW_CANCEL_EVERY pieces the flag is read. 1 when the writer

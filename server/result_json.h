@@ -21,11 +21,18 @@
  * Every value counts one piece; every GPD_JW_CANCEL_EVERY pieces the writer reads the cancel
  * flag, and once it is up (or memory ran out) every later call does nothing: the writers need
  * no checks of their own. One writer belongs to one thread; the flag may be raised by any.
- * The writer owns its text until gpd_jw_take hands it over; the buffer doubles as it grows
- * (glibc moves a large block by remapping it, without a copy), so a worker's memory is the
- * specimen plus the text. Reals of 1e-6 <= |x| < 1e38 are formatted from their exact 17-digit
- * rounding in 128-bit integers (~5x faster than printf, the same bytes), the others by
- * printf. */
+ * The writer owns its text until gpd_jw_take or gpd_jw_finish hands it over; the buffer
+ * doubles as it grows (glibc moves a large block by remapping it, without a copy).
+ * Spilling (gpd_jw_spill, the workers'): once the text passes a threshold (a few MB) the writer
+ * moves it into an unlinked temporary file (O_TMPFILE, else mkstemp + unlink, in the directory
+ * it was given: the database's, so on its disk rather than a RAM /tmp) and from then on appends
+ * every GPD_JW_CHUNK bytes to it, so that a worker's memory is the specimen plus a few MB
+ * however long the text; the store then copies the file into the database in pieces
+ * (store.h, store_text). A file that cannot be made leaves the text in memory (logged); a
+ * write that fails (disk full) stops the writer with GPD_JW_IO (errno in w->err). The file
+ * goes with its descriptor: a crash leaves nothing behind.
+ * Reals of 1e-6 <= |x| < 1e38 are formatted from their exact 17-digit rounding in 128-bit
+ * integers (~5x faster than printf, the same bytes), the others by printf. */
 #ifndef GPD_RESULT_JSON_H
 #define GPD_RESULT_JSON_H
 
@@ -50,11 +57,20 @@ int gpd_cancel_raised(const volatile int *cancel);
 #define GPD_JW_CANCEL_EVERY 4096 /* pieces between two looks at the cancel flag (~1 ms) */
 #define GPD_JW_MAX_DEPTH 64
 
-/* the writer's state: anything but OK stops it (INVALID: nested deeper than GPD_JW_MAX_DEPTH) */
-enum { GPD_JW_OK = 0, GPD_JW_CANCELLED, GPD_JW_OOM, GPD_JW_INVALID };
+#define GPD_JW_SPILL_AT ((size_t)4 << 20) /* the workers' spill threshold: 4 MB */
+#define GPD_JW_CHUNK ((size_t)1 << 20)    /* bytes appended to the file at a time, once spilled */
+
+/* the writer's state: anything but OK stops it (INVALID: nested deeper than GPD_JW_MAX_DEPTH;
+ * IO: its temporary file could not be written) */
+enum { GPD_JW_OK = 0, GPD_JW_CANCELLED, GPD_JW_OOM, GPD_JW_INVALID, GPD_JW_IO };
 
 typedef struct gpd_jw {
-    gpd_buf b;                    /* the text so far (owned) */
+    gpd_buf b;                    /* the text so far, or past `spilled` once in the file (owned) */
+    int fd;                       /* the temporary file (owned), -1 while the text is in memory */
+    uint64_t spilled;             /* bytes of the text already in the file */
+    size_t flush_at;              /* b.len that sends b to the file (SIZE_MAX: never) */
+    char *spill_dir;              /* where the file is made (owned; NULL: no spilling) */
+    int err;                      /* errno of a failed file write (state GPD_JW_IO) */
     const volatile int *cancel;   /* may be NULL */
     unsigned long pieces;         /* values written, for the cancel checks */
     int state;                    /* GPD_JW_*: anything but OK stops the writing */
@@ -64,14 +80,24 @@ typedef struct gpd_jw {
     double pause_s;               /* a testing hook: slept at each look at the flag (0: none) */
 } gpd_jw;
 
-/* An empty writer that reads *cancel (may be NULL). */
+/* An empty writer that reads *cancel (may be NULL); it keeps its text in memory. */
 void gpd_jw_init(gpd_jw *w, const volatile int *cancel);
-/* Drops the text (the writer may be initialised again). */
+/* From now on the text spills into a temporary file made in dir once it passes `at` bytes
+ * (before anything is written; `at` 0: GPD_JW_SPILL_AT). 0, or -1 (out of memory: the text
+ * stays in memory). */
+int gpd_jw_spill(gpd_jw *w, const char *dir, size_t at);
+/* Drops the text and its file (the writer may be initialised again). */
 void gpd_jw_free(gpd_jw *w);
 /* The finished text (malloc'ed, NUL-terminated; its length in *len, may be NULL), the writer
- * left empty; NULL (text dropped) when it was cancelled, ran out of memory or has a container
- * still open. */
+ * left empty; NULL (text dropped) when it was cancelled, ran out of memory, could not write its
+ * file or has a container still open. A spilled text is read back into memory. */
 char *gpd_jw_take(gpd_jw *w, size_t *len);
+/* The finished text where it is: in memory (*mem malloc'ed, NUL-terminated, *fd -1) or, once
+ * spilled, in the temporary file (*fd, the caller's to close, to be read with pread from
+ * offset 0; *mem NULL), *len bytes either way; the writer left empty. 0, or (nothing handed
+ * over, text dropped) where gpd_jw_take gives NULL: the errno of a failed write of the file
+ * (> 0), else -1 (cancelled, out of memory, nesting open). */
+int gpd_jw_finish(gpd_jw *w, char **mem, int *fd, uint64_t *len);
 
 void gpd_jw_begin_object(gpd_jw *w);
 void gpd_jw_end_object(gpd_jw *w);

@@ -1,11 +1,14 @@
 /* store.c -- the job store's dispatch to its back end (store_impl.h) and what the back ends
  * share: the last failed write, result summaries, values as byte sources. */
+#define _GNU_SOURCE /* pread */
 #include "store_impl.h"
 
+#include <errno.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "json_scan.h"
 
@@ -13,6 +16,7 @@
 static const store_backend *be = &store_sqlite;
 static double lease_s = STORE_LEASE_DEFAULT_S;
 static void (*cancel_hook)(const char *id) = NULL;
+static void (*wal_hook)(void) = NULL;
 
 int store_is_url(const char *target)
 {
@@ -38,6 +42,22 @@ void store_cancel_seen(const char *id)
 {
     void (*fn)(const char *) = __atomic_load_n(&cancel_hook, __ATOMIC_ACQUIRE);
     if (fn) fn(id);
+}
+
+void store_on_wal_grown(void (*fn)(void))
+{
+    __atomic_store_n(&wal_hook, fn, __ATOMIC_RELEASE);
+}
+
+void store_wal_grown_seen(void)
+{
+    void (*fn)(void) = __atomic_load_n(&wal_hook, __ATOMIC_ACQUIRE);
+    if (fn) fn();
+}
+
+char *store_spill_dir(void)
+{
+    return be->spill_dir();
 }
 
 const char *store_backend_name(void)
@@ -110,6 +130,8 @@ int store_purge_finished_before(const char *before, int max)
 }
 
 int store_reclaim(void) { return be->reclaim(); }
+int store_checkpoint(int may_yield) { return be->checkpoint(may_yield); }
+void store_checkpoint_yield(void) { be->checkpoint_yield(); }
 
 int store_count_by_kind(void (*fn)(void *user, const char *kind, const char *status, long n),
                         void *user)
@@ -233,22 +255,44 @@ int store_spans_parse(const char *text, uint64_t spans[STORE_SUMMARY_NSKIP][2])
     return 0;
 }
 
-store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
+/* store_text_source's reader: a file, from offset 0 */
+static int file_read(void *user, uint64_t off, void *dst, size_t n)
+{
+    const store_text *t = user;
+    char *p = dst;
+    while (n > 0) {
+        ssize_t k = pread(t->fd, p, n, (off_t)off);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return -1;
+        p += k;
+        off += (uint64_t)k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+js_source store_text_source(const store_text *t)
+{
+    if (t->mem) return js_memory_source(t->mem, (size_t)t->len);
+    return (js_source){file_read, (void *)t, t->len};
+}
+
+store_rc store_succeed(const char *id, const store_text *result, const char *progress_json,
                        const char *brief_json, const void *pack, size_t pack_len, gpd_err *why)
 {
     gpd_err dummy;
     if (!why) why = &dummy;
     gpd_err_set(why, 0, "%s", "");
-    if (!result_json) {
+    if (!result || (!result->mem && result->fd < 0)) {
         gpd_err_set(why, 500, "there is no result to store");
         return STORE_ERROR;
     }
-    size_t rlen = strlen(result_json);
     /* the summary (the result without its per-item arrays), made before the write lock is
-     * taken; a result it cannot be made of (not an object, out of memory) is stored without
-     * one, and its readers fall back to scanning the result */
+     * taken, from the same source the store then copies; a result it cannot be made of (not an
+     * object, out of memory, a failed read) is stored without one, and its readers fall back
+     * to scanning the result */
     static const char *const skip[] = STORE_SUMMARY_SKIP;
-    js_source rsrc = js_memory_source(result_json, rlen);
+    js_source rsrc = store_text_source(result);
     size_t slen = 0;
     uint64_t spans[STORE_SUMMARY_NSKIP][2];
     char *summary = js_object_without(&rsrc, skip, &slen, spans);
@@ -258,8 +302,8 @@ store_rc store_succeed(const char *id, const char *result_json, const char *prog
         free(summary);
         summary = NULL;
     }
-    store_rc rc = be->succeed(id, result_json, rlen, progress_json, brief_json, pack, pack_len,
-                              summary, slen, arrays, why);
+    store_rc rc = be->succeed(id, result, progress_json, brief_json, pack, pack_len, summary,
+                              slen, arrays, why);
     free(summary);
     free(arrays);
     return rc;

@@ -7,7 +7,7 @@
  * SQLite: one table, jobs (WAL journal, busy_timeout 5 s, synchronous=FULL; a new database is
  * made with auto_vacuum=INCREMENTAL so that purged jobs give their space back (store_reclaim),
  * and every connection sets journal_size_limit=64 MB so that the WAL shrinks after a
- * checkpoint):
+ * checkpoint; no connection checkpoints by itself -- see "Checkpoints" below):
  *   seq         INTEGER PRIMARY KEY AUTOINCREMENT  submission order (newest = largest)
  *   id          TEXT NOT NULL UNIQUE               32 hex digits, 128 random bits (/dev/urandom)
  *   kind        TEXT NOT NULL
@@ -16,13 +16,17 @@
  *   progress    TEXT                               JSON {phase, fraction, eta_s, detail}
  *   created_at, started_at, finished_at TEXT       RFC 3339 UTC with milliseconds
  *   error       TEXT                               JSON {code, message} or NULL
- *   result      TEXT                               JSON, written in the same statement as
- *                                                  status='succeeded' (durable before it shows)
+ *   result      TEXT                               the result of a job that succeeded before
+ *                                                  the results table (NULL for newer jobs)
  *   attempts    INTEGER NOT NULL DEFAULT 0         times a worker claimed the job
  *   brief       TEXT                               JSON, the job object's "brief" (kind.h):
  *                                                  written at submit, replaced at success;
  *                                                  added by store_open to a database made
  *                                                  before it, filled by store_fill_briefs
+ * and results(seq INTEGER PRIMARY KEY = jobs.seq, result BLOB NOT NULL): the result's JSON
+ * text (a BLOB: it is written in pieces, below), committed in the same transaction as
+ * status='succeeded' (durable before it shows); readers take results.result, else the older
+ * jobs.result;
  * and exports(seq INTEGER PRIMARY KEY = jobs.seq, pack BLOB NOT NULL): the export pack of a
  * succeeded job (core/export/gp_export.h), committed with the result;
  * and summaries(seq INTEGER PRIMARY KEY = jobs.seq, summary TEXT NOT NULL, arrays TEXT): the
@@ -32,6 +36,21 @@
  * Connections: one per thread (opened lazily, closed when the thread exits or on
  * store_close()); every write is a single statement or an IMMEDIATE transaction, so claims and
  * cancels are atomic across threads and processes.
+ *
+ * Writing a large value without a second copy (SQLite): the result and the pack are inserted as
+ * zeroblob(n) -- the last column of their row, so that SQLite keeps the zeros implicit and
+ * never builds the record in memory -- and then written with sqlite3_blob_write in
+ * STORE_PIECE pieces read from their source (memory, or a worker's temporary file:
+ * store_text), inside the one transaction of store_succeed; the pager spills the dirty pages to
+ * the WAL as the cache fills, so the store's memory is a piece plus SQLite's page cache.
+ *
+ * Checkpoints (SQLite): a commit of a large result leaves hundreds of MB in the WAL; SQLite's
+ * automatic checkpoint would copy them into the database on the connection that commits next
+ * (a worker, or an HTTP thread), holding it for seconds. So no connection checkpoints by
+ * itself (wal_autocheckpoint off); a commit that leaves the WAL over STORE_WAL_KICK_PAGES pages
+ * calls the store_on_wal_grown hook instead, and the maintenance thread (maint.h) checkpoints:
+ * a PASSIVE pass that copies the frames without blocking writers or readers, then a TRUNCATE
+ * that does not wait (store_checkpoint); it waits for idle workers and gives way to a claim.
  *
  * Restart rule (store_recover): a job found 'running' when the daemon starts was interrupted
  * by a crash. It is put back in the queue unless it has already been claimed
@@ -163,16 +182,35 @@ store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts);
  * (cancelled meanwhile). */
 store_rc store_progress(const char *id, const char *progress_json);
 
+/* A value to store, where its writer left it: len bytes in memory at mem, or (mem NULL) in
+ * the file fd from offset 0, read with pread (a worker's temporary file, result_json.h). The
+ * store reads it, never changes or closes it. */
+#define STORE_PIECE ((size_t)1 << 20) /* bytes read and written at a time */
+typedef struct store_text {
+    const char *mem;
+    int fd;
+    uint64_t len;
+} store_text;
+/* The value as a byte source (json_scan.h). */
+js_source store_text_source(const store_text *t);
+
+/* Where a worker may put the temporary file of a large result (malloc'ed): the database's
+ * directory (SQLite; its disk, not a RAM /tmp); NULL when the back end reads the value whole
+ * anyway (PostgreSQL binds it as one parameter) or the store is closed. */
+char *store_spill_dir(void);
+
 /* Final transitions of a running job (no-ops returning STORE_CONFLICT when it is no longer
  * running, e.g. cancelled by DELETE).
- * store_succeed commits the result (non-NULL), the pack (may be NULL), the result's summary
- * (store_get_summary; made here from the result text, left out when it cannot be made) and
- * status 'succeeded' in one transaction, or nothing: every SQLite code is checked and a failure rolls it all
- * back, leaving the job running. STORE_TOOBIG: the result or the pack is larger than the
+ * store_succeed commits the result (non-NULL; its JSON text), the pack (may be NULL), the
+ * result's summary (store_get_summary; made here from the result, read through its source,
+ * left out when it cannot be made) and status 'succeeded' in one transaction, or nothing: every
+ * SQLite code is checked and a failure rolls it all back, leaving the job running. SQLite
+ * writes the result and the pack in pieces (above); PostgreSQL reads a result in a file back
+ * into memory for its bind. STORE_TOOBIG: the result or the pack is larger than the
  * database can store (SQLite's length limit, 1e9 bytes by default), so it never will be;
  * STORE_ERROR: anything else (disk full, I/O error, a failed commit...), which may pass on a
  * retry. On both, why (may be NULL) gets a sentence saying what went wrong (status 500). */
-store_rc store_succeed(const char *id, const char *result_json, const char *progress_json,
+store_rc store_succeed(const char *id, const store_text *result, const char *progress_json,
                        const char *brief_json, const void *pack, size_t pack_len, gpd_err *why);
 /* brief_json: the brief with what the run achieved (NULL: the one of the submit is kept).
  * store_fail, store_cancel and the restart rule's failures keep the last progress's phase and
@@ -202,13 +240,28 @@ store_rc store_purge(const char *id, char status_out[16]);
  * oldest first. Returns how many were purged, -1 when the candidates could not be read. */
 int store_purge_finished_before(const char *before, int max);
 
-/* Gives the space of purged jobs back: incremental vacuum (in steps of a few MB, each its own
- * short write transaction) and a WAL checkpoint in TRUNCATE mode that does not wait: readers
- * (a download in progress) block it, and the caller tries again later. 0 when done, 1 when the
+/* Gives the space of purged jobs back and empties the WAL: incremental vacuum (in steps of a
+ * few MB, each its own short write transaction), a PASSIVE checkpoint (copies the WAL into the
+ * database without blocking anyone: the long part after a large result) and a checkpoint in
+ * TRUNCATE mode that does not wait: a writer at that moment or a reader of an older snapshot
+ * (a download in progress) blocks it, and the caller tries again later. 0 when done, 1 when the
  * checkpoint was blocked, -1 on an error (logged). A database made without auto_vacuum (before
  * it was set at creation) only checkpoints: its file keeps its size, its free pages are
  * reused. */
 int store_reclaim(void);
+
+/* The WAL checkpoint of store_reclaim alone (no vacuum): 0 done, 1 blocked (try again later),
+ * 2 given way to a job (may_yield: a claim on any thread interrupted it, store_checkpoint_yield;
+ * its copying starts over next time), -1 an error (logged). PostgreSQL: 0. */
+int store_checkpoint(int may_yield);
+/* Interrupts a checkpoint running with may_yield, if any (any thread; store_claim calls it). */
+void store_checkpoint_yield(void);
+
+/* fn() is called (on the committing thread, which must not wait for it) after a commit that
+ * left the WAL over STORE_WAL_KICK_PAGES pages (SQLite; never on PostgreSQL): a checkpoint is
+ * due (store_reclaim). NULL: none. */
+#define STORE_WAL_KICK_PAGES 1000 /* SQLite's own autocheckpoint threshold: ~4 MB */
+void store_on_wal_grown(void (*fn)(void));
 
 /* The jobs in the store by kind and status (one GROUP BY over an index): fn is called once
  * per pair present. 0, or -1. */

@@ -36,16 +36,19 @@ typedef struct store_backend {
     store_rc (*progress)(const char *id, const char *progress_json);
     /* store_succeed after the shared part: summary (may be NULL) of slen bytes and its arrays'
      * spans as text (store_spans_text) were made by store.c from the result */
-    store_rc (*succeed)(const char *id, const char *result_json, size_t rlen,
-                        const char *progress_json, const char *brief_json, const void *pack,
-                        size_t pack_len, const char *summary, size_t slen, const char *arrays,
-                        gpd_err *why);
+    store_rc (*succeed)(const char *id, const store_text *result, const char *progress_json,
+                        const char *brief_json, const void *pack, size_t pack_len,
+                        const char *summary, size_t slen, const char *arrays, gpd_err *why);
+    /* store_spill_dir (NULL: values are bound whole) */
+    char *(*spill_dir)(void);
     store_rc (*fail)(const char *id, const char *code, const char *message);
     store_rc (*requeue)(const char *id);
     store_rc (*cancel)(const char *id, int *was_running, char status_out[16], char kind_out[64]);
     store_rc (*purge)(const char *id, char status_out[16]);
     int (*purge_finished_before)(const char *before, int max);
     int (*reclaim)(void);
+    int (*checkpoint)(int may_yield);
+    void (*checkpoint_yield)(void);
     int (*count_by_kind)(void (*fn)(void *user, const char *kind, const char *status, long n),
                          void *user);
     int (*size)(long long *bytes);
@@ -65,6 +68,8 @@ extern const store_backend store_pg;
 
 /* Calls the hook of store_on_cancel, if any (store_pg's listener). */
 void store_cancel_seen(const char *id);
+/* Calls the hook of store_on_wal_grown, if any (store_sqlite's WAL hook). */
+void store_wal_grown_seen(void);
 /* Records a failed write for store_last_write_error (/v1/health): what was being written and
  * the database's message. Thread-safe. */
 void store_note_write_error(const char *what, const char *msg);

@@ -763,10 +763,10 @@ static store_rc succeed_extras(const char *seq, const void *pack, size_t pack_le
     return STORE_OK;
 }
 
-static store_rc pg_succeed(const char *id, const char *result_json, size_t rlen,
-                           const char *progress_json, const char *brief_json, const void *pack,
-                           size_t pack_len, const char *summary, size_t slen, const char *arrays,
-                           gpd_err *why)
+static store_rc succeed_mem(const char *id, const char *result_json, size_t rlen,
+                            const char *progress_json, const char *brief_json, const void *pack,
+                            size_t pack_len, const char *summary, size_t slen,
+                            const char *arrays, gpd_err *why)
 {
     if (too_big(rlen, pack, pack_len, why)) return STORE_TOOBIG;
     char now[40], seq[24] = "";
@@ -798,6 +798,45 @@ static store_rc pg_succeed(const char *id, const char *result_json, size_t rlen,
         store_note_write_error("storing a result", why->msg);
     }
     return rc;
+}
+
+/* store_succeed: the result is bound whole as one bytea parameter, so a result a worker wrote
+ * into a file is read back into memory first (workers spill only where store_spill_dir says so:
+ * never with this back end; chunked storage here is later work) */
+static store_rc pg_succeed(const char *id, const store_text *result, const char *progress_json,
+                           const char *brief_json, const void *pack, size_t pack_len,
+                           const char *summary, size_t slen, const char *arrays, gpd_err *why)
+{
+    if (result->mem)
+        return succeed_mem(id, result->mem, (size_t)result->len, progress_json, brief_json,
+                           pack, pack_len, summary, slen, arrays, why);
+    if (too_big((size_t)result->len, pack, pack_len, why)) return STORE_TOOBIG;
+    char *text = malloc((size_t)result->len + 1);
+    js_source src = store_text_source(result);
+    if (!text || src.read(src.user, 0, text, (size_t)result->len)) {
+        free(text);
+        gpd_err_set(why, 500, "cannot read the result's temporary file back");
+        return STORE_ERROR;
+    }
+    store_rc rc = succeed_mem(id, text, (size_t)result->len, progress_json, brief_json, pack,
+                              pack_len, summary, slen, arrays, why);
+    free(text);
+    return rc;
+}
+
+/* no WAL of ours to checkpoint (the server runs its own) */
+static int pg_checkpoint(int may_yield)
+{
+    (void)may_yield;
+    return 0;
+}
+
+static void pg_checkpoint_yield(void) {}
+
+/* values are bound whole: workers keep results in memory */
+static char *pg_spill_dir(void)
+{
+    return NULL;
 }
 
 static store_rc pg_cancel(const char *id, int *was_running, char status_out[16], char kind_out[64])
@@ -1103,6 +1142,9 @@ const store_backend store_pg = {
     .claim = pg_claim,
     .progress = pg_progress,
     .succeed = pg_succeed,
+    .spill_dir = pg_spill_dir,
+    .checkpoint = pg_checkpoint,
+    .checkpoint_yield = pg_checkpoint_yield,
     .fail = pg_fail,
     .requeue = pg_requeue,
     .cancel = pg_cancel,

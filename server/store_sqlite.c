@@ -44,8 +44,19 @@ static int lock_fd = -1; /* holds the database lock from store_open to store_clo
  * SQLite's length limit (GRAINPACK_TEST_SQLITE_MAX_LENGTH, bytes: a result over it is
  * SQLITE_TOOBIG) or the database's page count (GRAINPACK_TEST_SQLITE_MAX_PAGES: a write past it
  * is SQLITE_FULL, as on a full disk) on every connection, so that the integration tests can
- * drive the failure paths of the store. 0 = not set. */
+ * drive the failure paths of the store. 0 = not set. The page cap is set once the schema is
+ * made (SQLite keeps it at least the file's size: a cap below the schema's pages means "no
+ * page more than the schema"). */
 static long test_max_length = 0, test_max_pages = 0;
+static int schema_made = 0; /* atomic: store_open made the tables (the page cap applies) */
+
+static void test_page_cap(sqlite3 *db)
+{
+    if (test_max_pages <= 0 || !__atomic_load_n(&schema_made, __ATOMIC_ACQUIRE)) return;
+    char pragma[64];
+    snprintf(pragma, sizeof pragma, "PRAGMA max_page_count=%ld", test_max_pages);
+    sqlite3_exec(db, pragma, NULL, NULL, NULL);
+}
 
 /* A thread's connection and its prepared statements, cached by SQL text address (every SQL
  * string here is a literal), so that a status poll costs one sqlite3_step. */
@@ -88,6 +99,9 @@ static const char *SCHEMA_SQL =
     "CREATE INDEX IF NOT EXISTS jobs_kind_status ON jobs(kind, status);"
     "CREATE INDEX IF NOT EXISTS jobs_finished_at ON jobs(finished_at)"
     " WHERE finished_at IS NOT NULL;"
+    /* the result of a succeeded job, keyed by the job's seq: the row's last column, so that it
+     * is written as zeroblob(n) + incremental blob I/O without a copy in memory (store.h) */
+    "CREATE TABLE IF NOT EXISTS results(seq INTEGER PRIMARY KEY, result BLOB NOT NULL);"
     /* the export pack of a succeeded job (core/export/gp_export.h), keyed by the job's seq so that
      * it can be read with incremental blob I/O */
     "CREATE TABLE IF NOT EXISTS exports(seq INTEGER PRIMARY KEY, pack BLOB NOT NULL);"
@@ -119,6 +133,17 @@ static char *path_copy(void)
     return path;
 }
 
+/* Replaces SQLite's automatic checkpoint on every connection (store.h, "Checkpoints"): a
+ * commit that left the WAL large only tells the maintenance thread. */
+static int wal_grown(void *user, sqlite3 *db, const char *name, int pages)
+{
+    (void)user;
+    (void)db;
+    (void)name;
+    if (pages >= STORE_WAL_KICK_PAGES) store_wal_grown_seen();
+    return SQLITE_OK;
+}
+
 static sqlite3 *conn_open(void)
 {
     char *path = path_copy();
@@ -134,6 +159,7 @@ static sqlite3 *conn_open(void)
         return NULL;
     }
     sqlite3_busy_timeout(db, 5000);
+    sqlite3_wal_hook(db, wal_grown, NULL);
     char *em = NULL;
     /* journal_size_limit: a WAL that a big result grew to hundreds of MB is cut back to this
      * once a checkpoint has reset it (store_reclaim truncates it to nothing) */
@@ -147,11 +173,7 @@ static sqlite3 *conn_open(void)
         return NULL;
     }
     if (test_max_length > 0) sqlite3_limit(db, SQLITE_LIMIT_LENGTH, (int)test_max_length);
-    if (test_max_pages > 0) {
-        char pragma[64];
-        snprintf(pragma, sizeof pragma, "PRAGMA max_page_count=%ld", test_max_pages);
-        sqlite3_exec(db, pragma, NULL, NULL, NULL);
-    }
+    test_page_cap(db);
     return db;
 }
 
@@ -242,6 +264,7 @@ static int sq_open(const char *path)
     }
     test_max_length = env_long("GRAINPACK_TEST_SQLITE_MAX_LENGTH");
     test_max_pages = env_long("GRAINPACK_TEST_SQLITE_MAX_PAGES");
+    __atomic_store_n(&schema_made, 0, __ATOMIC_RELEASE);
     /* the lock first: nothing may read or change the jobs of another daemon's database */
     if (lock_fd < 0) {
         int l = lock_take(path);
@@ -269,6 +292,8 @@ static int sq_open(const char *path)
         return -1;
     }
     if (add_brief_column(db)) return -1;
+    __atomic_store_n(&schema_made, 1, __ATOMIC_RELEASE);
+    test_page_cap(db);
     auto_vacuum = query_long(db, "PRAGMA auto_vacuum") == 2;
     if (!auto_vacuum)
         gpd_log(GPD_LOG_WARN,
@@ -522,7 +547,8 @@ static store_rc sq_get_text(const char *id, const char *column, char **text, cha
     if (!db) return STORE_ERROR;
     const char *sql;
     if (!strcmp(column, "result"))
-        sql = "SELECT status, result FROM jobs WHERE id=?1";
+        sql = "SELECT j.status, coalesce(r.result, j.result) FROM jobs j "
+              "LEFT JOIN results r ON r.seq = j.seq WHERE j.id=?1";
     else if (!strcmp(column, "spec"))
         sql = "SELECT status, spec FROM jobs WHERE id=?1";
     else if (!strcmp(column, "kind"))
@@ -648,6 +674,8 @@ static store_rc sq_claim(char id[33], char **kind, char **spec_json, int *attemp
         *attempts = sqlite3_column_int(st, 3);
         s = sqlite3_step(st); /* finish the statement so that the change commits */
         rc = (s == SQLITE_DONE && *kind && *spec_json) ? STORE_OK : STORE_ERROR;
+        /* a job runs now: a checkpoint that waited for idle workers gives way to it */
+        if (rc == STORE_OK) store_checkpoint_yield();
         if (rc != STORE_OK) {
             free(*kind);
             free(*spec_json);
@@ -692,23 +720,18 @@ static store_rc sq_progress(const char *id, const char *progress_json)
                           progress_json, NULL, NULL);
 }
 
-/* Runs sql, a write of one row, with ?1 = id, ?2 = the value v of n bytes (text when is_text,
- * else a blob; bound without a copy: a result may be hundreds of MB, and it outlives the
- * statement) and ?3, ?4 = the texts a, b where the statement has them. Returns SQLite's code
- * (SQLITE_OK once done) and the rows changed in *changes. */
-static int write_value(sqlite3 *db, const char *sql, const char *id, const void *v, size_t n,
-                       int is_text, const char *a, const char *b, int *changes)
+/* Runs sql, a write of one row, with ?1 = id, ?2 = the text v and ?3 = the text a where the
+ * statement has it (small values: the summary, the brief). Returns SQLite's code (SQLITE_OK
+ * once done) and the rows changed in *changes. */
+static int write_small(sqlite3 *db, const char *sql, const char *id, const char *v,
+                       const char *a, int *changes)
 {
     *changes = 0;
     sqlite3_stmt *st = prep(db, sql);
     if (!st) return sqlite3_errcode(db);
-    int np = sqlite3_bind_parameter_count(st);
     int rc = bind_text(st, 1, id);
-    if (rc == SQLITE_OK)
-        rc = is_text ? sqlite3_bind_text64(st, 2, v, (sqlite3_uint64)n, SQLITE_STATIC, SQLITE_UTF8)
-                     : sqlite3_bind_blob64(st, 2, v, (sqlite3_uint64)n, SQLITE_STATIC);
-    if (rc == SQLITE_OK && np >= 3) rc = bind_text(st, 3, a);
-    if (rc == SQLITE_OK && np >= 4) rc = bind_text(st, 4, b);
+    if (rc == SQLITE_OK) rc = bind_text(st, 2, v);
+    if (rc == SQLITE_OK && sqlite3_bind_parameter_count(st) >= 3) rc = bind_text(st, 3, a);
     if (rc == SQLITE_OK) {
         rc = sqlite3_step(st);
         if (rc == SQLITE_DONE) {
@@ -720,23 +743,87 @@ static int write_value(sqlite3 *db, const char *sql, const char *id, const void 
     return rc;
 }
 
+/* Status 'succeeded' with the "done" progress, only while the job is running: SQLite's code,
+ * and the job's seq (0 when it was not running: cancelled meanwhile). */
+static int mark_succeeded(sqlite3 *db, const char *id, const char *progress_json,
+                          const char *now, sqlite3_int64 *seq)
+{
+    *seq = 0;
+    sqlite3_stmt *st = prep(db, "UPDATE jobs SET status='succeeded', progress=?2, "
+                                "finished_at=?3, error=NULL WHERE id=?1 AND status='running' "
+                                "RETURNING seq");
+    if (!st) return sqlite3_errcode(db);
+    int rc = bind_text(st, 1, id);
+    if (rc == SQLITE_OK) rc = bind_text(st, 2, progress_json);
+    if (rc == SQLITE_OK) rc = bind_text(st, 3, now);
+    if (rc == SQLITE_OK) {
+        rc = sqlite3_step(st);
+        if (rc == SQLITE_ROW) {
+            *seq = sqlite3_column_int64(st, 0);
+            rc = sqlite3_step(st); /* to the end: the update is done */
+        }
+        if (rc == SQLITE_DONE) rc = SQLITE_OK;
+    }
+    done(st);
+    return rc;
+}
+
+/* Writes v into `table`(seq, `column`) for row seq: inserted (or replaced) as zeroblob(len)
+ * -- the row's last column, so SQLite keeps the zeros implicit and builds no record of len
+ * bytes -- then filled with sqlite3_blob_write, STORE_PIECE bytes at a time, straight from
+ * memory or read from the file into buf. Inside the caller's transaction. SQLite's code
+ * (SQLITE_OK when done); a failed read of the file is SQLITE_IOERR with *read_errno set. */
+static int write_pieces(sqlite3 *db, const char *insert_sql, const char *table,
+                        const char *column, sqlite3_int64 seq, const store_text *v, char *buf,
+                        int *read_errno)
+{
+    sqlite3_stmt *st = prep(db, insert_sql);
+    if (!st) return sqlite3_errcode(db);
+    sqlite3_bind_int64(st, 1, seq);
+    int rc = sqlite3_bind_zeroblob64(st, 2, v->len);
+    if (rc == SQLITE_OK) {
+        rc = sqlite3_step(st);
+        if (rc == SQLITE_DONE) rc = SQLITE_OK;
+    }
+    done(st);
+    if (rc != SQLITE_OK) return rc;
+    sqlite3_blob *b = NULL;
+    rc = sqlite3_blob_open(db, "main", table, column, seq, 1, &b);
+    js_source src = store_text_source(v);
+    for (uint64_t off = 0; rc == SQLITE_OK && off < v->len; off += STORE_PIECE) {
+        size_t n = v->len - off < STORE_PIECE ? (size_t)(v->len - off) : STORE_PIECE;
+        const char *piece = v->mem ? v->mem + off : buf;
+        if (!v->mem && src.read(src.user, off, buf, n)) {
+            *read_errno = errno ? errno : EIO;
+            rc = SQLITE_IOERR;
+            break;
+        }
+        rc = sqlite3_blob_write(b, piece, (int)n, (int)off); /* len <= the length limit < 2^31 */
+    }
+    int crc = sqlite3_blob_close(b);
+    return rc == SQLITE_OK ? crc : rc;
+}
+
 /* A value over SQLite's length limit (1e9 bytes by default) cannot be stored at all: 1 (with
- * the sizes in why), without trying (binding it would leave the column NULL); else 0. */
-static int too_big(sqlite3 *db, size_t rlen, const void *pack, size_t pack_len, gpd_err *why)
+ * the sizes in why), without trying; else 0. */
+static int too_big(sqlite3 *db, uint64_t rlen, const void *pack, size_t pack_len, gpd_err *why)
 {
     long long lim = sqlite3_limit(db, SQLITE_LIMIT_LENGTH, -1);
-    if ((long long)rlen <= lim && !(pack && (long long)pack_len > lim)) return 0;
-    int is_pack = (long long)rlen <= lim;
+    if (rlen <= (uint64_t)lim && !(pack && (long long)pack_len > lim)) return 0;
+    int is_pack = rlen <= (uint64_t)lim;
     gpd_err_set(why, 500,
-                "the %s is %zu bytes, more than the job database can store in one value "
+                "the %s is %llu bytes, more than the job database can store in one value "
                 "(%lld bytes)",
-                is_pack ? "export pack" : "result", is_pack ? pack_len : rlen, lim);
+                is_pack ? "export pack" : "result",
+                (unsigned long long)(is_pack ? pack_len : rlen), lim);
     return 1;
 }
 
 /* The end of store_succeed's transaction: COMMIT when every write passed, else the reason
- * (before ROLLBACK replaces SQLite's message) in why and the log. src: the last SQLite code. */
-static store_rc succeed_end(sqlite3 *db, const char *id, store_rc rc, int src, gpd_err *why)
+ * (before ROLLBACK replaces SQLite's message) in why and the log. src: the last SQLite code;
+ * read_errno: a failed read of the result's file (0: none). */
+static store_rc succeed_end(sqlite3 *db, const char *id, store_rc rc, int src, int read_errno,
+                            gpd_err *why)
 {
     if (rc == STORE_OK) {
         src = sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
@@ -747,7 +834,12 @@ static store_rc succeed_end(sqlite3 *db, const char *id, store_rc rc, int src, g
         const char *em = sqlite3_errmsg(db);
         int more = em && strcmp(em, sqlite3_errstr(src));
         if ((src & 0xff) == SQLITE_TOOBIG) rc = STORE_TOOBIG;
-        gpd_err_set(why, 500, "%s%s%s", sqlite3_errstr(src), more ? ": " : "", more ? em : "");
+        if (read_errno)
+            gpd_err_set(why, 500, "reading the result's temporary file: %s",
+                        strerror(read_errno));
+        else
+            gpd_err_set(why, 500, "%s%s%s", sqlite3_errstr(src), more ? ": " : "",
+                        more ? em : "");
         gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result: %s", id, why->msg);
         if (rc != STORE_TOOBIG) store_note_write_error("storing a result", why->msg);
     }
@@ -756,49 +848,70 @@ static store_rc succeed_end(sqlite3 *db, const char *id, store_rc rc, int src, g
     return rc;
 }
 
-/* store_succeed's transaction (store.c made the summary and checked the arguments) */
-static store_rc sq_succeed(const char *id, const char *result_json, size_t rlen,
-                           const char *progress_json, const char *brief_json, const void *pack,
-                           size_t pack_len, const char *summary, size_t slen, const char *arrays,
-                           gpd_err *why)
+/* The writes of store_succeed's transaction after the status: brief, result, pack, summary. */
+static store_rc succeed_rows(sqlite3 *db, const char *id, sqlite3_int64 seq,
+                             const store_text *result, const char *brief_json,
+                             const void *pack, size_t pack_len, const char *summary,
+                             const char *arrays, int *src, int *read_errno)
 {
+    int changes = 0;
+    if (brief_json) {
+        *src = write_small(db, "UPDATE jobs SET brief=?2 WHERE id=?1", id, brief_json, NULL,
+                           &changes);
+        if (*src != SQLITE_OK || changes != 1) return STORE_ERROR;
+    }
+    char *buf = result->mem ? NULL : malloc(STORE_PIECE);
+    if (!result->mem && !buf) {
+        *src = SQLITE_NOMEM;
+        return STORE_ERROR;
+    }
+    *src = write_pieces(db, "INSERT OR REPLACE INTO results(seq, result) VALUES (?1, ?2)",
+                        "results", "result", seq, result, buf, read_errno);
+    free(buf);
+    if (*src != SQLITE_OK) return STORE_ERROR;
+    if (pack) {
+        store_text p = {pack, -1, pack_len};
+        *src = write_pieces(db, "INSERT OR REPLACE INTO exports(seq, pack) VALUES (?1, ?2)",
+                            "exports", "pack", seq, &p, NULL, read_errno);
+        if (*src != SQLITE_OK) return STORE_ERROR;
+    }
+    if (summary) {
+        *src = write_small(db, "INSERT OR REPLACE INTO summaries(seq, summary, arrays) "
+                               "SELECT seq, ?2, ?3 FROM jobs WHERE id=?1",
+                           id, summary, arrays, &changes);
+        if (*src != SQLITE_OK || changes != 1) return STORE_ERROR;
+    }
+    return STORE_OK;
+}
+
+/* store_succeed's transaction (store.c made the summary and checked the arguments) */
+static store_rc sq_succeed(const char *id, const store_text *result, const char *progress_json,
+                           const char *brief_json, const void *pack, size_t pack_len,
+                           const char *summary, size_t slen, const char *arrays, gpd_err *why)
+{
+    (void)slen;
     sqlite3 *db = conn();
     if (!db) {
         gpd_err_set(why, 500, "no connection to the database");
         return STORE_ERROR;
     }
-    if (too_big(db, rlen, pack, pack_len, why)) return STORE_TOOBIG;
+    if (too_big(db, result->len, pack, pack_len, why)) return STORE_TOOBIG;
     char now[40];
     gpd_now_rfc3339(now, sizeof now);
     /* The result, the pack and the status change commit together: a job never shows
      * succeeded without its files. Every SQLite code is checked: a failure anywhere rolls the
      * whole transaction back, so the job stays running for the caller to retry or fail. */
-    int changes = 0, src = sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL);
+    int read_errno = 0, src = sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL);
     store_rc rc = STORE_ERROR;
+    sqlite3_int64 seq = 0;
     if (src == SQLITE_OK) {
-        src = write_value(db, "UPDATE jobs SET status='succeeded', result=?2, progress=?3, "
-                              "finished_at=?4, error=NULL WHERE id=?1 AND status='running'",
-                          id, result_json, rlen, 1, progress_json, now, &changes);
-        if (src == SQLITE_OK) rc = changes > 0 ? STORE_OK : STORE_CONFLICT;
+        src = mark_succeeded(db, id, progress_json, now, &seq);
+        if (src == SQLITE_OK) rc = seq > 0 ? STORE_OK : STORE_CONFLICT;
     }
-    if (rc == STORE_OK && brief_json) {
-        src = write_value(db, "UPDATE jobs SET brief=?2 WHERE id=?1", id, brief_json,
-                          strlen(brief_json), 1, NULL, NULL, &changes);
-        rc = src == SQLITE_OK && changes == 1 ? STORE_OK : STORE_ERROR;
-    }
-    if (rc == STORE_OK && pack) {
-        src = write_value(db, "INSERT OR REPLACE INTO exports(seq, pack) "
-                              "SELECT seq, ?2 FROM jobs WHERE id=?1",
-                          id, pack, pack_len, 0, NULL, NULL, &changes);
-        rc = src == SQLITE_OK && changes == 1 ? STORE_OK : STORE_ERROR;
-    }
-    if (rc == STORE_OK && summary) {
-        src = write_value(db, "INSERT OR REPLACE INTO summaries(seq, summary, arrays) "
-                              "SELECT seq, ?2, ?3 FROM jobs WHERE id=?1",
-                          id, summary, slen, 1, arrays, NULL, &changes);
-        rc = src == SQLITE_OK && changes == 1 ? STORE_OK : STORE_ERROR;
-    }
-    return succeed_end(db, id, rc, src, why);
+    if (rc == STORE_OK)
+        rc = succeed_rows(db, id, seq, result, brief_json, pack, pack_len, summary, arrays,
+                          &src, &read_errno);
+    return succeed_end(db, id, rc, src, read_errno, why);
 }
 
 /* ------------------------------------------------------------------ streams */
@@ -883,9 +996,13 @@ static store_rc sq_stream_open(const char *id, const char *what, size_t small,
     sqlite3_int64 seq = st ? sqlite3_column_int64(st, 1) : 0;
     done(st);
     if (rc != STORE_OK) return rc;
-    const char *table = is_pack ? "exports" : "jobs", *column = is_pack ? "pack" : "result";
+    /* a result is in results, or in jobs.result when it was stored before that table */
+    const char *table = is_pack ? "exports" : "results", *column = is_pack ? "pack" : "result";
     sqlite3_blob *b;
-    if (blob_open(db, table, column, seq, &b)) return STORE_OK; /* no value */
+    if (blob_open(db, table, column, seq, &b)) {
+        if (is_pack || blob_open(db, "jobs", "result", seq, &b)) return STORE_OK; /* none */
+        table = "jobs";
+    }
     uint64_t size = (uint64_t)sqlite3_blob_bytes(b);
     if (size <= small) rc = read_small(b, size, text, text_len) ? STORE_ERROR : STORE_OK;
     sqlite3_blob_close(b);
@@ -1115,8 +1232,9 @@ static store_rc sq_purge(const char *id, char status_out[16])
     sqlite3_int64 seq = st ? sqlite3_column_int64(st, 1) : 0;
     done(st);
     if (rc == STORE_OK && !store_is_finished(status_out)) rc = STORE_CONFLICT;
-    /* the pack and the summary first (keyed by the job's seq), then the row with its result */
-    static const char *const del[] = {"DELETE FROM exports WHERE seq=?1",
+    /* the result, the pack and the summary first (keyed by the job's seq), then the row */
+    static const char *const del[] = {"DELETE FROM results WHERE seq=?1",
+                                      "DELETE FROM exports WHERE seq=?1",
                                       "DELETE FROM summaries WHERE seq=?1",
                                       "DELETE FROM jobs WHERE seq=?1"};
     for (size_t i = 0; rc == STORE_OK && i < sizeof del / sizeof *del; i++) {
@@ -1182,6 +1300,60 @@ static int sq_purge_finished_before(const char *before, int max)
  * of the write lock */
 #define RECLAIM_STEP_SQL "PRAGMA incremental_vacuum(1024)"
 
+/* The connection of a checkpoint that yields to jobs (store_checkpoint(1)), for
+ * store_checkpoint_yield; guarded by ckpt_mu, so that it is never interrupted once done. */
+static pthread_mutex_t ckpt_mu = PTHREAD_MUTEX_INITIALIZER;
+static sqlite3 *ckpt_db = NULL;
+
+static void sq_checkpoint_yield(void)
+{
+    pthread_mutex_lock(&ckpt_mu);
+    if (ckpt_db) sqlite3_interrupt(ckpt_db);
+    pthread_mutex_unlock(&ckpt_mu);
+}
+
+/* PASSIVE first: it copies the WAL into the database (after a large result: hundreds of MB,
+ * seconds) taking no lock that a writer or a reader waits for; with may_yield a claim
+ * interrupts it (SQLite checks the interrupt in its copy loop; what was copied is copied
+ * again next time). Then TRUNCATE: the WAL goes back to nothing and the file to its pages in
+ * use; it needs the write lock and every reader on the newest snapshot, so with no busy
+ * handler a writer at that moment or a download in progress makes it answer SQLITE_BUSY at
+ * once instead of waiting; what it still copies is only what was committed since the PASSIVE
+ * pass. */
+static int checkpoint_on(sqlite3 *db, int may_yield)
+{
+    if (may_yield) {
+        pthread_mutex_lock(&ckpt_mu);
+        ckpt_db = db;
+        pthread_mutex_unlock(&ckpt_mu);
+    }
+    int rc = sqlite3_wal_checkpoint_v2(db, "main", SQLITE_CHECKPOINT_PASSIVE, NULL, NULL);
+    if (may_yield) {
+        pthread_mutex_lock(&ckpt_mu);
+        ckpt_db = NULL;
+        pthread_mutex_unlock(&ckpt_mu);
+        /* an interrupt that came after the copy would stop this connection's next statement:
+         * a statement started with none active clears it */
+        sqlite3_exec(db, "SELECT 1", NULL, NULL, NULL);
+    }
+    if (rc == SQLITE_INTERRUPT) return 2;
+    if (rc != SQLITE_OK && rc != SQLITE_BUSY && rc != SQLITE_LOCKED)
+        gpd_log(GPD_LOG_WARN, "sqlite passive checkpoint: %s", sqlite3_errmsg(db));
+    sqlite3_busy_timeout(db, 0);
+    rc = sqlite3_wal_checkpoint_v2(db, "main", SQLITE_CHECKPOINT_TRUNCATE, NULL, NULL);
+    sqlite3_busy_timeout(db, 5000);
+    if (rc == SQLITE_OK) return 0;
+    if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) return 1;
+    gpd_log(GPD_LOG_WARN, "sqlite checkpoint: %s", sqlite3_errmsg(db));
+    return -1;
+}
+
+static int sq_checkpoint(int may_yield)
+{
+    sqlite3 *db = conn();
+    return db ? checkpoint_on(db, may_yield) : -1;
+}
+
 static int sq_reclaim(void)
 {
     sqlite3 *db = conn();
@@ -1201,16 +1373,7 @@ static int sq_reclaim(void)
             }
         }
     }
-    /* TRUNCATE: the WAL goes back to nothing and the file to its pages in use; it needs every
-     * reader on the newest snapshot, so with no busy handler a download in progress makes it
-     * answer SQLITE_BUSY at once (after a passive checkpoint) instead of waiting for it */
-    sqlite3_busy_timeout(db, 0);
-    int rc = sqlite3_wal_checkpoint_v2(db, "main", SQLITE_CHECKPOINT_TRUNCATE, NULL, NULL);
-    sqlite3_busy_timeout(db, 5000);
-    if (rc == SQLITE_OK) return 0;
-    if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) return 1;
-    gpd_log(GPD_LOG_WARN, "sqlite checkpoint: %s", sqlite3_errmsg(db));
-    return -1;
+    return checkpoint_on(db, 0);
 }
 
 static int sq_count_by_kind(void (*fn)(void *user, const char *kind, const char *status, long n),
@@ -1252,6 +1415,22 @@ static int sq_size(long long *bytes)
     return 0;
 }
 
+/* the database's directory: a worker's temporary result file goes on the same disk */
+static char *sq_spill_dir(void)
+{
+    char *dir = path_copy();
+    char *slash = dir ? strrchr(dir, '/') : NULL;
+    if (slash == dir && dir) /* "/x.db" */
+        dir[1] = 0;
+    else if (slash)
+        *slash = 0;
+    else if (dir) {
+        free(dir);
+        dir = strdup(".");
+    }
+    return dir;
+}
+
 const store_backend store_sqlite = {
     .name = "sqlite",
     .open = sq_open,
@@ -1267,12 +1446,15 @@ const store_backend store_sqlite = {
     .claim = sq_claim,
     .progress = sq_progress,
     .succeed = sq_succeed,
+    .spill_dir = sq_spill_dir,
     .fail = sq_fail,
     .requeue = sq_requeue,
     .cancel = sq_cancel,
     .purge = sq_purge,
     .purge_finished_before = sq_purge_finished_before,
     .reclaim = sq_reclaim,
+    .checkpoint = sq_checkpoint,
+    .checkpoint_yield = sq_checkpoint_yield,
     .count_by_kind = sq_count_by_kind,
     .size = sq_size,
     .stream_open = sq_stream_open,

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <jansson.h>
 
@@ -378,11 +379,13 @@ static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err, const
     finish_failed(ctx->id, ctx->kind->name, ctx->t0, gp_status_name(st), msg);
 }
 
-/* The result text, the "done" progress and the pack committed with status succeeded; a write
- * the database refuses is tried once more, and a result it can never take fails the job.
- * timings: the result's "timings" (may be NULL), observed by the metrics once it is stored. */
-static void store_result(run_ctx *ctx, const char *text, const char *prog, const char *brief,
-                         const void *pack, size_t pack_len, const json_t *timings)
+/* The result text (in memory or in its temporary file), the "done" progress and the pack
+ * committed with status succeeded; a write the database refuses is tried once more, and a
+ * result it can never take fails the job. timings: the result's "timings" (may be NULL),
+ * observed by the metrics once it is stored. */
+static void store_result(run_ctx *ctx, const store_text *text, const char *prog,
+                         const char *brief, const void *pack, size_t pack_len,
+                         const json_t *timings)
 {
     gpd_err why;
     store_rc rc = store_succeed(ctx->id, text, prog, brief, pack, pack_len, &why);
@@ -395,8 +398,8 @@ static void store_result(run_ctx *ctx, const char *text, const char *prog, const
     char msg[600];
     if (rc == STORE_OK) {
         double run_s = gpd_monotonic_s() - ctx->t0;
-        gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%zu bytes)", ctx->id, run_s,
-                strlen(text));
+        gpd_log(GPD_LOG_INFO, "job %s succeeded in %.3f s (%llu bytes)", ctx->id, run_s,
+                (unsigned long long)text->len);
         metrics_job_finished(ctx->kind->name, "succeeded", run_s);
         metrics_job_timings(ctx->kind, timings);
     } else if (rc == STORE_TOOBIG) {
@@ -409,11 +412,12 @@ static void store_result(run_ctx *ctx, const char *text, const char *prog, const
     /* STORE_CONFLICT: cancelled by a DELETE meanwhile */
 }
 
-/* Stores a result (its text, taken; head: its small members, taken) and the export pack
- * (takes pack, may be NULL) together with status succeeded and the "done" progress (takes
- * detail, NULL = {}). The text was written to the end (finish_built); it is stored even when a
- * shutdown came meanwhile, not after a DELETE (the job is cancelled). */
-static void finish_succeeded(run_ctx *ctx, char *text, json_t *head, json_t *detail,
+/* Stores a result (its text, in memory or in its temporary file: both taken; head: its small
+ * members, taken) and the export pack (takes pack, may be NULL) together with status succeeded
+ * and the "done" progress (takes detail, NULL = {}). The text was written to the end
+ * (finish_built); it is stored even when a shutdown came meanwhile, not after a DELETE (the job
+ * is cancelled). */
+static void finish_succeeded(run_ctx *ctx, store_text text, json_t *head, json_t *detail,
                              void *pack, size_t pack_len)
 {
     result_phase_stop(ctx); /* what follows writes the job's final state */
@@ -438,24 +442,32 @@ static void finish_succeeded(run_ctx *ctx, char *text, json_t *head, json_t *det
         finish_failed(ctx->id, ctx->kind->name, ctx->t0, "internal",
                       "out of memory while serialising the result");
     } else {
-        store_result(ctx, text, prog, brief, pack, pack_len, json_object_get(head, "timings"));
+        store_result(ctx, &text, prog, brief, pack, pack_len, json_object_get(head, "timings"));
     }
     free(brief);
     json_decref(head);
     json_decref(detail);
-    free(text);
+    free((char *)text.mem);
+    if (text.fd >= 0) close(text.fd); /* the unlinked file goes with it */
     free(prog);
     free(pack);
 }
 
-/* The result could not be written: cancelled meanwhile, or out of memory. */
-static void result_not_built(run_ctx *ctx)
+/* The result could not be written: cancelled meanwhile, out of memory, or its temporary file
+ * could not be written (io_errno, 0: it was not that). */
+static void result_not_built(run_ctx *ctx, int io_errno)
 {
-    if (__atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED))
+    char msg[200];
+    if (__atomic_load_n(&ctx->s->cancel, __ATOMIC_RELAXED)) {
         finish_not_ok(ctx, GP_ERR_CANCELLED, NULL, NULL);
-    else
+    } else if (io_errno) {
+        snprintf(msg, sizeof msg, "the result's temporary file could not be written: %s",
+                 strerror(io_errno));
+        finish_failed(ctx->id, ctx->kind->name, ctx->t0, "store_error", msg);
+    } else {
         finish_failed(ctx->id, ctx->kind->name, ctx->t0, "internal",
                       "out of memory while building the result");
+    }
 }
 
 static void unavailable(const char *id, const char *kind)
@@ -466,27 +478,35 @@ static void unavailable(const char *id, const char *kind)
 }
 
 /* A built specimen (taken) becomes the result, the export pack and the final "done" detail of
- * the job, stored together; a result that could not be written is dropped (cancelled, or out
- * of memory). The result's text is written straight from the specimen (result_json.h): the
- * worker holds the specimen, the text and the pack at once, never a tree of the specimen. */
+ * the job, stored together; a result that could not be written is dropped (cancelled, out of
+ * memory, its file not written). The result's text is written straight from the specimen
+ * (result_json.h) and, past a few MB, straight into a temporary file that the store copies
+ * into the database in pieces (store_spill_dir: SQLite): the worker holds the specimen, a few
+ * MB of text and the pack, never a tree of the specimen nor the text twice. */
 static void finish_built(run_ctx *ctx, const void *spec, const json_t *spec_json, void *out)
 {
     const gpd_kind *k = ctx->kind;
     result_phase_start(ctx, out);
     gpd_jw w;
     gpd_jw_init(&w, &ctx->s->cancel);
+    char *dir = store_spill_dir();
+    if (dir) gpd_jw_spill(&w, dir, 0);
+    free(dir);
     /* a testing hook: GRAINPACK_TEST_RESULT_PAUSE_MS slows the writing (a pause at each look
      * at the flag), so that the tests can cancel a job in its result phase */
     const char *pause = getenv("GRAINPACK_TEST_RESULT_PAUSE_MS");
     w.pause_s = pause ? atof(pause) / 1e3 : 0;
     json_t *head = k->result(out, spec, spec_json, &w);
-    char *text = head ? gpd_jw_take(&w, NULL) : NULL;
+    char *mem = NULL;
+    store_text text = {NULL, -1, 0};
+    int frc = head ? gpd_jw_finish(&w, &mem, &text.fd, &text.len) : -1;
+    text.mem = mem;
     gpd_jw_free(&w);
-    if (!text) { /* cancelled (the writer stopped at the flag) or out of memory */
+    if (frc != 0) { /* cancelled (the writer stopped at the flag), out of memory, a failed write */
         result_phase_stop(ctx);
         json_decref(head);
         k->destroy(out);
-        result_not_built(ctx);
+        result_not_built(ctx, frc > 0 ? frc : 0);
         return;
     }
     void *pack = NULL;
@@ -497,8 +517,8 @@ static void finish_built(run_ctx *ctx, const void *spec, const json_t *spec_json
     json_t *detail = k->done_detail ? k->done_detail(ctx->id, out) : NULL;
     k->destroy(out);
 #ifdef __GLIBC__
-    /* the specimen's heap back before the store copies the text (100,000 grains: ~350 MB,
-     * which glibc would otherwise keep resident through the write) */
+    /* the specimen's heap back before the store copies the text and the pack (100,000 grains:
+     * ~350 MB, which glibc would otherwise keep resident through the write) */
     malloc_trim(0);
 #endif
     finish_succeeded(ctx, text, head, detail, pack, pack_len);
