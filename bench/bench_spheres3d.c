@@ -31,6 +31,26 @@ static double psd_error(const gp_stats3d *S)
     return werr;
 }
 
+/* The specimen of spec s, timed: *cpu the process CPU seconds of the build, *st its status
+ * (and e its message); NULL (after printing why) when there is nothing to report. */
+static gp_specimen3d *build_timed(const gp_spec3d *s, double *cpu, gp_status *st, gp_error *e)
+{
+    gp_specimen3d *r = NULL;
+    double c0 = cpu_seconds();
+    *st = gp_specimen3d_build(s, NULL, NULL, NULL, &r, e);
+    *cpu = cpu_seconds() - c0;
+    if (!r)
+        printf("build failed: %s\n", e->message);
+    return r;
+}
+
+/* the DEM's millions of sphere-steps per second over its three phases */
+static double dem_rate(const gp_specimen3d *r)
+{
+    double dem = r->t_deposition + r->t_compaction + r->t_relaxation;
+    return r->stats.steps * (double)r->stats.sample_particles / dem / 1e6;
+}
+
 /* --sample: the paper's sample alone, one row */
 static int sample_row(int threads, unsigned long long seed)
 {
@@ -38,25 +58,20 @@ static int sample_row(int threads, unsigned long long seed)
     gp_spec3d_defaults(&s);
     s.threads = threads;
     s.seed = seed;
-    gp_specimen3d *r = NULL;
+    double cpu;
+    gp_status st;
     gp_error e;
-    double c0 = cpu_seconds();
-    gp_status st = gp_specimen3d_build(&s, NULL, NULL, NULL, &r, &e);
-    double cpu = cpu_seconds() - c0;
-    if (!r) {
-        printf("build failed: %s\n", e.message);
+    gp_specimen3d *r = build_timed(&s, &cpu, &st, &e);
+    if (!r)
         return 1;
-    }
     const gp_stats3d *S = &r->stats;
-    double dem = r->t_deposition + r->t_compaction + r->t_relaxation;
     printf("| code | threads | spheres | steps | wall s | CPU s | M sphere-steps/s | S_c | stop | "
            "porosity | porosity error | max PSD error (pp) | z |\n"
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     printf("| grainpack | %d | %zu | %ld | %.3f | %.3f | %.2f | %.3g | %s%s%s | %.4f | %+.1e | %.2g | %.3f |\n",
-           threads, S->sample_particles, S->steps, r->t_total, cpu,
-           S->steps * (double)S->sample_particles / dem / 1e6, S->stability, S->stop_reason,
-           st ? ": " : "", st ? e.message : "", S->porosity, S->porosity - S->porosity_target,
-           psd_error(S), S->coordination_number);
+           threads, S->sample_particles, S->steps, r->t_total, cpu, dem_rate(r), S->stability,
+           S->stop_reason, st ? ": " : "", st ? e.message : "", S->porosity,
+           S->porosity - S->porosity_target, psd_error(S), S->coordination_number);
     gp_specimen3d_destroy(r);
     return st != GP_OK;
 }
@@ -103,17 +118,13 @@ int main(int argc, char **argv)
     if (argc > 3 && strcmp(argv[3], "--sample") == 0)
         return sample_row(s.threads, s.seed);
     s.outputs = GP_OUT3_SPHERES | GP_OUT3_CONTACTS | GP_OUT3_FABRIC | GP_OUT3_STRESS;
-    gp_specimen3d *r = NULL;
+    double cpu;
+    gp_status st;
     gp_error e;
-    double c0 = cpu_seconds();
-    gp_status st = gp_specimen3d_build(&s, NULL, NULL, NULL, &r, &e);
-    double cpu = cpu_seconds() - c0;
-    if (!r) {
-        printf("build failed: %s\n", e.message);
+    gp_specimen3d *r = build_timed(&s, &cpu, &st, &e);
+    if (!r)
         return 1;
-    }
     const gp_stats3d *S = &r->stats;
-    double dem = r->t_deposition + r->t_compaction + r->t_relaxation;
     printf("## spheres-3d, paper example (0.5 m cube, Table 1, Table 2, porosity 0.38), "
            "threads %d, seed %llu: %s%s\n", s.threads, (unsigned long long)s.seed,
            gp_status_name(st), st ? e.message : "");
@@ -121,7 +132,7 @@ int main(int argc, char **argv)
     printf("| deposition | %.2f |\n| compaction | %.2f |\n| relaxation | %.2f |\n| total | %.2f "
            "(CPU %.2f) |\n", r->t_deposition, r->t_compaction, r->t_relaxation, r->t_total, cpu);
     printf("| DEM | %ld steps x %zu spheres, dt %.3g s, %.2f M sphere-steps/s |\n", S->steps,
-           S->sample_particles, S->dt, S->steps * (double)S->sample_particles / dem / 1e6);
+           S->sample_particles, S->dt, dem_rate(r));
     printf("| result | porosity %.4f (target %.2f, error %+.1e), phase 0 %.3f, S_c %.2g (%s), "
            "z %.3f (spheres only %.3f) |\n", S->porosity, S->porosity_target,
            S->porosity - S->porosity_target, S->deposition_porosity, S->stability,

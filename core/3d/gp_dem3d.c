@@ -21,6 +21,12 @@
  *  - S_c, the kinetic energy and vmax are read only after a run, so only a run's last step
  *    sums them (a square root per sphere saved on every other step); the walls' forces and
  *    stiffnesses, which the servo needs, are summed on every step.
+ *  - speed (issue #16): the pair kernel and the sphere step run on vectors of four doubles
+ *    (GCC's generic vectors; an AVX2 clone picked at load time on x86-64, two SSE2 halves
+ *    elsewhere), branch-free where a branch would be a coin toss; every lane does the IEEE
+ *    operations of the scalar code in its order, so the bits are those of the scalar code
+ *    (the sample's spheres and contacts hash the same as before this layout) and the same
+ *    on any machine (-ffp-contract=off: no FMA).
  */
 #include "gp_dem3d.h"
 
@@ -66,17 +72,25 @@ typedef struct worker_arg {
     int tid;
 } worker_arg;
 
-/* the arrays of one pair list (capacity cap pairs) */
+/* The arrays of one pair list (capacity cap pairs). The per-pair reals are component planes
+ * (one array per component, all in one block) so that the pair kernel reads and writes them
+ * with unit stride and the compiler vectorises it. The contents are never kept across a
+ * reserve: a rebuild reserves the spare list, then fills all of it. */
+enum { PS_FS = 0, PS_F = 3, PS_C = 6, PS_FN = 9, PS_PLANES = 10 };
+
 typedef struct pair_set {
     size_t cap;
     uint32_t *pi, *pj;
-    double *fs, *F, *c, *fn;
+    double *buf;                   /* PS_PLANES planes of cap reals */
+    double *fs[3], *F[3], *c[3];   /* shear spring, force on i, n x fs: planes of buf */
+    double *fn;                    /* f_n (> 0 touching, -1 within free_gap, 0 beyond) */
+    uint32_t *idx;                 /* the touching pairs of a step (pair_kernel) */
     size_t *adj;
 } pair_set;
 
 static void pair_set_free(pair_set *p)
 {
-    free(p->pi); free(p->pj); free(p->fs); free(p->F); free(p->c); free(p->fn); free(p->adj);
+    free(p->pi); free(p->pj); free(p->buf); free(p->idx); free(p->adj);
     memset(p, 0, sizeof *p);
 }
 
@@ -85,35 +99,35 @@ static int pair_set_reserve(pair_set *p, size_t cap)
     if (cap <= p->cap)
         return 0;
     cap += cap / 4 + 64;
-    uint32_t *a = realloc(p->pi, cap * sizeof *a);
-    if (a) p->pi = a;
-    uint32_t *b = realloc(p->pj, cap * sizeof *b);
-    if (b) p->pj = b;
-    double *fs = realloc(p->fs, 3 * cap * sizeof *fs);
-    if (fs) p->fs = fs;
-    double *F = realloc(p->F, 3 * cap * sizeof *F);
-    if (F) p->F = F;
-    double *c = realloc(p->c, 3 * cap * sizeof *c);
-    if (c) p->c = c;
-    double *fn = realloc(p->fn, cap * sizeof *fn);
-    if (fn) p->fn = fn;
-    size_t *adj = realloc(p->adj, 2 * cap * sizeof *adj);
-    if (adj) p->adj = adj;
-    if (!a || !b || !fs || !F || !c || !fn || !adj)
+    pair_set_free(p);
+    p->pi = malloc(cap * sizeof *p->pi);
+    p->pj = malloc(cap * sizeof *p->pj);
+    p->buf = malloc(PS_PLANES * cap * sizeof *p->buf);
+    p->idx = malloc(cap * sizeof *p->idx);
+    p->adj = malloc(2 * cap * sizeof *p->adj);
+    if (!p->pi || !p->pj || !p->buf || !p->idx || !p->adj) {
+        pair_set_free(p);
         return -1;
+    }
+    for (int a = 0; a < 3; a++) {
+        p->fs[a] = p->buf + (PS_FS + a) * cap;
+        p->F[a] = p->buf + (PS_F + a) * cap;
+        p->c[a] = p->buf + (PS_C + a) * cap;
+    }
+    p->fn = p->buf + PS_FN * cap;
     p->cap = cap;
     return 0;
 }
 
 struct gp_dem3d {
     size_t n;
-    double *x, *v, *w;         /* 3n */
+    double *x, *v, *w;         /* 3n (+ 1 double of padding: see gather3) */
     double *r0, *r;            /* full and current radii */
     double *m, *minv, *iinv;   /* true mass; inverse inertial mass and moment */
     double *xref;              /* positions at the last rebuild */
     double *mtinv;             /* 1 / true mass (free flight) */
-    /* the step's sums per sphere, in pair order (see step_forces): force (3n, starting from
-     * gravity), moment (3n), sum of f_n (n), a surface within free_gap (n) */
+    /* one thread's sums per sphere while a step runs, in pair order (see step_serial): force
+     * (3n, starting from gravity), moment (3n), sum of f_n (n), a surface within free_gap (n) */
     double *af, *at, *afn;
     unsigned char *anear;
     double rscale, rscale_ref, r0max, r0min;
@@ -125,8 +139,9 @@ struct gp_dem3d {
     /* candidate pairs (i < j), sorted */
     size_t np;
     pair_set cur, spare;       /* the list in use, and the buffers the next rebuild fills */
-    uint32_t *pi, *pj;         /* = cur.pi, cur.pj, ... (short names for the hot loops) */
-    double *pfs, *pF, *pc, *pfn; /* shear spring (3), force on i (3), n x fs (3), f_n */
+    uint32_t *pi, *pj;         /* = cur.pi, cur.pj, cur.fn (short names) */
+    double *pfn;
+    size_t *ioff;              /* pairs of sphere i as the first: ioff[i] .. ioff[i + 1] - 1 */
     /* per-sphere pair lists: entries (pair << 1) | (sphere is j) */
     size_t *off, *fill;
     size_t *adj;
@@ -245,7 +260,7 @@ static void pool_stop(gp_dem3d *d)
     p->started = 0;
 }
 
-/* more than one thread: forces per pair, then gathered per sphere (see step_forces) */
+/* more than one thread: forces per pair, then gathered per sphere (see step) */
 static int threaded(const gp_dem3d *d) { return d->pool.started && d->pool.nt > 1; }
 
 /* ------------------------------------------------------------------ create / destroy */
@@ -278,7 +293,7 @@ void gp_dem3d_destroy(gp_dem3d *d)
         free(d->lv_start[L]);
         free(d->lv_list[L]);
     }
-    free(d->off); free(d->fill);
+    free(d->off); free(d->ioff); free(d->fill);
     free(d->cell_of); free(d->level);
     free(d->blk);
     free(d);
@@ -302,9 +317,10 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
     if (!d)
         return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory");
     d->n = n;
-    d->x = malloc(3 * n * sizeof *d->x);
-    d->v = calloc(3 * n, sizeof *d->v);
-    d->w = calloc(3 * n, sizeof *d->w);
+    /* one double past the last sphere: the kernel reads each sphere's x, y, z as four */
+    d->x = calloc(3 * n + 1, sizeof *d->x);
+    d->v = calloc(3 * n + 1, sizeof *d->v);
+    d->w = calloc(3 * n + 1, sizeof *d->w);
     d->xref = malloc(3 * n * sizeof *d->xref);
     d->r0 = malloc(n * sizeof *d->r0);
     d->r = malloc(n * sizeof *d->r);
@@ -317,13 +333,14 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
     d->afn = malloc(n * sizeof *d->afn);
     d->anear = malloc(n);
     d->off = calloc(n + 1, sizeof *d->off);
+    d->ioff = calloc(n + 1, sizeof *d->ioff);
     d->fill = malloc(n * sizeof *d->fill);
     d->cell_of = malloc(n * sizeof *d->cell_of);
     d->level = malloc(n * sizeof *d->level);
     d->nblk = (n + BLK - 1) / BLK;
     d->blk = calloc(d->nblk, sizeof *d->blk);
     if (!d->x || !d->v || !d->w || !d->xref || !d->r0 || !d->r || !d->m || !d->minv || !d->iinv
-        || !d->mtinv || !d->af || !d->at || !d->afn || !d->anear || !d->off || !d->fill
+        || !d->mtinv || !d->af || !d->at || !d->afn || !d->anear || !d->off || !d->ioff || !d->fill
         || !d->cell_of || !d->level || !d->blk) {
         gp_dem3d_destroy(d);
         return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (%zu spheres)", n);
@@ -532,28 +549,35 @@ static gp_status level_grids(gp_dem3d *d, level_grid lv[NLEVEL], double reach, g
     return GP_OK;
 }
 
+/* Room in d->raw for one more pair (-1: out of memory). */
+static int raw_grow(gp_dem3d *d)
+{
+    size_t c = d->raw_cap + d->raw_cap / 2 + 1024;
+    uint32_t *b2 = realloc(d->raw, 2 * c * sizeof *b2);
+    if (!b2)
+        return -1;
+    d->raw = b2;
+    d->raw_cap = c;
+    return 0;
+}
+
 /* Appends the pair (a, b) to d->raw when its gap is below reach. The test is written on
- * (min, max) so that it gives the same bits whichever sphere found the pair. */
-static int try_pair(gp_dem3d *d, size_t a, size_t b, double reach, size_t *m)
+ * (min, max) so that it gives the same bits whichever sphere found the pair. Inlined into
+ * the cell loops, and branch-free: the pair is always written and counted only when it
+ * passes (one test in ten or so does, at random). */
+static inline __attribute__((always_inline)) int try_pair(gp_dem3d *d, size_t a, size_t b,
+                                                          double reach, size_t *m)
 {
     size_t i = a < b ? a : b, j = a < b ? b : a;
     const double *x = d->x;
     double ex = x[3 * j] - x[3 * i], ey = x[3 * j + 1] - x[3 * i + 1];
     double ez = x[3 * j + 2] - x[3 * i + 2];
     double rr = d->r[i] + reach + d->r[j];
-    if (!(ex * ex + ey * ey + ez * ez < rr * rr))
-        return 0;
-    if (*m == d->raw_cap) {
-        size_t c = d->raw_cap + d->raw_cap / 2 + 1024;
-        uint32_t *b2 = realloc(d->raw, 2 * c * sizeof *b2);
-        if (!b2)
-            return -1;
-        d->raw = b2;
-        d->raw_cap = c;
-    }
+    if (*m == d->raw_cap && raw_grow(d))
+        return -1;
     d->raw[2 * *m] = (uint32_t)i;
     d->raw[2 * *m + 1] = (uint32_t)j;
-    (*m)++;
+    *m += (size_t)(ex * ex + ey * ey + ez * ez < rr * rr);
     return 0;
 }
 
@@ -614,27 +638,27 @@ static int cross_pairs(gp_dem3d *d, size_t i, const level_grid *G, double reach,
     return 0;
 }
 
-/* The m pairs of d->raw into P sorted by (i, j): counted by i (d->off), then each sphere's
- * handful of partners by insertion. */
+/* The m pairs of d->raw into P sorted by (i, j): counted by i (d->ioff, which the serial
+ * force loop keeps), then each sphere's handful of partners by insertion. */
 static void sort_pairs(gp_dem3d *d, pair_set *P, size_t m)
 {
     size_t n = d->n;
-    memset(d->off, 0, (n + 1) * sizeof *d->off);
+    memset(d->ioff, 0, (n + 1) * sizeof *d->ioff);
     for (size_t k = 0; k < m; k++)
-        d->off[d->raw[2 * k] + 1]++;
+        d->ioff[d->raw[2 * k] + 1]++;
     for (size_t i = 0; i < n; i++)
-        d->off[i + 1] += d->off[i];
-    memcpy(d->fill, d->off, n * sizeof *d->fill);
+        d->ioff[i + 1] += d->ioff[i];
+    memcpy(d->fill, d->ioff, n * sizeof *d->fill);
     for (size_t k = 0; k < m; k++) {
         size_t e = d->fill[d->raw[2 * k]]++;
         P->pi[e] = d->raw[2 * k];
         P->pj[e] = d->raw[2 * k + 1];
     }
     for (size_t i = 0; i < n; i++)
-        for (size_t k = d->off[i] + 1; k < d->off[i + 1]; k++) {
+        for (size_t k = d->ioff[i] + 1; k < d->ioff[i + 1]; k++) {
             uint32_t v = P->pj[k];
             size_t q = k;
-            while (q > d->off[i] && P->pj[q - 1] > v) {
+            while (q > d->ioff[i] && P->pj[q - 1] > v) {
                 P->pj[q] = P->pj[q - 1];
                 q--;
             }
@@ -672,15 +696,18 @@ static gp_status find_candidates(gp_dem3d *d, const level_grid lv[NLEVEL], doubl
  * of P by (i, j): both lists are sorted by (i, j). */
 static void carry_springs(const gp_dem3d *d, pair_set *P, size_t np)
 {
-    memset(P->fs, 0, 3 * np * sizeof *P->fs);
+    const pair_set *C = &d->cur;
+    for (int a = 0; a < 3; a++)
+        memset(P->fs[a], 0, np * sizeof *P->fs[a]);
     memset(P->fn, 0, np * sizeof *P->fn);
     size_t o = 0;
     for (size_t k = 0; k < np && o < d->np; k++) {
-        while (o < d->np && (d->pi[o] < P->pi[k] || (d->pi[o] == P->pi[k] && d->pj[o] < P->pj[k])))
+        while (o < d->np && (C->pi[o] < P->pi[k] || (C->pi[o] == P->pi[k] && C->pj[o] < P->pj[k])))
             o++;
-        if (o < d->np && d->pi[o] == P->pi[k] && d->pj[o] == P->pj[k]) {
-            memcpy(P->fs + 3 * k, d->pfs + 3 * o, 3 * sizeof *P->fs);
-            P->fn[k] = d->pfn[o]; /* job_pairs clears the spring of a contact that opens */
+        if (o < d->np && C->pi[o] == P->pi[k] && C->pj[o] == P->pj[k]) {
+            for (int a = 0; a < 3; a++)
+                P->fs[a][k] = C->fs[a][o];
+            P->fn[k] = C->fn[o]; /* the pair kernel clears the spring of a contact that opens */
         }
     }
 }
@@ -723,14 +750,13 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
     if ((st = find_candidates(d, lv, reach, P, &np, err)))
         return st;
     carry_springs(d, P, np);
-    if (threaded(d)) /* one thread sums the forces in the pair loop (step_forces) */
+    if (threaded(d)) /* one thread sums the forces in pair order (step_serial) */
         pair_adjacency(d, P, np);
     pair_set t = d->cur;
     d->cur = *P;
     *P = t;
     d->np = np;
-    d->pi = d->cur.pi; d->pj = d->cur.pj; d->pfs = d->cur.fs; d->pF = d->cur.F;
-    d->pc = d->cur.c; d->pfn = d->cur.fn; d->adj = d->cur.adj;
+    d->pi = d->cur.pi; d->pj = d->cur.pj; d->pfn = d->cur.fn; d->adj = d->cur.adj;
     memcpy(d->xref, d->x, 3 * n * sizeof *d->x);
     d->rscale_ref = d->rscale;
     d->need_rebuild = 0;
@@ -751,211 +777,263 @@ static pair_consts consts_of(const gp_dem3d *d)
     return q;
 }
 
-/* Candidate pair k = (i, j) (Eqs. 1-3): updates its shear spring and its f_n (d->pfn: > 0
- * touching, -1 within free_gap, 0 beyond; job_spheres reads -1 as "not in free flight") and,
- * when the spheres touch, returns 1 with the force on i in F and n x f_s in c (the moment of
- * the pair on either sphere is that sphere's radius times c). */
-static inline int pair_force(gp_dem3d *d, const pair_consts *q, size_t k, size_t i, size_t j,
-                             double F[3], double c[3])
+/* ---- the pair kernel (Eqs. 1-3), four pairs at a time ----
+ * Two passes: sift_pairs finds which candidates touch (a third of them do not, most of them
+ * early in a run) and settles those that do not; touch_pairs computes the contacts. Both
+ * are written on GCC's generic vectors of four doubles: every branch is a select (bitwise,
+ * on the comparison masks), every square root and quotient is taken in all lanes and only
+ * its result selected. A lane computes exactly what the scalar expressions do (IEEE sqrt
+ * and division are correctly rounded in any width, and -ffp-contract=off forbids FMA), so
+ * the bits depend neither on the width the machine runs (the AVX2 clone or two SSE2
+ * halves) nor on where a thread's range of pairs starts. */
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4l __attribute__((vector_size(32)));
+#define VL 4
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) \
+    && !defined(GP_DEM3D_NO_CLONES) /* (-D to build the default alone: compare the bits) */
+#define KERNEL_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define KERNEL_CLONES
+#endif
+/* Every function that takes or returns a vector is inlined into its caller: called across
+ * targets (a clone and the default), a vector would pass by two conventions (-Wpsabi). */
+#define VINLINE static inline __attribute__((always_inline))
+
+VINLINE v4d vsel(v4l m, v4d a, v4d b) { return (v4d)((m & (v4l)a) | (~m & (v4l)b)); }
+VINLINE v4d vsqrt(v4d a)
 {
-    const double *x = d->x, *v = d->v, *w = d->w, *r = d->r;
-    double dx = x[3 * j] - x[3 * i], dy = x[3 * j + 1] - x[3 * i + 1];
-    double dz = x[3 * j + 2] - x[3 * i + 2];
-    double ri = r[i], rj = r[j], R = ri + rj;
-    double d2 = dx * dx + dy * dy + dz * dz;
-    double *fs = d->pfs + 3 * k;
-    if (d2 >= R * R || d2 == 0) {
-        /* the spring goes when the contact opens */
-        if (d->pfn[k] > 0)
-            fs[0] = fs[1] = fs[2] = 0;
-        double rg = R + q->gap;
-        d->pfn[k] = d2 < rg * rg ? -1 : 0;
-        return 0;
-    }
-    double dist = sqrt(d2), id = 1.0 / dist;
-    double nx = dx * id, ny = dy * id, nz = dz * id;
-    double ov = R - dist;
-    double kn = q->E2 * ri * rj / R;
-    double fn = kn * ov;
-    /* contact-point velocities: i at +ri n, j at -rj n */
-    const double *vi = v + 3 * i, *vj = v + 3 * j, *wi = w + 3 * i, *wj = w + 3 * j;
-    double vrx = vi[0] - vj[0] + ri * (wi[1] * nz - wi[2] * ny) + rj * (wj[1] * nz - wj[2] * ny);
-    double vry = vi[1] - vj[1] + ri * (wi[2] * nx - wi[0] * nz) + rj * (wj[2] * nx - wj[0] * nz);
-    double vrz = vi[2] - vj[2] + ri * (wi[0] * ny - wi[1] * nx) + rj * (wj[0] * ny - wj[1] * nx);
-    double vn = vrx * nx + vry * ny + vrz * nz;
-    double vtx = vrx - vn * nx, vty = vry - vn * ny, vtz = vrz - vn * nz;
-    /* keep the spring tangent (rotate with the contact, same magnitude) */
-    double sx = fs[0], sy = fs[1], sz = fs[2];
-    double s2 = sx * sx + sy * sy + sz * sz;
-    if (s2 > 0) {
-        double sn = sx * nx + sy * ny + sz * nz;
-        sx -= sn * nx; sy -= sn * ny; sz -= sn * nz;
-        double t2 = sx * sx + sy * sy + sz * sz;
-        if (t2 > 0) {
-            double f = sqrt(s2 / t2);
-            sx *= f; sy *= f; sz *= f;
+    v4d r;
+    for (int l = 0; l < VL; l++)
+        r[l] = sqrt(a[l]);
+    return r;
+}
+VINLINE v4d vsplat(double a) { return (v4d){a, a, a, a}; }
+/* p[s * k[l] + o] in lane l: built in registers (stored lane by lane and read back whole,
+ * it would stall on store forwarding) */
+VINLINE v4d gather(const double *p, size_t s, const size_t k[VL], size_t o)
+{
+    return (v4d){p[s * k[0] + o], p[s * k[1] + o], p[s * k[2] + o], p[s * k[3] + o]};
+}
+
+#if defined(__clang__)
+#define SHUF(a, b, p, q, r, s) __builtin_shufflevector(a, b, p, q, r, s)
+#else
+#define SHUF(a, b, p, q, r, s) __builtin_shuffle(a, b, (v4l){p, q, r, s})
+#endif
+
+/* The 3-vectors p[3 k[l] .. 3 k[l] + 2] into x, y, z by lane: each read as four doubles
+ * (the arrays end with one double of padding), then transposed in registers (four loads
+ * and six shuffles instead of twelve loads and inserts). */
+VINLINE void gather3(const double *p, const size_t k[VL], v4d *x, v4d *y, v4d *z)
+{
+    v4d a0, a1, a2, a3;
+    memcpy(&a0, p + 3 * k[0], sizeof a0);
+    memcpy(&a1, p + 3 * k[1], sizeof a1);
+    memcpy(&a2, p + 3 * k[2], sizeof a2);
+    memcpy(&a3, p + 3 * k[3], sizeof a3);
+    v4d t0 = SHUF(a0, a1, 0, 4, 2, 6), t1 = SHUF(a0, a1, 1, 5, 3, 7);
+    v4d t2 = SHUF(a2, a3, 0, 4, 2, 6), t3 = SHUF(a2, a3, 1, 5, 3, 7);
+    *x = SHUF(t0, t2, 0, 1, 4, 5);
+    *y = SHUF(t1, t3, 0, 1, 4, 5);
+    *z = SHUF(t0, t2, 2, 3, 6, 7);
+}
+
+/* Pass 1 over the candidates k0 .. k1 - 1, VL at a time (a block's lanes from k1 on repeat
+ * pair k1 - 1 and are dropped): which touch (a pair at the same centre does not: no normal;
+ * NaN does, to be caught as a sphere that is not finite), into idx in pair order (returns
+ * how many); each other one gets f_n = -1 (within free_gap: the sphere step reads it as
+ * "not in free flight") or 0, and its spring goes if it was touching. mark: also set both
+ * spheres' d->anear (one thread only: two ranges may share a sphere). Branch-free but for
+ * an opening contact: whether a pair touches is a coin toss. */
+KERNEL_CLONES
+static size_t sift_pairs(gp_dem3d *d, size_t k0, size_t k1, uint32_t *idx, int mark)
+{
+    pair_set *P = &d->cur;
+    const double *x = d->x, *r = d->r;
+    unsigned char *anear = d->anear;
+    size_t m = 0;
+    for (size_t k = k0; k < k1; k += VL) {
+        size_t kk[VL], ii[VL], jj[VL];
+        for (int l = 0; l < VL; l++) {
+            kk[l] = k + (size_t)l < k1 ? k + (size_t)l : k1 - 1;
+            ii[l] = P->pi[kk[l]];
+            jj[l] = P->pj[kk[l]];
         }
-    }
-    double ks = q->ksr * kn;
-    sx -= ks * vtx * q->dt; sy -= ks * vty * q->dt; sz -= ks * vtz * q->dt;
-    double smax = q->mu * fn;
-    double ss = sx * sx + sy * sy + sz * sz;
-    if (ss > smax * smax) {
-        double f = ss > 0 ? smax / sqrt(ss) : 0;
-        sx *= f; sy *= f; sz *= f;
-    }
-    fs[0] = sx; fs[1] = sy; fs[2] = sz;
-    F[0] = -fn * nx + sx;
-    F[1] = -fn * ny + sy;
-    F[2] = -fn * nz + sz;
-    c[0] = ny * sz - nz * sy;
-    c[1] = nz * sx - nx * sz;
-    c[2] = nx * sy - ny * sx;
-    d->pfn[k] = fn;
-    return 1;
-}
-
-/* sums of sphere i before its pairs: gravity on the true mass, nothing else */
-static void sums_start(gp_dem3d *d, size_t i)
-{
-    double m = d->m[i];
-    for (int a = 0; a < 3; a++) {
-        d->af[3 * i + a] = m * d->g[a];
-        d->at[3 * i + a] = 0;
-    }
-    d->afn[i] = 0;
-    d->anear[i] = 0;
-}
-
-/* One thread: every pair once, in pair order, its force added to both spheres' sums at once
- * (a sphere's sums thus run over its pairs in pair order, as the threaded gather does: the
- * same bits). The forces on i stay in d->pF for gp_dem3d_contacts. Returns the contacts. */
-static size_t forces_serial(gp_dem3d *d)
-{
-    const pair_consts q = consts_of(d);
-    double *restrict af = d->af, *restrict at = d->at, *restrict afn = d->afn;
-    const uint32_t *pi = d->pi, *pj = d->pj;
-    const double *r = d->r;
-    size_t nc = 0;
-    for (size_t i = 0; i < d->n; i++)
-        sums_start(d, i);
-    for (size_t k = 0; k < d->np; k++) {
-        size_t i = pi[k], j = pj[k];
-        double F[3], c[3];
-        if (!pair_force(d, &q, k, i, j, F, c)) {
-            if (d->pfn[k] < 0)
-                d->anear[i] = d->anear[j] = 1;
-            continue;
-        }
-        double fn = d->pfn[k], ri = r[i], rj = r[j];
-        for (int a = 0; a < 3; a++) {
-            d->pF[3 * k + a] = F[a];
-            af[3 * i + a] += F[a];
-            af[3 * j + a] -= F[a];
-            at[3 * i + a] += ri * c[a];
-            at[3 * j + a] += rj * c[a];
-        }
-        afn[i] += fn;
-        afn[j] += fn;
-        nc++;
-    }
-    return nc;
-}
-
-/* threads, first half: each thread a range of pairs; force and n x f_s kept per pair */
-static void job_pairs(gp_dem3d *d, int tid, int nt)
-{
-    const pair_consts q = consts_of(d);
-    size_t np = d->np, nc = 0;
-    size_t k0 = np * (size_t)tid / (size_t)nt, k1 = np * (size_t)(tid + 1) / (size_t)nt;
-    for (size_t k = k0; k < k1; k++)
-        nc += (size_t)pair_force(d, &q, k, d->pi[k], d->pj[k], d->pF + 3 * k, d->pc + 3 * k);
-    d->tnc[tid] = nc;
-}
-
-/* threads, second half: each sphere's sums gathered from its pairs in pair order (d->adj) */
-static void job_gather(gp_dem3d *d, int tid, int nt)
-{
-    const double *restrict pfn = d->pfn, *restrict pF = d->pF, *restrict pc = d->pc;
-    const size_t *restrict adj = d->adj, *restrict off = d->off;
-    for (size_t b = (size_t)tid; b < d->nblk; b += (size_t)nt) {
-        size_t i0 = b * BLK, i1 = i0 + BLK < d->n ? i0 + BLK : d->n;
-        for (size_t i = i0; i < i1; i++) {
-            double ri = d->r[i];
-            double *F = d->af + 3 * i, *T = d->at + 3 * i;
-            sums_start(d, i);
-            for (size_t e = off[i]; e < off[i + 1]; e++) {
-                size_t k = adj[e] >> 1;
-                double fn = pfn[k];
-                if (fn <= 0) { /* not touching (an overlap always has f_n > 0); -1: near */
-                    d->anear[i] |= fn < 0;
-                    continue;
-                }
-                const double *Fk = pF + 3 * k, *ck = pc + 3 * k;
-                double sg = (adj[e] & 1) ? -1 : 1;
-                for (int a = 0; a < 3; a++) {
-                    F[a] += sg * Fk[a];
-                    T[a] += ri * ck[a];
-                }
-                d->afn[i] += fn;
+        v4d xi, yi, zi, xj, yj, zj;
+        gather3(x, ii, &xi, &yi, &zi);
+        gather3(x, jj, &xj, &yj, &zj);
+        v4d dx = xj - xi, dy = yj - yi, dz = zj - zi;
+        v4d R = gather(r, 1, ii, 0) + gather(r, 1, jj, 0);
+        v4d d2 = dx * dx + dy * dy + dz * dz, rg = R + d->free_gap;
+        v4l touch = ~((d2 >= R * R) | (d2 == 0)), near = ~touch & (d2 < rg * rg);
+        v4d fn0 = gather(P->fn, 1, kk, 0);
+        v4d fn = vsel(touch, fn0, vsel(near, vsplat(-1), vsplat(0)));
+        v4l opened = ~touch & (fn0 > 0);
+        size_t lanes = k1 - k < VL ? k1 - k : VL;
+        for (size_t l = 0; l < lanes; l++) {
+            P->fn[k + l] = fn[l];
+            idx[m] = (uint32_t)(k + l);
+            m += (size_t)(touch[l] & 1);
+            if (mark) {
+                anear[ii[l]] |= (unsigned char)(near[l] & 1);
+                anear[jj[l]] |= (unsigned char)(near[l] & 1);
             }
         }
+        if (opened[0] | opened[1] | opened[2] | opened[3]) /* the spring goes */
+            for (size_t l = 0; l < lanes; l++)
+                if (opened[l])
+                    P->fs[0][k + l] = P->fs[1][k + l] = P->fs[2][k + l] = 0;
+    }
+    return m;
+}
+
+/* The touching pairs kk[0 .. VL - 1] (Eqs. 1-3): each one's shear spring, f_n (> 0), force
+ * on i (F) and n x f_s (c: the moment of the pair on either sphere is that sphere's radius
+ * times c). A pair may repeat (a block's tail): it is computed twice from the same values. */
+VINLINE void touch_block(gp_dem3d *d, const pair_consts *q, const size_t kk[VL])
+{
+    pair_set *P = &d->cur;
+    size_t ii[VL], jj[VL];
+    for (int l = 0; l < VL; l++) {
+        ii[l] = P->pi[kk[l]];
+        jj[l] = P->pj[kk[l]];
+    }
+    v4d xi, yi, zi, xj, yj, zj;
+    gather3(d->x, ii, &xi, &yi, &zi);
+    gather3(d->x, jj, &xj, &yj, &zj);
+    v4d dx = xj - xi, dy = yj - yi, dz = zj - zi;
+    v4d ri = gather(d->r, 1, ii, 0), rj = gather(d->r, 1, jj, 0), R = ri + rj;
+    v4d d2 = dx * dx + dy * dy + dz * dz;
+    v4d dist = vsqrt(d2), id = 1.0 / dist;
+    v4d nx = dx * id, ny = dy * id, nz = dz * id;
+    v4d kn = q->E2 * ri * rj / R;
+    v4d fn = kn * (R - dist);
+    /* contact-point velocities: i at +ri n, j at -rj n */
+    v4d wi0, wi1, wi2, wj0, wj1, wj2, vi0, vi1, vi2, vj0, vj1, vj2;
+    gather3(d->w, ii, &wi0, &wi1, &wi2);
+    gather3(d->w, jj, &wj0, &wj1, &wj2);
+    gather3(d->v, ii, &vi0, &vi1, &vi2);
+    gather3(d->v, jj, &vj0, &vj1, &vj2);
+    v4d vrx = vi0 - vj0 + ri * (wi1 * nz - wi2 * ny) + rj * (wj1 * nz - wj2 * ny);
+    v4d vry = vi1 - vj1 + ri * (wi2 * nx - wi0 * nz) + rj * (wj2 * nx - wj0 * nz);
+    v4d vrz = vi2 - vj2 + ri * (wi0 * ny - wi1 * nx) + rj * (wj0 * ny - wj1 * nx);
+    v4d vn = vrx * nx + vry * ny + vrz * nz;
+    v4d vtx = vrx - vn * nx, vty = vry - vn * ny, vtz = vrz - vn * nz;
+    /* keep the spring tangent (rotate with the contact, same magnitude) */
+    v4d ox = gather(P->fs[0], 1, kk, 0), oy = gather(P->fs[1], 1, kk, 0);
+    v4d oz = gather(P->fs[2], 1, kk, 0);
+    v4d s2 = ox * ox + oy * oy + oz * oz;
+    v4d sn = ox * nx + oy * ny + oz * nz;
+    v4d tx = ox - sn * nx, ty = oy - sn * ny, tz = oz - sn * nz;
+    v4d t2 = tx * tx + ty * ty + tz * tz;
+    v4d rot = vsqrt(s2 / t2);
+    v4l spring = s2 > 0, turn = spring & (t2 > 0);
+    v4d sx = vsel(spring, vsel(turn, tx * rot, tx), ox);
+    v4d sy = vsel(spring, vsel(turn, ty * rot, ty), oy);
+    v4d sz = vsel(spring, vsel(turn, tz * rot, tz), oz);
+    v4d ks = q->ksr * kn;
+    sx -= ks * vtx * q->dt; sy -= ks * vty * q->dt; sz -= ks * vtz * q->dt;
+    /* Coulomb: the spring truncated at tan(phi) f_n */
+    v4d smax = q->mu * fn;
+    v4d ss = sx * sx + sy * sy + sz * sz;
+    v4d cut = vsel(ss > 0, smax / vsqrt(ss), vsplat(0));
+    v4l slip = ss > smax * smax;
+    sx = vsel(slip, sx * cut, sx); sy = vsel(slip, sy * cut, sy); sz = vsel(slip, sz * cut, sz);
+    v4d Fx = -fn * nx + sx, Fy = -fn * ny + sy, Fz = -fn * nz + sz;
+    v4d cx = ny * sz - nz * sy, cy = nz * sx - nx * sz, cz = nx * sy - ny * sx;
+    for (int l = 0; l < VL; l++) {
+        size_t k = kk[l];
+        P->fs[0][k] = sx[l]; P->fs[1][k] = sy[l]; P->fs[2][k] = sz[l];
+        P->fn[k] = fn[l];
+        P->F[0][k] = Fx[l]; P->F[1][k] = Fy[l]; P->F[2][k] = Fz[l];
+        P->c[0][k] = cx[l]; P->c[1][k] = cy[l]; P->c[2][k] = cz[l];
     }
 }
 
-/* The step's force and moment sums of every sphere (d->af, d->at, d->afn, d->anear); returns
- * the sphere-sphere contacts. */
-static size_t step_forces(gp_dem3d *d)
+/* Pass 2: the m touching pairs idx[0 .. m - 1] */
+KERNEL_CLONES
+static void touch_pairs(gp_dem3d *d, const uint32_t *idx, size_t m)
 {
-    if (!threaded(d))
-        return forces_serial(d);
-    run_job(d, job_pairs);
-    run_job(d, job_gather);
-    size_t nc = 0;
-    for (int t = 0; t < d->pool.nt; t++)
-        nc += d->tnc[t];
-    return nc;
+    const pair_consts q = consts_of(d);
+    for (size_t c = 0; c < m; c += VL) {
+        size_t kk[VL];
+        for (size_t l = 0; l < VL; l++)
+            kk[l] = idx[c + l < m ? c + l : m - 1];
+        touch_block(d, &q, kk);
+    }
 }
+
+/* Both passes over the candidates k0 .. k1 - 1 (idx: room for k1 - k0 indices); returns
+ * the contacts. */
+static size_t pair_kernel(gp_dem3d *d, size_t k0, size_t k1, uint32_t *idx, int mark)
+{
+    size_t m = sift_pairs(d, k0, k1, idx, mark);
+    touch_pairs(d, idx, m);
+    return m;
+}
+
+/* Each sphere's x, y, z in the first three lanes of a vector (the fourth is idle), so that
+ * one vector operation does what the scalar code did per component, with the same bits. */
+VINLINE v4d vload3(const double *p) { return (v4d){p[0], p[1], p[2], 0}; }
+VINLINE void vstore3(double *p, v4d a)
+{
+    p[0] = a[0];
+    p[1] = a[1];
+    p[2] = a[2];
+}
+/* any of the first three lanes */
+VINLINE int vany3(v4l m) { return (m[0] | m[1] | m[2]) != 0; }
 
 /* Local damping: the force times dm = 1 - c where it does work (f v > 0), times dp = 1 + c
- * where it brakes, unchanged where f v = 0. Written as selects, which the compiler makes
- * branch-free: the sign of f v is a coin toss. */
-static inline double sgn_damp(double f, double v, double dm, double dp)
+ * where it brakes, unchanged where f v = 0 (selects: the sign of f v is a coin toss). */
+VINLINE v4d damp(v4d f, v4d v, double dm, double dp)
 {
-    double p = f * v;
-    double k = p > 0 ? dm : 1.0;
-    k = p < 0 ? dp : k;
-    return f * k;
+    v4d p = f * v;
+    return f * vsel(p > 0, vsplat(dm), vsel(p < 0, vsplat(dp), vsplat(1)));
 }
 
-/* The walls' forces on sphere i added to F and to the block's wall sums; returns the sum of
- * their normal forces and sets *near when a wall is within free_gap. */
-static double wall_forces(const gp_dem3d *d, size_t i, double F[3], blk_acc *acc, int *near)
+/* what every sphere of a step shares (copied: the compiler then knows that the spheres'
+ * arrays, which a step writes, do not hold them) */
+typedef struct sphere_consts {
+    v4d lo, hi; /* the walls: x-, y-, z-, -inf and x+, y+, z+, +inf (the idle lane never
+                   touches a wall, nor leaves the box) */
+    double dt, dm, dp, dscale, E2, gap, g[3];
+    int measure;
+} sphere_consts;
+
+static sphere_consts sphere_consts_of(const gp_dem3d *d)
 {
-    const double E2 = 2 * d->E, gap = d->free_gap, *x = d->x + 3 * i, *wall = d->wall;
-    double ri = d->r[i], sfn = 0;
-    for (int a = 0; a < 3; a++) {
-        double dl = x[a] - wall[2 * a];
-        if (dl < ri) {
-            double f = E2 * ri * (ri - dl);
-            F[a] += f;
-            acc->wf[2 * a] += f;
-            acc->wk[2 * a] += E2 * ri;
-            acc->wn++;
-            sfn += f;
-        }
-        double dh = wall[2 * a + 1] - x[a];
-        if (dh < ri) {
-            double f = E2 * ri * (ri - dh);
-            F[a] -= f;
-            acc->wf[2 * a + 1] += f;
-            acc->wk[2 * a + 1] += E2 * ri;
-            acc->wn++;
-            sfn += f;
-        }
-        *near |= (dl < ri + gap) | (dh < ri + gap);
+    const double *W = d->wall;
+    sphere_consts k = {{W[0], W[2], W[4], -INFINITY}, {W[1], W[3], W[5], INFINITY}, d->dt,
+                       1 - d->damping, 1 + d->damping,
+                       d->rscale > d->rscale_ref ? d->rscale - d->rscale_ref : 0, 2 * d->E,
+                       d->free_gap, {d->g[0], d->g[1], d->g[2]}, d->measure};
+    return k;
+}
+
+/* a block's sums while it runs: the scalar ones, the walls' by axis in lanes, and masks
+ * (-1 per lane) counted or or-ed only at the end */
+typedef struct blk_run {
+    blk_acc s;
+    v4d wf_lo, wf_hi, wk_lo, wk_hi;
+    v4l wn;  /* minus the wall contacts, by axis */
+    v4l bad; /* a sphere outside the box, or not finite, by axis */
+} blk_run;
+
+static void blk_begin(blk_run *a) { memset(a, 0, sizeof *a); }
+
+static void blk_end(const blk_run *a, blk_acc *out)
+{
+    *out = a->s;
+    out->wn = (size_t)-(a->wn[0] + a->wn[1] + a->wn[2] + a->wn[3]);
+    out->bad = (a->bad[0] | a->bad[1] | a->bad[2] | a->bad[3]) != 0;
+    for (int x = 0; x < 3; x++) {
+        out->wf[2 * x] = a->wf_lo[x];
+        out->wf[2 * x + 1] = a->wf_hi[x];
+        out->wk[2 * x] = a->wk_lo[x];
+        out->wk[2 * x + 1] = a->wk_hi[x];
     }
-    return sfn;
 }
 
 /* t[0] >= t[1]: the two largest values seen */
@@ -971,59 +1049,195 @@ static inline void top2(double t[2], double v)
     }
 }
 
-/* Per sphere: the walls, S_c's sums, local damping and the leapfrog step; the block's sums
- * (fixed blocks of BLK spheres, whatever the thread count) and its two largest moves. */
-static void job_spheres(gp_dem3d *d, int tid, int nt)
+/* The walls' forces on a sphere (centre x, radius ri) added to F and to the block's wall
+ * sums (a wall acts as the mirror image: 2 E ri (ri - d)); returns the sum of their normal
+ * forces, in the order x-, x+, y-, y+, z-, z+, and sets *near when a wall is within
+ * free_gap. A wall not touched adds zeros, which change no sum. */
+VINLINE double wall_forces(const sphere_consts *k, v4d x, double ri, v4d *F, blk_run *acc,
+                           int *near)
 {
-    const double dt = d->dt, dm = 1 - d->damping, dp = 1 + d->damping;
-    const double dscale = d->rscale > d->rscale_ref ? d->rscale - d->rscale_ref : 0;
-    const double *wall = d->wall;
-    for (size_t b = (size_t)tid; b < d->nblk; b += (size_t)nt) {
-        blk_acc *acc = d->blk + b;
-        memset(acc, 0, sizeof *acc);
+    const v4d rv = vsplat(ri), zero = vsplat(0), kw = vsplat(k->E2 * ri);
+    v4d dl = x - k->lo, dh = k->hi - x;
+    v4l ml = dl < rv, mh = dh < rv;
+    v4d fl = vsel(ml, k->E2 * ri * (rv - dl), zero), fh = vsel(mh, k->E2 * ri * (rv - dh), zero);
+    *F = *F + fl - fh;
+    acc->wf_lo += fl;
+    acc->wf_hi += fh;
+    acc->wk_lo += vsel(ml, kw, zero);
+    acc->wk_hi += vsel(mh, kw, zero);
+    acc->wn += ml + mh; /* true is -1 (the idle lane never is) */
+    const v4d rg = vsplat(ri + k->gap);
+    *near |= vany3((dl < rg) | (dh < rg));
+    double sfn = 0;
+    for (int a = 0; a < 3; a++) {
+        sfn += fl[a];
+        sfn += fh[a];
+    }
+    return sfn;
+}
+
+/* Sphere i once its pair sums are complete (F: gravity and the pairs' forces, T: their
+ * moments, sfn: their sum of f_n, near: a sphere within free_gap): the walls, S_c's sums,
+ * local damping and the leapfrog step; the block's sums (acc) and two largest moves. */
+VINLINE void move_sphere(gp_dem3d *d, const sphere_consts *k, size_t i, v4d F, v4d T,
+                         double sfn, int near, blk_run *acc)
+{
+    double *restrict xp = d->x + 3 * i, *restrict vp = d->v + 3 * i, *restrict wp = d->w + 3 * i;
+    const double dt = k->dt, ri = d->r[i];
+    v4d x = vload3(xp), v = vload3(vp), w = vload3(wp);
+    sfn += wall_forces(k, x, ri, &F, acc, &near);
+    if (k->measure) /* read only after a run: summed on its last step */
+        acc->s.sum_f += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
+    if (k->measure)
+        acc->s.sum_fn += sfn;
+    /* free flight: nothing within free_gap, so no contact stiffness for density scaling to
+     * serve and no oscillation for local damping to take out; the sphere falls with its true
+     * mass, undamped (see the top of this file) */
+    int fly = !(near || sfn > 0);
+    double mi = (fly ? d->mtinv[i] : d->minv[i]) * dt, ii = d->iinv[i] * dt;
+    v = v + damp(F, v, fly ? 1.0 : k->dm, fly ? 1.0 : k->dp) * mi;
+    w = w + damp(T, w, k->dm, k->dp) * ii;
+    x = x + v * dt;
+    v4d e = x - vload3(d->xref + 3 * i);
+    e = e * e;
+    double d2 = e[0] + e[1] + e[2];
+    if (k->measure) {
+        double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        acc->s.ke += 0.5 * d->m[i] * v2;
+        if (v2 > acc->s.vmax2) acc->s.vmax2 = v2;
+    }
+    double mv = d2; /* the distance a gap may have closed by this sphere, squared */
+    if (k->dscale > 0) {
+        double g = sqrt(d2) + k->dscale * d->r0[i];
+        mv = g * g;
+    }
+    top2(acc->s.move, mv);
+    /* outside, or not a number (a velocity that is not finite makes x so at once) */
+    const v4d rv = vsplat(ri);
+    acc->bad |= ~((x > k->lo - rv) & (x < k->hi + rv));
+    vstore3(xp, x);
+    vstore3(vp, v);
+    vstore3(wp, w);
+}
+
+/* ---- a step: the pair kernel, then each sphere's sums and its move ---- */
+
+/* One thread: the kernel over every pair, then the spheres in order, block by block. Each
+ * contact's force is added to both spheres' sums in pair order: sphere i's contacts as the
+ * second sphere (i' < i) all come before its own (i, j), so when its turn comes its sums
+ * are taken into registers, run over its own contacts (its partners j get their share
+ * added in place), and are then complete: the sphere moves at once (no later pair reads
+ * it, and the kernel has already read every position). A sphere's sums thus run over its
+ * contacts in pair order, as the threaded gather does: the same bits. Returns the
+ * contacts. */
+KERNEL_CLONES
+static size_t step_serial(gp_dem3d *d)
+{
+    const sphere_consts sk = sphere_consts_of(d);
+    const pair_set *P = &d->cur;
+    const uint32_t *restrict pj = P->pj, *restrict idx = P->idx;
+    const size_t *restrict ioff = d->ioff; /* i's pairs: ioff[i] .. ioff[i + 1] - 1 */
+    const double *restrict r = d->r, *restrict pfn = P->fn;
+    const double *restrict Fx = P->F[0], *restrict Fy = P->F[1], *restrict Fz = P->F[2];
+    const double *restrict cx = P->c[0], *restrict cy = P->c[1], *restrict cz = P->c[2];
+    double *restrict af = d->af, *restrict at = d->at, *restrict afn = d->afn;
+    for (size_t i = 0; i < d->n; i++) { /* gravity on the true mass */
+        for (int a = 0; a < 3; a++) {
+            af[3 * i + a] = d->m[i] * sk.g[a];
+            at[3 * i + a] = 0;
+        }
+        afn[i] = 0;
+        d->anear[i] = 0;
+    }
+    size_t nc = pair_kernel(d, 0, d->np, P->idx, 1), c = 0;
+    for (size_t b = 0; b < d->nblk; b++) {
+        blk_run acc;
+        blk_begin(&acc);
         size_t i0 = b * BLK, i1 = i0 + BLK < d->n ? i0 + BLK : d->n;
         for (size_t i = i0; i < i1; i++) {
-            double *x = d->x + 3 * i, *v = d->v + 3 * i, *w = d->w + 3 * i;
-            const double *T = d->at + 3 * i;
-            double ri = d->r[i], m = d->m[i];
-            double F[3] = {d->af[3 * i], d->af[3 * i + 1], d->af[3 * i + 2]};
-            int near = d->anear[i];
-            double sfn = d->afn[i];
-            sfn += wall_forces(d, i, F, acc, &near);
-            if (d->measure) { /* read only after a run: summed on its last step */
-                acc->sum_f += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
-                acc->sum_fn += sfn;
+            double f0 = af[3 * i], f1 = af[3 * i + 1], f2 = af[3 * i + 2];
+            double t0 = at[3 * i], t1 = at[3 * i + 1], t2 = at[3 * i + 2];
+            double sfn = afn[i], ri = r[i];
+            for (size_t end = ioff[i + 1]; c < nc && idx[c] < end; c++) { /* i's own */
+                size_t k = idx[c], j = pj[k];
+                double rj = r[j];
+                f0 += Fx[k]; f1 += Fy[k]; f2 += Fz[k];
+                af[3 * j] -= Fx[k]; af[3 * j + 1] -= Fy[k]; af[3 * j + 2] -= Fz[k];
+                t0 += ri * cx[k]; t1 += ri * cy[k]; t2 += ri * cz[k];
+                at[3 * j] += rj * cx[k]; at[3 * j + 1] += rj * cy[k]; at[3 * j + 2] += rj * cz[k];
+                sfn += pfn[k];
+                afn[j] += pfn[k];
             }
-            /* free flight: nothing within free_gap, so no contact stiffness for density scaling
-             * to serve and no oscillation for local damping to take out; the sphere falls with
-             * its true mass, undamped (see the top of this file) */
-            int fly = !(near || sfn > 0);
-            double mi = (fly ? d->mtinv[i] : d->minv[i]) * dt, ii = d->iinv[i] * dt;
-            double fm = fly ? 1.0 : dm, fp = fly ? 1.0 : dp; /* free flight: no damping */
-            double d2 = 0;
-            for (int a = 0; a < 3; a++) {
-                v[a] += sgn_damp(F[a], v[a], fm, fp) * mi;
-                w[a] += sgn_damp(T[a], w[a], dm, dp) * ii;
-                x[a] += v[a] * dt;
-                double e = x[a] - d->xref[3 * i + a];
-                d2 += e * e;
-            }
-            if (d->measure) {
-                double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-                acc->ke += 0.5 * m * v2;
-                if (v2 > acc->vmax2) acc->vmax2 = v2;
-            }
-            double mv = d2; /* the distance a gap may have closed by this sphere, squared */
-            if (dscale > 0) {
-                double e = sqrt(d2) + dscale * d->r0[i];
-                mv = e * e;
-            }
-            top2(acc->move, mv);
-            /* a velocity that is not finite makes x so (or far outside the box) at once */
-            for (int a = 0; a < 3; a++) /* outside, or not a number */
-                acc->bad |= !(x[a] > wall[2 * a] - ri) | !(x[a] < wall[2 * a + 1] + ri);
+            move_sphere(d, &sk, i, (v4d){f0, f1, f2, 0}, (v4d){t0, t1, t2, 0}, sfn, d->anear[i],
+                        &acc);
         }
+        blk_end(&acc, d->blk + b);
     }
+    return nc;
+}
+
+/* threads, first half: each thread the kernel over a range of pairs */
+static void job_pairs(gp_dem3d *d, int tid, int nt)
+{
+    size_t np = d->np;
+    size_t k0 = np * (size_t)tid / (size_t)nt, k1 = np * (size_t)(tid + 1) / (size_t)nt;
+    d->tnc[tid] = pair_kernel(d, k0, k1, d->cur.idx + k0, 0);
+}
+
+/* threads, second half: blocks of spheres, each sphere's sums gathered from its contacts
+ * in pair order (d->adj), the same additions in the same order as step_serial, and the
+ * sphere moved (no thread reads another sphere's position any more in this step) */
+KERNEL_CLONES
+static void job_spheres(gp_dem3d *d, int tid, int nt)
+{
+    const sphere_consts sk = sphere_consts_of(d);
+    const pair_set *P = &d->cur;
+    const double *restrict pfn = P->fn;
+    const double *restrict Fx = P->F[0], *restrict Fy = P->F[1], *restrict Fz = P->F[2];
+    const double *restrict cx = P->c[0], *restrict cy = P->c[1], *restrict cz = P->c[2];
+    const size_t *restrict adj = d->adj, *restrict off = d->off;
+    for (size_t b = (size_t)tid; b < d->nblk; b += (size_t)nt) {
+        blk_run acc;
+        blk_begin(&acc);
+        size_t i0 = b * BLK, i1 = i0 + BLK < d->n ? i0 + BLK : d->n;
+        for (size_t i = i0; i < i1; i++) {
+            double ri = d->r[i], m = d->m[i];
+            double f0 = m * sk.g[0], f1 = m * sk.g[1], f2 = m * sk.g[2];
+            double t0 = 0, t1 = 0, t2 = 0, sfn = 0;
+            int near = 0;
+            for (size_t e = off[i]; e < off[i + 1]; e++) {
+                size_t k = adj[e] >> 1;
+                double fn = pfn[k];
+                if (fn == 0 || fn == -1) { /* not touching (the kernel's own marks) */
+                    near |= fn < 0;
+                    continue;
+                }
+                if (adj[e] & 1) { /* i is the pair's j: the force on it is -F */
+                    f0 -= Fx[k]; f1 -= Fy[k]; f2 -= Fz[k];
+                } else {
+                    f0 += Fx[k]; f1 += Fy[k]; f2 += Fz[k];
+                }
+                t0 += ri * cx[k]; t1 += ri * cy[k]; t2 += ri * cz[k];
+                sfn += fn;
+            }
+            move_sphere(d, &sk, i, (v4d){f0, f1, f2, 0}, (v4d){t0, t1, t2, 0}, sfn, near, &acc);
+        }
+        blk_end(&acc, d->blk + b);
+    }
+}
+
+/* One step of every sphere (d->blk holds the blocks' sums); returns the sphere-sphere
+ * contacts. */
+static size_t step(gp_dem3d *d)
+{
+    if (!threaded(d))
+        return step_serial(d);
+    run_job(d, job_pairs);
+    run_job(d, job_spheres);
+    size_t nc = 0;
+    for (int t = 0; t < d->pool.nt; t++)
+        nc += d->tnc[t];
+    return nc;
 }
 
 void gp_dem3d_set_cancel(gp_dem3d *d, const volatile int *cancel) { d->cancel = cancel; }
@@ -1043,8 +1257,7 @@ gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err)
             if (st)
                 return st;
         }
-        size_t nc = step_forces(d), wn = 0;
-        run_job(d, job_spheres);
+        size_t nc = step(d), wn = 0;
         double sf = 0, sfn = 0, ke = 0, vm = 0;
         double wf[6] = {0}, wk[6] = {0};
         double move[2] = {0, 0};
@@ -1156,7 +1369,7 @@ gp_status gp_dem3d_contacts(const gp_dem3d *d, gp_contact3d **out, size_t *nout,
         c[m].j = (long)j;
         for (int a = 0; a < 3; a++) {
             c[m].normal[a] = e[a] / l;
-            c[m].force[a] = d->pF[3 * k + a];
+            c[m].force[a] = d->cur.F[a][k];
         }
         c[m].overlap = d->r[i] + d->r[j] - l;
         m++;

@@ -27,13 +27,17 @@
  *     smaller sphere). Shear springs persist across rebuilds by (i, j). Results do not depend
  *     on the skin, bit for bit (a sphere sums its pairs in (i, j) order, and a pair enters the
  *     list before it can come within the free-flight gap);
- *   - a step: the pair forces, then one pass over the spheres (walls, damping, leapfrog). One
- *     thread adds each pair's force to both spheres inside the pair loop; with threads, the
- *     pair forces are computed in ranges and each sphere gathers its own in pair order. Both
- *     sum a sphere's pairs in (i, j) order and every reduction runs over fixed blocks of
- *     spheres, so results are bit for bit the same for any thread count. Layout: the pair
- *     list is a structure of arrays (i, j, f_n, then 3-vectors per pair: spring, force), the
- *     per-sphere sums of the step arrays beside the spheres'.
+ *   - a step: the pair kernel, then the spheres. The kernel sifts the candidates (which
+ *     touch; a pair that does not gets its f_n mark and loses its spring) and computes the
+ *     touching ones, four pairs to a vector, branch-free. One thread then goes through the
+ *     spheres in order, adding each contact's force to both spheres' sums in pair order and
+ *     moving a sphere (walls, damping, leapfrog) as soon as its sums are complete; with
+ *     threads, the kernel runs on ranges of pairs and each block of spheres gathers its own
+ *     contacts in pair order, then moves. Both sum a sphere's pairs in (i, j) order and
+ *     every reduction runs over fixed blocks of spheres, so results are bit for bit the same
+ *     for any thread count, and for any vector width (each lane does the scalar operations
+ *     in the scalar order; no FMA). Layout: the pair list is a structure of arrays (i, j,
+ *     f_n, and one array per component of the spring, the force on i and n x f_s).
  * Units SI. Walls 0..5: x-, x+, y-, y+, z-, z+.
  *
  * Ownership: gp_dem3d_create copies the spheres; the gp_dem3d owns its state and its worker

@@ -287,13 +287,14 @@ static void test_skin_independent(void)
             s[4 * i + a] = 0.02 + 0.02 * (double)c[a] + 0.001 * (double)(lcg(&st) % 1000) / 1000.0;
     }
     double lo[3] = {0, 0, 0}, hi[3] = {0.2, 0.2, 0.2};
-    double *out[3];
-    long reb[3];
-    size_t ncon[3];
-    static const double skin[3] = {0.0001, 0.004, 0.004};
-    for (int t = 0; t < 3; t++) {
+    double *out[4];
+    long reb[4];
+    size_t ncon[4];
+    static const double skin[4] = {0.0001, 0.004, 0.004, 0.004};
+    static const int threads[4] = {1, 1, 2, 3}; /* 3: ranges of pairs that split vectors */
+    for (int t = 0; t < 4; t++) {
         gp_dem3d_params p = base();
-        p.threads = t == 2 ? 2 : 1;
+        p.threads = threads[t];
         p.scaled_radius = 0.01;
         p.gravity[2] = 0; /* three servo walls squeeze the cloud into a packing */
         p.skin = skin[t];
@@ -322,9 +323,55 @@ static void test_skin_independent(void)
     CHECK(reb[0] > 5 * reb[1]);            /* the tiny skin did rebuild far more often */
     CHECK(memcmp(out[0], out[1], 4 * n * sizeof(double)) == 0);
     CHECK(memcmp(out[1], out[2], 4 * n * sizeof(double)) == 0);
-    CHECK(ncon[0] == ncon[1] && ncon[1] == ncon[2]);
-    for (int t = 0; t < 3; t++)
+    CHECK(memcmp(out[1], out[3], 4 * n * sizeof(double)) == 0);
+    CHECK(ncon[0] == ncon[1] && ncon[1] == ncon[2] && ncon[2] == ncon[3]);
+    for (int t = 0; t < 4; t++)
         free(out[t]);
+    free(s);
+}
+
+/* The pair kernel works on four pairs at a time (and a padded tail): every contact's force in
+ * the first step from rest (no spring yet, no velocity: the force is the normal one alone,
+ * -k_n delta n with k_n = 2 E R_i R_j / (R_i + R_j)) equals, bit for bit, the scalar formula
+ * evaluated here on the same positions, for a cloud whose contact count is no multiple of 4;
+ * and the contacts are those found by brute force. */
+static void test_kernel_lanes(void)
+{
+    size_t n = 150;
+    double *s = malloc(4 * n * sizeof *s);
+    uint64_t st = 4242;
+    for (size_t i = 0; i < n; i++) {
+        s[4 * i + 3] = 0.004 + 0.008 * (double)(lcg(&st) % 1000) / 1000.0;
+        for (int a = 0; a < 3; a++)
+            s[4 * i + a] = 0.015 + 0.07 * (double)(lcg(&st) % 100000) / 100000.0;
+    }
+    double lo[3] = {0, 0, 0}, hi[3] = {0.1, 0.1, 0.1};
+    gp_dem3d_params p = base();
+    p.gravity[2] = 0;
+    gp_dem3d *d = in_box(&p, s, n, hi);
+    if (!d) {
+        free(s);
+        return;
+    }
+    (void)lo;
+    check_contacts_brute(d, s, n); /* one step, and the contacts are the overlaps of s */
+    gp_contact3d *c;
+    size_t nc, pairs = 0, exact = 0;
+    gp_error e;
+    CHECK(gp_dem3d_contacts(d, &c, &nc, &e) == GP_OK);
+    for (size_t k = 0; k < nc && c[k].j >= 0; k++) {
+        const double *a = s + 4 * c[k].i, *b = s + 4 * c[k].j;
+        double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2], R = a[3] + b[3];
+        double dist = sqrt(dx * dx + dy * dy + dz * dz), id = 1.0 / dist;
+        double fn = 2 * p.young * a[3] * b[3] / R * (R - dist);
+        double F[3] = {-fn * (dx * id) + 0.0, -fn * (dy * id) + 0.0, -fn * (dz * id) + 0.0};
+        pairs++;
+        exact += F[0] == c[k].force[0] && F[1] == c[k].force[1] && F[2] == c[k].force[2];
+    }
+    CHECK(pairs > 20 && pairs % 4 != 0);
+    CHECK(exact == pairs);
+    free(c);
+    gp_dem3d_destroy(d);
     free(s);
 }
 
@@ -345,6 +392,7 @@ int main(void)
     test_servo();
     test_pairs_and_threads();
     test_skin_independent();
+    test_kernel_lanes();
     test_solid_volume();
     return gp_test_summary();
 }
