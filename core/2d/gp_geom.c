@@ -1136,35 +1136,51 @@ double gp_axis_angle(double ex, double ey)
 
 /* Rotating calipers: for edge k, the antipodal vertex j maximises h = cross(e_k, h[j] - h[k]);
  * as k turns counter-clockwise so does j, so one walk serves every edge (O(m)). */
+/* The lowest (then leftmost) vertex of h: where gp_min_caliper_edge starts, which fixes which
+ * of two equally thin edges wins. */
+static size_t caliper_start(const gp_vec2 *h, size_t m)
+{
+    size_t s = 0;
+    double sy = h[0].y, sx = h[0].x;
+    for (size_t k = 1; k < m; k++)
+        if (h[k].y < sy || (h[k].y == sy && h[k].x < sx)) {
+            s = k;
+            sy = h[k].y;
+            sx = h[k].x;
+        }
+    return s;
+}
+
 size_t gp_min_caliper_edge(const gp_vec2 *h, size_t m, double eps2, int squared)
 {
     if (!h || m < 2) return m;
-    size_t s = 0;
-    for (size_t k = 1; k < m; k++)
-        if (h[k].y < h[s].y || (h[k].y == h[s].y && h[k].x < h[s].x)) s = k;
     size_t best_k = m, j = m; /* j == m: not placed yet (the first edge kept places it) */
     double best = INFINITY;
+    size_t k = caliper_start(h, m);
+    /* the arithmetic of each width is fixed (the results are pinned to it): only the
+     * bookkeeping around it is lean -- the edge's start held in registers, indices stepped */
     for (size_t c = 0; c < m; c++) {
-        size_t k = s + c;
-        if (k >= m) k -= m;
         size_t k1 = k + 1 == m ? 0 : k + 1;
-        double ex = h[k1].x - h[k].x, ey = h[k1].y - h[k].y;
+        const double kx = h[k].x, ky = h[k].y;
+        double ex = h[k1].x - kx, ey = h[k1].y - ky;
         double l2 = ex * ex + ey * ey;
-        if (l2 <= eps2) continue;
-        if (j == m) j = k1;
-        double cur = ex * (h[j].y - h[k].y) - ey * (h[j].x - h[k].x);
-        for (size_t step = 0; step < m; step++) {
-            size_t j1 = j + 1 == m ? 0 : j + 1;
-            double nxt = ex * (h[j1].y - h[k].y) - ey * (h[j1].x - h[k].x);
-            if (nxt < cur) break;
-            cur = nxt;
-            j = j1;
+        if (l2 > eps2) {
+            if (j == m) j = k1;
+            double cur = ex * (h[j].y - ky) - ey * (h[j].x - kx);
+            for (size_t step = 0; step < m; step++) {
+                size_t j1 = j + 1 == m ? 0 : j + 1;
+                double nxt = ex * (h[j1].y - ky) - ey * (h[j1].x - kx);
+                if (nxt < cur) break;
+                cur = nxt;
+                j = j1;
+            }
+            double w = squared ? cur * cur / l2 : cur / hypot(ex, ey);
+            if (w < best) {
+                best = w;
+                best_k = k;
+            }
         }
-        double w = squared ? cur * cur / l2 : cur / hypot(ex, ey);
-        if (w < best) {
-            best = w;
-            best_k = k;
-        }
+        k = k1;
     }
     return best_k;
 }

@@ -57,7 +57,9 @@
  *    the nearest), popping seeds in increasing distance from p and clipping by each. By the
  *    lemma every seed is reached through a chain of nearer ones, so a seed not popped yet is
  *    at least as far as the heap's top; the search stops when the top is 2 Rmax away, where
- *    no seed can cut. The convex ring's edges: those in the bins under the polygon.
+ *    no seed can cut. A seed found 2 Rmax away is not pushed at all (Rmax only shrinks, so it
+ *    would never be popped; the seeds beyond it that could still cut have nearer chains).
+ *    The convex ring's edges: those in the bins under the polygon.
  *  - a former neighbour j of i (compute_cell_nb): removing i hands each point of i's old cell
  *    to its second-nearest seed, a neighbour of i; so new contacts arise only among nb_old(i),
  *    and inserting i at p removes contacts except with i: nb_new(j) is in nb_old(j) U nb_old(i)
@@ -341,17 +343,19 @@ static inline __attribute__((always_inline)) int32_t
 clip_hp(const gp_vec2 *sv, const int32_t *st, int32_t m, gp_vec2 o, gp_vec2 nrm, double eps, int32_t newtag,
         gp_vec2 *dv, int32_t *dt, double *d, gp_vec2 s, double *rmax2)
 {
-    /* one pass: snapped signed distances; no vertex beyond the line is the common quick exit */
-    int any = 0, allout = 1;
+    /* First pass: the raw signed distances and their largest. A snapped distance is > 0 exactly
+     * when the raw one is > eps, so "no vertex beyond the line" (a candidate that does not
+     * cut: about half of them) is decided here, without snapping or flag bookkeeping. */
+    double tmax = -INFINITY;
     for (int32_t k = 0; k < m; k++) {
         double t = (sv[k].x - o.x) * nrm.x + (sv[k].y - o.y) * nrm.y;
-        if (t <= eps && t >= -eps) t = 0.0;
         d[k] = t;
-        any |= t > 0.0;
-        allout &= t > 0.0;
+        tmax = t > tmax ? t : tmax;
     }
-    if (!any) return -1;
-    if (allout) return 0;
+    if (!(tmax > eps)) return -1;
+    /* Second pass: the kept part, each distance snapped as it is first read (d[0] up front, the
+     * others as the next vertex). Nothing kept (w == 0) is the "all beyond the line" case. */
+#define GP_SNAP(T) ((T) <= eps && (T) >= -eps ? 0.0 : (T))
     int32_t w = 0;
     double r2 = 0.0;
 #define GP_EMIT(P, T)                                                                  \
@@ -362,10 +366,11 @@ clip_hp(const gp_vec2 *sv, const int32_t *st, int32_t m, gp_vec2 o, gp_vec2 nrm,
         dv[w] = p_;                                                                    \
         dt[w++] = (T);                                                                 \
     } while (0)
-    double dk = d[0];
+    const double d0 = GP_SNAP(d[0]);
+    double dk = d0;
     for (int32_t k = 0; k < m; k++) {
         int32_t j = k + 1 == m ? 0 : k + 1;
-        double dj = d[j];
+        double dj = j == 0 ? d0 : GP_SNAP(d[j]);
         if (dk <= 0.0) {
             GP_EMIT(sv[k], (dk == 0.0 && dj > 0.0) ? newtag : st[k]);
             if (dk < 0.0 && dj > 0.0) {
@@ -379,6 +384,7 @@ clip_hp(const gp_vec2 *sv, const int32_t *st, int32_t m, gp_vec2 o, gp_vec2 nrm,
         dk = dj;
     }
 #undef GP_EMIT
+#undef GP_SNAP
     *rmax2 = r2;
     return w;
 }
@@ -971,12 +977,14 @@ static void canonicalise(const gp_voronoi *v, gp_vec2 s, const gp_vec2 *cv, cons
     gp_vec2 n1, n2;
     double c1, c2;
     tag_line(v, s, ct[kp], &n1, &c1);
+    double a1 = fabs(n1.x) + fabs(n1.y); /* each line's L1 norm once: it serves two vertices */
     for (int32_t j = 0; j < m; j++) {
         int32_t k = st + j;
         if (k >= m) k -= m;
         tag_line(v, s, ct[k], &n2, &c2);
+        double a2 = fabs(n2.x) + fabs(n2.y);
         double det = n1.x * n2.y - n1.y * n2.x;
-        double sc = (fabs(n1.x) + fabs(n1.y)) * (fabs(n2.x) + fabs(n2.y));
+        double sc = a1 * a2;
         gp_vec2 x = cv[k];
         if (fabs(det) > 1e-10 * sc) {
             gp_vec2 y = {s.x + (c1 * n2.y - c2 * n1.y) / det, s.y + (n1.x * c2 - n2.x * c1) / det};
@@ -986,6 +994,7 @@ static void canonicalise(const gp_voronoi *v, gp_vec2 s, const gp_vec2 *cv, cons
         dt[j] = ct[k];
         n1 = n2;
         c1 = c2;
+        a1 = a2;
     }
 }
 
@@ -1014,12 +1023,23 @@ typedef struct cell_run {
     double epsr;
 } cell_run;
 
-/* The starting polygon: the box B, or (full == 0) its part within 2 bins of the seed, whose
- * sides are tagged TAG_SMALL. */
-static gp_status cell_start(cell_run *R, gp_voronoi *v, uint32_t i, int full)
+/* The run of cell i without a polygon yet: for the recomputations of a move that start from
+ * an old cell (compute_cell_cut, compute_cell_nb), which then need no box. */
+static gp_status cell_init(cell_run *R, gp_voronoi *v, uint32_t i)
 {
-    const gp_vec2 s = v->seed[i];
     if (scratch_reserve(v, 64)) return GP_ERR_NOMEM;
+    stamp_next(&v->stamp, v->estamp, v->nedges);
+    *R = (cell_run){.v = v, .i = i, .s = v->seed[i], .m = 0, .ina = 1, .es = v->stamp,
+                    .epsr = 1e-13 * v->L};
+    return GP_OK;
+}
+
+/* The starting polygon of R into sa/ta: the box B, or (full == 0) its part within 2 bins of
+ * the seed, whose sides are tagged TAG_SMALL. */
+static void cell_box(cell_run *R, int full)
+{
+    gp_voronoi *v = R->v;
+    const gp_vec2 s = R->s;
     gp_vec2 *cv = v->sa;
     int32_t *ct = v->ta;
     double r0 = 2.0 * fmax(v->hx, v->hy);
@@ -1043,9 +1063,19 @@ static gp_status cell_start(cell_run *R, gp_voronoi *v, uint32_t i, int full)
         double dx = cv[k].x - s.x, dy = cv[k].y - s.y, d2 = dx * dx + dy * dy;
         if (d2 > rmax2) rmax2 = d2;
     }
-    stamp_next(&v->stamp, v->estamp, v->nedges);
-    *R = (cell_run){.v = v, .i = i, .s = s, .m = 4, .ina = 1, .rmax2 = rmax2, .es = v->stamp,
-                    .bx = bin_x(v, s.x), .by = bin_y(v, s.y), .epsr = 1e-13 * v->L};
+    R->m = 4;
+    R->ina = 1;
+    R->rmax2 = rmax2;
+}
+
+/* A cell run from the box (cell_box), with the seed's bin for the grid search. */
+static gp_status cell_start(cell_run *R, gp_voronoi *v, uint32_t i, int full)
+{
+    gp_status st = cell_init(R, v, i);
+    if (st != GP_OK) return st;
+    cell_box(R, full);
+    R->bx = bin_x(v, R->s.x);
+    R->by = bin_y(v, R->s.y);
     return GP_OK;
 }
 
@@ -1158,26 +1188,29 @@ static int cell_done(const cell_run *R, int32_t r)
  * two lists a move reads to find the candidates of the cells it recomputes. */
 static gp_status cell_neighbours(const gp_voronoi *v, vcell *out, const int32_t *ct, int32_t m)
 {
-    int32_t nn = 0, ne = 0;
+    /* both lists together hold at most one entry per edge: reserve m instead of counting */
+    if (cell_reserve(out, m, 1, m)) return GP_ERR_NOMEM;
+    int32_t nn = 0, other = 0;
+    int32_t *nb = out->nb;
     for (int32_t k = 0; k < m; k++) {
-        if (ct[k] >= 0) nn++;
-        else if (v->outer_convex && ct[k] < -1 && ct[k] > TAG_SMALL && v->ering[-ct[k] - 2] == 0) ne++;
-    }
-    if (cell_reserve(out, m, 1, nn + ne)) return GP_ERR_NOMEM;
-    out->nnb = 0;
-    out->nce = 0;
-    for (int32_t k = 0; k < m; k++) {
-        if (ct[k] < 0) continue;
-        int32_t t = ct[k], q = out->nnb++;
-        while (q > 0 && out->nb[q - 1] > t) {
-            out->nb[q] = out->nb[q - 1];
-            q--;
+        int32_t t = ct[k], q = nn;
+        if (t < 0) {
+            other = 1;
+            continue;
         }
-        out->nb[q] = t;
+        for (; q > 0; q--) { /* insertion: a handful of entries */
+            int32_t u = nb[q - 1];
+            if (u <= t) break;
+            nb[q] = u;
+        }
+        nb[q] = t;
+        nn++;
     }
-    for (int32_t k = 0; k < m && ne; k++)
-        if (ct[k] < -1 && ct[k] > TAG_SMALL && v->ering[-ct[k] - 2] == 0)
-            out->nb[out->nnb + out->nce++] = -ct[k] - 2;
+    int32_t ne = 0;
+    for (int32_t k = 0; k < m && other && v->outer_convex; k++)
+        if (ct[k] < -1 && ct[k] > TAG_SMALL && v->ering[-ct[k] - 2] == 0) nb[nn + ne++] = -ct[k] - 2;
+    out->nnb = nn;
+    out->nce = ne;
     return GP_OK;
 }
 
@@ -1398,11 +1431,12 @@ static gp_status compute_cell_nb(gp_voronoi *v, uint32_t j, const vcell *old_j, 
                                  uint32_t i, vcell *out)
 {
     cell_run R;
-    gp_status st = cell_start(&R, v, j, 1);
+    gp_status st = cell_init(&R, v, j);
     if (st == GP_OK && old_j->nv + 2 > v->scap && scratch_reserve(v, old_j->nv + 2)) st = GP_ERR_NOMEM;
     if (st != GP_OK) return st;
     /* from old C_j less i's edge (exactly: 2), j's old lines are in already; else they clip */
     const int start = unclip_start(&R, old_j, i), skip_j = start == 2;
+    if (start == 0) cell_box(&R, 1);
     int32_t nc = 0;
     st = nb_candidates(v, &R, old_j, old_i, i, skip_j, &nc);
     const gp_vec2 s = R.s;
@@ -1567,8 +1601,13 @@ static gp_status compute_cell_moved(gp_voronoi *v, uint32_t i, vcell *out)
         for (int32_t q = 0; q < c->nnb; q++) {
             int32_t t = c->nb[q];
             if (v->kst[t] == v->kstamp) continue;
+            /* A seed 2 Rmax away now would never be popped (Rmax only shrinks): it is not
+             * pushed, nor marked, so that another path may test it again. The seeds it would
+             * lead to that can still cut are reached through nearer ones (header, "Moves"). */
+            double d = node_d2(v, t, s);
+            if (d >= 4.0 * R.rmax2) continue;
             v->kst[t] = v->kstamp;
-            if (heap_push(v, &nh, node_d2(v, t, s), t)) return GP_ERR_NOMEM;
+            if (heap_push(v, &nh, d, t)) return GP_ERR_NOMEM;
         }
     }
     if (v->outer_convex) {
@@ -1584,7 +1623,7 @@ static gp_status compute_cell_moved(gp_voronoi *v, uint32_t i, vcell *out)
 static gp_status compute_cell_cut(gp_voronoi *v, uint32_t j, const vcell *old_j, uint32_t i, vcell *out)
 {
     cell_run R;
-    gp_status st = cell_start(&R, v, j, 1);
+    gp_status st = cell_init(&R, v, j);
     if (st == GP_OK && old_j->nv + 2 > v->scap && scratch_reserve(v, old_j->nv + 2)) st = GP_ERR_NOMEM;
     if (st != GP_OK) return st;
     memcpy(v->sa, old_j->v, (size_t)old_j->nv * sizeof(gp_vec2));

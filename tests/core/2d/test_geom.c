@@ -582,6 +582,64 @@ static double angle_diff(double a, double b)
     return fabs(d);
 }
 
+/* gp_min_caliper_edge, the pass gp_voronoi's cell orientations use, against brute force: the
+ * width across every edge from all its vertices, on random convex polygons with short
+ * (collinear) edges slipped in; the tie rule (first thinnest from the lowest-leftmost vertex)
+ * on squares given from every starting vertex; and its edge cases. */
+static double edge_width(const gp_vec2 *h, size_t m, size_t k)
+{
+    size_t k1 = (k + 1) % m;
+    double ex = h[k1].x - h[k].x, ey = h[k1].y - h[k].y, wmax = 0.0;
+    for (size_t j = 0; j < m; j++) wmax = fmax(wmax, ex * (h[j].y - h[k].y) - ey * (h[j].x - h[k].x));
+    return wmax / hypot(ex, ey);
+}
+
+static void test_caliper_edge(void)
+{
+    int bad = 0, trials = 0;
+    for (int trial = 0; trial < 400; trial++) {
+        gp_vec2 pts[24], h[48], g[96];
+        size_t n = 3 + (size_t)(urand() * 21);
+        for (size_t i = 0; i < n; i++) pts[i] = (gp_vec2){urand() * 3 - 1, urand() * 0.7 + 2};
+        size_t m = gp_convex_hull(pts, n, h);
+        if (m < 3) continue;
+        /* a short collinear edge after some vertices: 1e-13 of the size, below eps2's 1e-12 */
+        size_t mg = 0;
+        for (size_t k = 0; k < m; k++) {
+            g[mg++] = h[k];
+            if (urand() < 0.3) {
+                gp_vec2 a = h[k], b = h[(k + 1) % m];
+                g[mg++] = (gp_vec2){a.x + 1e-13 * (b.x - a.x), a.y + 1e-13 * (b.y - a.y)};
+            }
+        }
+        double wmin = INFINITY;
+        for (size_t k = 0; k < m; k++) wmin = fmin(wmin, edge_width(h, m, k));
+        for (int sq = 0; sq < 2; sq++) {
+            size_t k = gp_min_caliper_edge(g, mg, 1e-24, sq);
+            trials++;
+            if (k >= mg) { bad++; continue; }
+            gp_vec2 a = g[k], b = g[(k + 1) % mg];
+            if (hypot(b.x - a.x, b.y - a.y) <= 1e-12) bad++; /* a short edge was not skipped */
+            if (fabs(edge_width(g, mg, k) - wmin) > 1e-12 * wmin) bad++;
+        }
+    }
+    CHECK(trials > 700 && bad == 0);
+    /* a square from every start: the first edge from (0, 0) wins the four-way tie */
+    for (size_t r = 0; r < 4; r++) {
+        gp_vec2 q[4];
+        for (size_t k = 0; k < 4; k++) q[k] = SQ[(k + r) % 4];
+        size_t want = (4 - r) % 4; /* where (0, 0) now is */
+        CHECK(gp_min_caliper_edge(q, 4, -1.0, 0) == want);
+        CHECK(gp_min_caliper_edge(q, 4, -1.0, 1) == want);
+    }
+    /* a 3 x 1 rectangle: one of the two long sides, the first from the lowest vertex */
+    gp_vec2 rc[4] = {{3, 1}, {0, 1}, {0, 0}, {3, 0}};
+    CHECK(gp_min_caliper_edge(rc, 4, -1.0, 1) == 2);
+    CHECK(gp_min_caliper_edge(rc, 1, -1.0, 1) == 1);
+    CHECK(gp_min_caliper_edge(NULL, 4, -1.0, 1) == 4);
+    CHECK(gp_min_caliper_edge(rc, 4, 100.0, 1) == 4); /* every edge skipped */
+}
+
 static void test_caliper(void)
 {
     double w, ang, len;
@@ -880,6 +938,7 @@ int main(void)
     test_mec();
     test_mic();
     test_caliper();
+    test_caliper_edge();
     test_contains();
     test_simple_inside_overlap();
     test_nan();
