@@ -12,14 +12,17 @@
  *                                          N = 1,000            N = 100,000
  *     grid candidates                      139k (voronoi 109k)  169k (voronoi 103k)
  *     neighbour lists, AD on a treap        72k (voronoi  42k)  107k (voronoi  42k)
- *     AD on sorted blocks (now)             68k (voronoi  42k)   82k (voronoi  41k)
- * Now, N = 1,000 / 100,000: the tessellation 42k / 41k (clipping and the moved seed's search
- * ~23k, canonical cells with their areas and orientations ~18k), the what-if of the two
- * statistics (gp_adstat_a2_if) 15k / 18k (treap: 17k / 27k), the cells' CDF values and logs
- * 7.4k, committing accepted moves (gp_adstat_set) 1.9k / 12.6k (treap: 3.6k / 29k; 2 x 9
- * cells an accepted step, ~1,600 instructions each at N = 100,000). What still grows with N is
- * the commits, by the acceptance rate as much as by N, and the cache misses: the treap's
- * pointer walks (perf: 45 % of the time at N = 100,000 in its rank queries) are now binary
+ *     AD on sorted blocks                   68k (voronoi  42k)   82k (voronoi  41k)
+ *     leaner clipping and search (now)      65k (voronoi ~38k)   79k (voronoi ~38k)
+ * Now, N = 1,000 / 100,000: the tessellation ~38k (clipping ~8k, canonical lines 5.7k,
+ * min caliper 5.9k and atan2 1.3k, the moved seed's search ~4k, the rest cell bookkeeping),
+ * the what-if of the two statistics (gp_adstat_a2_if) 15k / 18k (treap: 17k / 27k), the
+ * cells' CDF values and logs 7.4k, committing accepted moves (gp_adstat_set) 1.9k / 12.6k
+ * (treap: 3.6k / 29k; 2 x 9 cells an accepted step, ~1,600 instructions each at N = 100,000).
+ * Each of the ~9 cells recomputed a step really changes; twice the rate would take another
+ * kind of update (a Delaunay structure kept by edge flips instead of re-clipping the cells).
+ * What still grows with N is the commits, by the acceptance rate as much as by N, and the
+ * cache misses: the treap's pointer walks (perf: 45 % of the time at N = 100,000 in its rank queries) are now binary
  * searches in contiguous blocks of 64.
  */
 #include "gp_imc.h"
