@@ -81,8 +81,9 @@ def call(url, method="GET", body=None):
         return e.code, json.loads(e.read() or b"null")
 
 
-def download(url):
-    """GET url, reading the body in 1 MB pieces without keeping it: (status, bytes)."""
+def download(url, each=None):
+    """GET url, reading the body in 1 MB pieces without keeping it, each piece handed to
+    each(piece) when given: (status, bytes)."""
     n = 0
     with urllib.request.urlopen(url, timeout=600) as r:
         status = r.status
@@ -91,6 +92,8 @@ def download(url):
             if not b:
                 break
             n += len(b)
+            if each:
+                each(b)
     return status, n
 
 

@@ -38,10 +38,9 @@ import sys
 import tempfile
 import threading
 import time
-import urllib.request
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_export import call, start, stop  # noqa: E402
+from bench_export import call, download, start, stop  # noqa: E402
 
 SQUARE = {"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]], "holes": []}
 MZ12 = {"kind": "fourier-voronoi-2d", "seed": 2012, "container": SQUARE, "particles": 500,
@@ -105,29 +104,27 @@ TIMINGS = b'"timings":{'
 def download_sha(url):
     """GET url in 1 MB pieces, counted and hashed, not kept: (status, bytes, sha256 hex of the
     text with the "timings" object -- flat, near the head -- replaced by null)."""
-    n, h = 0, hashlib.sha256()
-    head = b""  # the text until the timings object has been passed (a few KB)
-    with urllib.request.urlopen(url, timeout=600) as r:
-        status = r.status
-        while True:
-            b = r.read(1 << 20)
-            if not b:
-                break
-            n += len(b)
-            if head is None:
-                h.update(b)
-                continue
-            head += b
-            i = head.find(TIMINGS)
-            j = head.find(b"}", i) if i >= 0 else -1
-            if j >= 0:
-                h.update(head[:i] + b'"timings":null' + head[j + 1:])
-                head = None
-            elif len(head) > (16 << 20):  # no timings: the text as it is
-                h.update(head)
-                head = None
-    if head:
-        h.update(head)
+    h = hashlib.sha256()
+    st = {"head": b""}  # the text until the timings object has been passed (a few KB)
+
+    def each(b):
+        if st["head"] is None:
+            h.update(b)
+            return
+        head = st["head"] + b
+        i = head.find(TIMINGS)
+        j = head.find(b"}", i) if i >= 0 else -1
+        if j >= 0:
+            h.update(head[:i] + b'"timings":null' + head[j + 1:])
+            head = None
+        elif len(head) > (16 << 20):  # no timings: the text as it is
+            h.update(head)
+            head = None
+        st["head"] = head
+
+    status, n = download(url, each)
+    if st["head"]:
+        h.update(st["head"])
     return status, n, h.hexdigest()
 
 

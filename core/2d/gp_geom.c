@@ -287,25 +287,32 @@ double gp_poly_boundary_distance(const gp_vec2 *p, size_t n, gp_vec2 q)
  * outside. Crossings are decided by the exact orientation predicate. With tol >= 0 a point
  * within tol of an edge is on the boundary too (gp_poly_contains); with tol < 0 only a point
  * exactly on it (the exact predicates of gp_poly_inside_poly and gp_poly_overlap). */
+/* point_class's test of one edge a -> b: 1 when q lies on it (within tol when tol >= 0), else
+ * 0 with the crossing parity *c updated */
+static inline int edge_class(gp_vec2 a, gp_vec2 b, gp_vec2 q, double tol, double tol2, int *c)
+{
+    if (tol >= 0.0 && q.x >= dmin(a.x, b.x) - tol && q.x <= dmax(a.x, b.x) + tol &&
+        q.y >= dmin(a.y, b.y) - tol && q.y <= dmax(a.y, b.y) + tol &&
+        seg_dist2(q.x, q.y, a.x, a.y, b.x, b.y) <= tol2)
+        return 1;
+    if ((a.y > q.y) != (b.y > q.y)) {
+        int o = orient(a, b, q);
+        if (o == 0) return 1;
+        if ((o > 0) == (b.y > a.y)) *c ^= 1;
+    } else if (a.y == q.y && b.y == q.y) {
+        if ((a.x <= q.x && q.x <= b.x) || (b.x <= q.x && q.x <= a.x)) return 1;
+    } else if (veq(a, q)) {
+        return 1;
+    }
+    return 0;
+}
+
 static int point_class(const gp_vec2 *p, size_t n, gp_vec2 q, double tol)
 {
     const double tol2 = tol * tol;
     int c = 0;
     for (size_t i = 0, j = n - 1; i < n; j = i++) {
-        gp_vec2 a = p[j], b = p[i];
-        if (tol >= 0.0 && q.x >= dmin(a.x, b.x) - tol && q.x <= dmax(a.x, b.x) + tol &&
-            q.y >= dmin(a.y, b.y) - tol && q.y <= dmax(a.y, b.y) + tol &&
-            seg_dist2(q.x, q.y, a.x, a.y, b.x, b.y) <= tol2)
-            return 0;
-        if ((a.y > q.y) != (b.y > q.y)) {
-            int o = orient(a, b, q);
-            if (o == 0) return 0;
-            if ((o > 0) == (b.y > a.y)) c ^= 1;
-        } else if (a.y == q.y && b.y == q.y) {
-            if ((a.x <= q.x && q.x <= b.x) || (b.x <= q.x && q.x <= a.x)) return 0;
-        } else if (veq(a, q)) {
-            return 0;
-        }
+        if (edge_class(p[j], p[i], q, tol, tol2, &c)) return 0;
     }
     return c ? 1 : -1;
 }
@@ -336,21 +343,7 @@ static int contains_screened(const gp_vec2 *p, size_t n, gp_vec2 q, double tol)
         int mask = _mm_movemask_pd(_mm_or_pd(near, strad)) & (i + 1 < n ? 3 : 1);
         for (int e = 0; e < 2; e++) {
             if (!(mask >> e & 1)) continue;
-            gp_vec2 a = e ? p[i] : p[j], b = e ? p[k] : p[i];
-            /* point_class's body for edge a -> b */
-            if (q.x >= dmin(a.x, b.x) - tol && q.x <= dmax(a.x, b.x) + tol &&
-                q.y >= dmin(a.y, b.y) - tol && q.y <= dmax(a.y, b.y) + tol &&
-                seg_dist2(q.x, q.y, a.x, a.y, b.x, b.y) <= tol2)
-                return 0;
-            if ((a.y > q.y) != (b.y > q.y)) {
-                int o = orient(a, b, q);
-                if (o == 0) return 0;
-                if ((o > 0) == (b.y > a.y)) c ^= 1;
-            } else if (a.y == q.y && b.y == q.y) {
-                if ((a.x <= q.x && q.x <= b.x) || (b.x <= q.x && q.x <= a.x)) return 0;
-            } else if (veq(a, q)) {
-                return 0;
-            }
+            if (edge_class(e ? p[i] : p[j], e ? p[k] : p[i], q, tol, tol2, &c)) return 0;
         }
     }
     return c ? 1 : -1;
