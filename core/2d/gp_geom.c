@@ -664,6 +664,20 @@ typedef struct {
 } mic_poly;
 
 enum { MIC_BLOCK = 16, MIC_K = 6 };
+
+/* d2 (of edge i) into the sorted list mk/ik of the MIC_K nearest so far, if it belongs there */
+static inline void nearest_k_add(double mk[MIC_K], size_t ik[MIC_K], double d2, size_t i)
+{
+    if (!(d2 < mk[MIC_K - 1])) return;
+    int j = MIC_K - 1;
+    for (; j > 0 && d2 < mk[j - 1]; j--) {
+        mk[j] = mk[j - 1];
+        ik[j] = ik[j - 1];
+    }
+    mk[j] = d2;
+    ik[j] = i;
+}
+
 #define MIC_SQRT2 1.4142135623730951
 
 /* Signed distance from (px, py) to the boundary (> 0 inside), scanning the edges from s;
@@ -721,18 +735,8 @@ static double mic_sdist(const mic_poly *P, double px, double py, size_t s, doubl
             double ex = wx - t * ddx, ey = wy - t * ddy;
             blk[k] = ex * ex + ey * ey;
         }
-        for (k = 0; k < cnt; k++) {
-            double d2 = blk[k];
-            if (d2 < mk[MIC_K - 1]) {
-                int j = MIC_K - 1;
-                for (; j > 0 && d2 < mk[j - 1]; j--) {
-                    mk[j] = mk[j - 1];
-                    ik[j] = ik[j - 1];
-                }
-                mk[j] = d2;
-                ik[j] = b + k;
-            }
-        }
+        for (k = 0; k < cnt; k++)
+            nearest_k_add(mk, ik, blk[k], b + k);
         if (mk[0] <= thr2) return -INFINITY;
     }
     for (int k = 0; k < MIC_K; k++) near[k] = mk[k] < INFINITY ? (ik[k] + s) % n : (size_t)-1;
@@ -755,16 +759,8 @@ static double mic_sdist_list(const mic_poly *P, const size_t *L, size_t m, doubl
         size_t i = L[q];
         double wx = px - P->x[i], wy = py - P->y[i], ddx = P->dx[i], ddy = P->dy[i];
         double t = clamp01((wx * ddx + wy * ddy) * P->il[i]);
-        double ex = wx - t * ddx, ey = wy - t * ddy, d2 = ex * ex + ey * ey;
-        if (d2 < mk[MIC_K - 1]) {
-            int j = MIC_K - 1;
-            for (; j > 0 && d2 < mk[j - 1]; j--) {
-                mk[j] = mk[j - 1];
-                ik[j] = ik[j - 1];
-            }
-            mk[j] = d2;
-            ik[j] = i;
-        }
+        double ex = wx - t * ddx, ey = wy - t * ddy;
+        nearest_k_add(mk, ik, ex * ex + ey * ey, i);
         if (mk[0] <= thr2) return -INFINITY;
     }
     for (int k = 0; k < MIC_K; k++) near[k] = ik[k];

@@ -264,6 +264,17 @@ static inline int32_t bin_y(const gp_voronoi *v, double y)
     return b;
 }
 
+/* The bins a polygon's bounding box reaches, padded by 1e-9 L (an edge on a bin's border is
+ * in both): r = {ix0, ix1, iy0, iy1}, inclusive. */
+static void poly_bins(const gp_voronoi *v, const gp_vec2 *p, size_t m, int32_t r[4])
+{
+    gp_vec2 lo, hi;
+    gp_poly_bbox(p, m, &lo, &hi, NULL);
+    double pad = 1e-9 * v->L;
+    r[0] = bin_x(v, lo.x - pad), r[1] = bin_x(v, hi.x + pad);
+    r[2] = bin_y(v, lo.y - pad), r[3] = bin_y(v, hi.y + pad);
+}
+
 static void stamp_next(uint32_t *stamp, uint32_t *arr, size_t n)
 {
     if (++*stamp == 0) {
@@ -1219,14 +1230,11 @@ static gp_status cell_neighbours(const gp_voronoi *v, vcell *out, const int32_t 
 static gp_status cell_general_edges(cell_run *R, const gp_vec2 *cv, int32_t m, int32_t *ngp)
 {
     gp_voronoi *v = R->v;
-    gp_vec2 lo, hi;
-    gp_poly_bbox(cv, (size_t)m, &lo, &hi, NULL);
-    double pad = 1e-9 * v->L;
-    int32_t ix0 = bin_x(v, lo.x - pad), ix1 = bin_x(v, hi.x + pad);
-    int32_t iy0 = bin_y(v, lo.y - pad), iy1 = bin_y(v, hi.y + pad);
+    int32_t r[4];
+    poly_bins(v, cv, (size_t)m, r);
     int32_t ng = 0;
-    for (int32_t yy = iy0; yy <= iy1; yy++)
-        for (int32_t xx = ix0; xx <= ix1; xx++) {
+    for (int32_t yy = r[2]; yy <= r[3]; yy++)
+        for (int32_t xx = r[0]; xx <= r[1]; xx++) {
             int32_t b = yy * v->nbx + xx;
             for (uint32_t q = v->ge_off[b]; q < v->ge_off[b + 1]; q++) {
                 uint32_t e = v->ge[q];
@@ -1550,13 +1558,10 @@ static void heap_pop(gp_voronoi *v, int32_t *nh)
 static gp_status clip_convex_edges_near(cell_run *R)
 {
     gp_voronoi *v = R->v;
-    gp_vec2 lo, hi;
-    gp_poly_bbox(R->ina ? v->sa : v->sb, (size_t)R->m, &lo, &hi, NULL);
-    double pad = 1e-9 * v->L;
-    int32_t ix0 = bin_x(v, lo.x - pad), ix1 = bin_x(v, hi.x + pad);
-    int32_t iy0 = bin_y(v, lo.y - pad), iy1 = bin_y(v, hi.y + pad);
-    for (int32_t yy = iy0; yy <= iy1; yy++)
-        for (int32_t xx = ix0; xx <= ix1; xx++) {
+    int32_t r[4];
+    poly_bins(v, R->ina ? v->sa : v->sb, (size_t)R->m, r);
+    for (int32_t yy = r[2]; yy <= r[3]; yy++)
+        for (int32_t xx = r[0]; xx <= r[1]; xx++) {
             int32_t b = yy * v->nbx + xx;
             for (uint32_t q = v->ce_off[b]; q < v->ce_off[b + 1]; q++) {
                 uint32_t e = v->ce[q];
