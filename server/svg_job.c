@@ -3,13 +3,11 @@
 
 #include <stdlib.h>
 #include <string.h>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
 
 #include "json_scan.h"
 #include "store.h"
 #include "svg_internal.h"
+#include "util.h"
 
 /* values up to this size are read whole, larger ones through a blob stream (as http.c) */
 #define SVG_JOB_SMALL (256u * 1024u)
@@ -168,9 +166,7 @@ void svg_job_close(svg_job *j)
     value_close(&j->pack);
     value_close(&j->result);
     free(j);
-#ifdef __GLIBC__
     /* what this picture freed (the summary's tree, the items, the private connections' page
      * caches) goes back to the system, as a worker's heap does after a job */
-    malloc_trim(0);
-#endif
+    gpd_heap_trim();
 }

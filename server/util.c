@@ -11,6 +11,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
 void gpd_err_set(gpd_err *e, int status, const char *fmt, ...)
 {
     if (!e) return;
@@ -181,4 +185,21 @@ int gpd_buf_printf(gpd_buf *b, const char *fmt, ...)
     va_end(ap);
     b->len += (size_t)n;
     return 0;
+}
+
+/* ---- the heap ---- */
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define GPD_SANITIZED_HEAP 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define GPD_SANITIZED_HEAP 1
+#endif
+#endif
+
+void gpd_heap_trim(void)
+{
+#if defined(__GLIBC__) && !defined(GPD_SANITIZED_HEAP)
+    malloc_trim(0);
+#endif
 }

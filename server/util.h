@@ -72,4 +72,12 @@ int gpd_buf_add(gpd_buf *b, const void *p, size_t n);
 /* Appends formatted text; 0, or -1 (oom). */
 int gpd_buf_printf(gpd_buf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
+/* ---- the heap ---- */
+
+/* Gives the freed heap back to the system (glibc's malloc_trim), so that a daemon that built a
+ * big specimen or picture is small again once idle. A no-op where malloc is not glibc's: under
+ * ASan glibc's arenas are never initialised, and two threads trimming at once raced in its lazy
+ * initialisation (a read of a NULL top chunk in mtrim, seen in CI on a cancel). */
+void gpd_heap_trim(void);
+
 #endif /* GPD_UTIL_H */

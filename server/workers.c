@@ -2,7 +2,6 @@
 #include "workers.h"
 
 #include <errno.h>
-#include <malloc.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -17,6 +16,7 @@
 #include "metrics.h"
 #include "progress.h"
 #include "result_json.h"
+#include "util.h"
 
 #define PROGRESS_MIN_INTERVAL_S 0.25 /* <= 4 Hz per job */
 #define STORE_RETRY_PAUSE_S 0.5      /* before the one retry of a failed final write */
@@ -516,11 +516,9 @@ static void finish_built(run_ctx *ctx, const void *spec, const json_t *spec_json
         gpd_log(GPD_LOG_WARN, "job %s: no export pack: %s", ctx->id, perr.message);
     json_t *detail = k->done_detail ? k->done_detail(ctx->id, out) : NULL;
     k->destroy(out);
-#ifdef __GLIBC__
     /* the specimen's heap back before the store copies the text and the pack (100,000 grains:
      * ~350 MB, which glibc would otherwise keep resident through the write) */
-    malloc_trim(0);
-#endif
+    gpd_heap_trim();
     finish_succeeded(ctx, text, head, detail, pack, pack_len);
 }
 
@@ -615,11 +613,9 @@ static void *worker_main(void *arg)
             run_job(s, id, kind, spec);
             free(kind);
             free(spec);
-#ifdef __GLIBC__
             /* a big job leaves hundreds of MB of freed heap (its specimen, its result text)
              * that glibc keeps resident; hand it back so that an idle daemon is small again */
-            malloc_trim(0);
-#endif
+            gpd_heap_trim();
             pthread_mutex_lock(&reg_mu);
             s->id[0] = '\0';
             s->deadline = 0;
