@@ -161,6 +161,43 @@ void store_stream_close(store_stream *s)
 
 /* ------------------------------------------------------------------ shared */
 
+/* ---- values in parts ---- */
+
+uint64_t store_part_size(long long limit)
+{
+    return limit > 2048 && (uint64_t)limit - 1024 < STORE_PART ? (uint64_t)limit - 1024
+                                                                : STORE_PART;
+}
+
+int store_parts_add(store_parts *p, uint64_t len)
+{
+    uint64_t *e = realloc(p->end, (p->n + 1) * sizeof *e);
+    if (!e) return -1;
+    e[p->n] = (p->n ? e[p->n - 1] : 0) + len;
+    p->end = e;
+    p->n++;
+    return 0;
+}
+
+size_t store_parts_find(const store_parts *p, uint64_t off, uint64_t *start)
+{
+    size_t lo = 0, hi = p->n - 1; /* the first part whose end is past off */
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (p->end[mid] > off) hi = mid;
+        else lo = mid + 1;
+    }
+    *start = lo ? p->end[lo - 1] : 0;
+    return lo;
+}
+
+void store_parts_free(store_parts *p)
+{
+    free(p->end);
+    p->end = NULL;
+    p->n = 0;
+}
+
 /* ---- the last failed write, for /v1/health ---- */
 static pthread_mutex_t werr_mu = PTHREAD_MUTEX_INITIALIZER;
 static struct {

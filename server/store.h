@@ -44,6 +44,14 @@
  * store_text), inside the one transaction of store_succeed; the pager spills the dirty pages to
  * the WAL as the cache fills, so the store's memory is a piece plus SQLite's page cache.
  *
+ * Values in parts (both): a result or a pack larger than one part (256 MiB, STORE_PART; less
+ * under a lower limit on one value) is stored as parts of that size, the last shorter: part 0
+ * where a value of one part is (results.result or exports.pack; on PostgreSQL jobs.result or
+ * exports.pack), the others in value_parts(seq, what, part, data) -- what 0 for the result, 1
+ * for the pack -- written in the same transaction. So neither database's limit on one value
+ * (SQLite 1e9 bytes, PostgreSQL 1 GB) bounds a result: a 10^6-grain specimen's ~7 GB result is
+ * 27 parts. A stream reads the parts as one value, in one snapshot; a purge removes them.
+ *
  * Checkpoints (SQLite): a commit of a large result leaves hundreds of MB in the WAL; SQLite's
  * automatic checkpoint would copy them into the database on the connection that commits next
  * (a worker, or an HTTP thread), holding it for seconds. So no connection checkpoints by
@@ -95,7 +103,7 @@
 /* ---- the store ---- */
 #define STORE_MAX_ATTEMPTS 3
 
-/* STORE_TOOBIG: a value larger than the database can hold (SQLITE_TOOBIG); retrying is futile.
+/* STORE_TOOBIG: a row larger than the database can hold (SQLITE_TOOBIG); retrying is futile.
  * STORE_FULL: the queue already holds the most jobs it may (store_insert's max_queued). */
 typedef enum {
     STORE_OK = 0,
@@ -155,8 +163,9 @@ int store_fill_briefs(store_brief_fn make);
 /* The job object of api.md (a new reference), or NULL with *rc set. */
 json_t *store_get_job(const char *id, store_rc *rc);
 
-/* The raw text of one column ("result" or "spec") and the job's status; *text is malloc'ed
- * (NULL when the column is NULL). STORE_NOT_FOUND for an unknown id. */
+/* The raw text of one column ("spec" or "kind") and the job's status; *text is malloc'ed
+ * (NULL when the column is NULL). STORE_NOT_FOUND for an unknown id. (A result is read with
+ * store_stream_open: it may be in parts.) */
 store_rc store_get_text(const char *id, const char *column, char **text, char status[16]);
 
 /* Lists jobs newest first: status may be NULL (all), after is a job id (exclusive cursor) or
@@ -195,8 +204,8 @@ typedef struct store_text {
 js_source store_text_source(const store_text *t);
 
 /* Where a worker may put the temporary file of a large result (malloc'ed): the database's
- * directory (SQLite; its disk, not a RAM /tmp); NULL when the back end reads the value whole
- * anyway (PostgreSQL binds it as one parameter) or the store is closed. */
+ * directory (SQLite; its disk, not a RAM /tmp), TMPDIR or else /var/tmp (PostgreSQL); NULL
+ * when the store is closed. */
 char *store_spill_dir(void);
 
 /* Final transitions of a running job (no-ops returning STORE_CONFLICT when it is no longer
@@ -204,10 +213,10 @@ char *store_spill_dir(void);
  * store_succeed commits the result (non-NULL; its JSON text), the pack (may be NULL), the
  * result's summary (store_get_summary; made here from the result, read through its source,
  * left out when it cannot be made) and status 'succeeded' in one transaction, or nothing: every
- * SQLite code is checked and a failure rolls it all back, leaving the job running. SQLite
- * writes the result and the pack in pieces (above); PostgreSQL reads a result in a file back
- * into memory for its bind. STORE_TOOBIG: the result or the pack is larger than the
- * database can store (SQLite's length limit, 1e9 bytes by default), so it never will be;
+ * SQLite code is checked and a failure rolls it all back, leaving the job running. Both write
+ * the result and the pack in parts (above); SQLite fills each in pieces, PostgreSQL binds each
+ * from memory or reads it from the file into a buffer of one part. STORE_TOOBIG: a row the
+ * database cannot store whatever the retries (SQLITE_TOOBIG: a summary over a lowered limit);
  * STORE_ERROR: anything else (disk full, I/O error, a failed commit...), which may pass on a
  * retry. On both, why (may be NULL) gets a sentence saying what went wrong (status 500). */
 store_rc store_succeed(const char *id, const store_text *result, const char *progress_json,

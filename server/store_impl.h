@@ -66,6 +66,25 @@ typedef struct store_backend {
 extern const store_backend store_sqlite;
 extern const store_backend store_pg;
 
+/* ---- values in parts (store.h "Values in parts") ---- */
+#define STORE_PART ((uint64_t)256 << 20) /* bytes of a part, under both databases' 1 GB */
+enum { STORE_VALUE_RESULT = 0, STORE_VALUE_PACK = 1 }; /* value_parts.what */
+/* The part size a writer uses under its database's limit on one value (bytes; <= 0: none):
+ * STORE_PART, or 1 kB less than the limit where that is lower (SQLite's limit bounds a row's
+ * record, keys and header included; a testing hook lowers it to a few kB). */
+uint64_t store_part_size(long long limit);
+/* Where a stream's parts are: end[k] is the value's offset just past part k (n parts, end[n-1]
+ * the value's size); made by a back end's stream when it opens, in its snapshot. */
+typedef struct store_parts {
+    size_t n;
+    uint64_t *end;
+} store_parts;
+/* Appends a part of len bytes; 0, or -1 (out of memory). */
+int store_parts_add(store_parts *p, uint64_t len);
+/* The part holding byte off (< the value's size), and its first byte in *start. */
+size_t store_parts_find(const store_parts *p, uint64_t off, uint64_t *start);
+void store_parts_free(store_parts *p);
+
 /* Calls the hook of store_on_cancel, if any (store_pg's listener). */
 void store_cancel_seen(const char *id);
 /* Calls the hook of store_on_wal_grown, if any (store_sqlite's WAL hook). */

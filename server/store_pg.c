@@ -4,7 +4,8 @@
  * Tables: those of SQLite with the same columns and meaning, plus jobs.owner (the daemon that
  * runs or ran the job), jobs.lease_until (server time; NULL unless running) and
  * jobs.results_written (how many times a result was stored: 1 for every succeeded job, the
- * check of "written exactly once"). Large values (jobs.result, exports.pack) are bytea with
+ * check of "written exactly once"). Large values (jobs.result, exports.pack and the parts of
+ * larger ones, value_parts.data: store.h "Values in parts") are bytea with
  * STORAGE EXTERNAL (out of line, uncompressed), so that substring(v from off for n) reads only
  * the TOAST chunks of the range: that is how a download streams a result or pack.
  *
@@ -210,6 +211,9 @@ static const char *SCHEMA_SQL =
     "CREATE INDEX IF NOT EXISTS jobs_owner ON jobs(owner) WHERE status = 'running';"
     "CREATE TABLE IF NOT EXISTS exports(seq BIGINT PRIMARY KEY, pack BYTEA NOT NULL);"
     "ALTER TABLE exports ALTER COLUMN pack SET STORAGE EXTERNAL;"
+    "CREATE TABLE IF NOT EXISTS value_parts(seq BIGINT NOT NULL, what SMALLINT NOT NULL,"
+    " part INTEGER NOT NULL, data BYTEA NOT NULL, PRIMARY KEY(seq, what, part));"
+    "ALTER TABLE value_parts ALTER COLUMN data SET STORAGE EXTERNAL;"
     "CREATE TABLE IF NOT EXISTS summaries(seq BIGINT PRIMARY KEY, summary TEXT NOT NULL,"
     " arrays TEXT);";
 
@@ -529,16 +533,14 @@ static store_rc pg_get_text(const char *id, const char *column, char **text, cha
 {
     *text = NULL;
     const char *sql;
-    if (!strcmp(column, "result"))
-        sql = "SELECT status, result FROM jobs WHERE id=$1";
-    else if (!strcmp(column, "spec"))
+    if (!strcmp(column, "spec"))
         sql = "SELECT status, spec FROM jobs WHERE id=$1";
     else if (!strcmp(column, "kind"))
         sql = "SELECT status, kind FROM jobs WHERE id=$1";
     else
         return STORE_ERROR;
     const char *v[1] = {id};
-    PGresult *r = run(sql, 1, v, NULL, NULL, 1); /* binary: the result's bytes as they are */
+    PGresult *r = run(sql, 1, v, NULL, NULL, 1);
     if (!r) return STORE_ERROR;
     store_rc rc = PQntuples(r) ? STORE_OK : STORE_NOT_FOUND;
     if (rc == STORE_OK) {
@@ -723,33 +725,76 @@ static store_rc pg_requeue(const char *id)
                        id, 2, NULL, NULL);
 }
 
-/* A value over the largest one stored: 1 with the sizes in why (store_sqlite's words). */
-static int too_big(size_t rlen, const void *pack, size_t pack_len, gpd_err *why)
+/* A value to write in parts (store.h "Values in parts"): its source, the part size, and a
+ * buffer of one part where the source is a file (libpq binds a parameter from memory). */
+typedef struct pg_value {
+    const store_text *v;
+    uint64_t part;
+    char *buf;
+} pg_value;
+
+/* Part k of pv as a parameter: *p and *len; 0, or -1 when the file cannot be read. */
+static int part_bytes(pg_value *pv, uint64_t k, const char **p, int *len)
 {
-    if ((long long)rlen <= max_value && !(pack && (long long)pack_len > max_value)) return 0;
-    int is_pack = (long long)rlen <= max_value;
-    gpd_err_set(why, 500,
-                "the %s is %zu bytes, more than the job database can store in one value "
-                "(%lld bytes)",
-                is_pack ? "export pack" : "result", is_pack ? pack_len : rlen, max_value);
-    return 1;
+    uint64_t base = k * pv->part, n = pv->v->len - base < pv->part ? pv->v->len - base : pv->part;
+    *len = (int)n; /* a part < 1 GB */
+    if (pv->v->mem) {
+        *p = pv->v->mem + base;
+        return 0;
+    }
+    js_source src = store_text_source(pv->v);
+    *p = pv->buf;
+    return n ? src.read(src.user, base, pv->buf, (size_t)n) : 0;
 }
 
-/* The rows of store_succeed's transaction after the job's own: its pack and summary. */
-static store_rc succeed_extras(const char *seq, const void *pack, size_t pack_len,
+/* The parts after part 0 of value `what` of job seq: the old ones removed, pv's written. */
+static store_rc write_parts(const char *seq, int what, pg_value *pv)
+{
+    char w[8], k[24];
+    snprintf(w, sizeof w, "%d", what);
+    const char *dv[2] = {seq, w};
+    PGresult *r = run("DELETE FROM value_parts WHERE seq=$1::bigint AND what=$2::smallint", 2, dv,
+                      NULL, NULL, 0);
+    if (!r) return STORE_ERROR;
+    PQclear(r);
+    for (uint64_t part = 1; part * pv->part < pv->v->len; part++) {
+        const char *bytes;
+        int blen;
+        if (part_bytes(pv, part, &bytes, &blen)) return STORE_ERROR;
+        snprintf(k, sizeof k, "%llu", (unsigned long long)part);
+        const char *v[4] = {seq, w, k, bytes};
+        int lens[4] = {0, 0, 0, blen}, fmts[4] = {0, 0, 0, 1};
+        r = run("INSERT INTO value_parts(seq, what, part, data) "
+                "VALUES ($1::bigint, $2::smallint, $3::int, $4::bytea)",
+                4, v, lens, fmts, 0);
+        long n = changed(r);
+        PQclear(r);
+        if (n != 1) return STORE_ERROR;
+    }
+    return STORE_OK;
+}
+
+/* The rows of store_succeed's transaction after the job's own: the result's other parts, the
+ * pack and the summary. */
+static store_rc succeed_extras(const char *seq, pg_value *result, pg_value *pack,
                                const char *summary, size_t slen, const char *arrays)
 {
-    if (pack) {
-        const char *v[2] = {seq, pack};
-        int lens[2] = {0, (int)pack_len}, fmts[2] = {0, 1};
+    store_rc rc = write_parts(seq, STORE_VALUE_RESULT, result);
+    if (rc == STORE_OK && pack->v) {
+        const char *bytes;
+        int blen;
+        if (part_bytes(pack, 0, &bytes, &blen)) return STORE_ERROR;
+        const char *v[2] = {seq, bytes};
+        int lens[2] = {0, blen}, fmts[2] = {0, 1};
         PGresult *r = run("INSERT INTO exports(seq, pack) VALUES ($1::bigint, $2::bytea) "
                           "ON CONFLICT (seq) DO UPDATE SET pack = EXCLUDED.pack",
                           2, v, lens, fmts, 0);
         long n = changed(r);
         PQclear(r);
         if (n != 1) return STORE_ERROR;
+        rc = write_parts(seq, STORE_VALUE_PACK, pack);
     }
-    if (summary) {
+    if (rc == STORE_OK && summary) {
         const char *v[3] = {seq, summary, arrays};
         int lens[3] = {0, (int)slen, 0}, fmts[3] = {0, 0, 0};
         PGresult *r = run("INSERT INTO summaries(seq, summary, arrays) VALUES ($1::bigint, $2, $3) "
@@ -760,34 +805,56 @@ static store_rc succeed_extras(const char *seq, const void *pack, size_t pack_le
         PQclear(r);
         if (n != 1) return STORE_ERROR;
     }
-    return STORE_OK;
+    return rc;
 }
 
-static store_rc succeed_mem(const char *id, const char *result_json, size_t rlen,
-                            const char *progress_json, const char *brief_json, const void *pack,
-                            size_t pack_len, const char *summary, size_t slen,
-                            const char *arrays, gpd_err *why)
+/* The job's row: succeeded with part 0 of the result, only while it is still ours (a daemon
+ * that lost it writes nothing: exactly one result). STORE_OK with its seq, STORE_CONFLICT. */
+static store_rc mark_succeeded(const char *id, pg_value *result, const char *progress_json,
+                               const char *brief_json, char seq[24])
 {
-    if (too_big(rlen, pack, pack_len, why)) return STORE_TOOBIG;
-    char now[40], seq[24] = "";
+    const char *bytes;
+    int blen;
+    if (part_bytes(result, 0, &bytes, &blen)) return STORE_ERROR;
+    char now[40];
     gpd_now_rfc3339(now, sizeof now);
-    if (simple("BEGIN")) {
-        gpd_err_set(why, 500, "cannot begin a transaction on the job database");
-        return STORE_ERROR;
-    }
-    /* the result, the pack, the summary and the status commit together, and only while the
-     * job is still ours: a daemon that lost it writes nothing (exactly one result) */
-    const char *v[6] = {id, result_json, progress_json, now, brief_json, owner};
-    int lens[6] = {0, (int)rlen, 0, 0, 0, 0}, fmts[6] = {0, 1, 0, 0, 0, 0};
+    const char *v[6] = {id, bytes, progress_json, now, brief_json, owner};
+    int lens[6] = {0, blen, 0, 0, 0, 0}, fmts[6] = {0, 1, 0, 0, 0, 0};
     PGresult *r = run("UPDATE jobs SET status='succeeded', result=$2::bytea, progress=$3, "
                       "finished_at=$4, error=NULL, brief=coalesce($5, brief), lease_until=NULL, "
                       "results_written = results_written + 1 "
                       "WHERE id=$1 AND status='running' AND owner=$6 RETURNING seq",
                       6, v, lens, fmts, 0);
     store_rc rc = !r ? STORE_ERROR : PQntuples(r) == 1 ? STORE_OK : STORE_CONFLICT;
-    if (rc == STORE_OK) snprintf(seq, sizeof seq, "%s", PQgetvalue(r, 0, 0));
+    if (rc == STORE_OK) snprintf(seq, 24, "%s", PQgetvalue(r, 0, 0));
     PQclear(r);
-    if (rc == STORE_OK) rc = succeed_extras(seq, pack, pack_len, summary, slen, arrays);
+    return rc;
+}
+
+/* store_succeed: the result (from memory or its worker's file) and the pack in parts of at
+ * most the largest value (store.h "Values in parts"), bound one part at a time, so that
+ * neither PostgreSQL's 1 GB a field nor this daemon's memory bounds a result. */
+static store_rc pg_succeed(const char *id, const store_text *result, const char *progress_json,
+                           const char *brief_json, const void *pack, size_t pack_len,
+                           const char *summary, size_t slen, const char *arrays, gpd_err *why)
+{
+    uint64_t part = store_part_size(max_value);
+    store_text pt = {pack, -1, pack_len};
+    pg_value rv = {result, part, NULL}, pv = {pack ? &pt : NULL, part, NULL};
+    if (!result->mem && !(rv.buf = malloc(result->len < part ? result->len + 1 : part))) {
+        gpd_err_set(why, 500, "out of memory for a part of the result");
+        return STORE_ERROR;
+    }
+    if (simple("BEGIN")) {
+        free(rv.buf);
+        gpd_err_set(why, 500, "cannot begin a transaction on the job database");
+        return STORE_ERROR;
+    }
+    /* the result, the pack, the summary and the status commit together */
+    char seq[24] = "";
+    store_rc rc = mark_succeeded(id, &rv, progress_json, brief_json, seq);
+    if (rc == STORE_OK) rc = succeed_extras(seq, &rv, &pv, summary, slen, arrays);
+    free(rv.buf);
     pg_conn *c = key_made ? pthread_getspecific(conn_key) : NULL;
     char em[300];
     snprintf(em, sizeof em, "%s", c ? PQerrorMessage(c->pg) : "no connection");
@@ -800,30 +867,6 @@ static store_rc succeed_mem(const char *id, const char *result_json, size_t rlen
     return rc;
 }
 
-/* store_succeed: the result is bound whole as one bytea parameter, so a result a worker wrote
- * into a file is read back into memory first (workers spill only where store_spill_dir says so:
- * never with this back end; chunked storage here is later work) */
-static store_rc pg_succeed(const char *id, const store_text *result, const char *progress_json,
-                           const char *brief_json, const void *pack, size_t pack_len,
-                           const char *summary, size_t slen, const char *arrays, gpd_err *why)
-{
-    if (result->mem)
-        return succeed_mem(id, result->mem, (size_t)result->len, progress_json, brief_json,
-                           pack, pack_len, summary, slen, arrays, why);
-    if (too_big((size_t)result->len, pack, pack_len, why)) return STORE_TOOBIG;
-    char *text = malloc((size_t)result->len + 1);
-    js_source src = store_text_source(result);
-    if (!text || src.read(src.user, 0, text, (size_t)result->len)) {
-        free(text);
-        gpd_err_set(why, 500, "cannot read the result's temporary file back");
-        return STORE_ERROR;
-    }
-    store_rc rc = succeed_mem(id, text, (size_t)result->len, progress_json, brief_json, pack,
-                              pack_len, summary, slen, arrays, why);
-    free(text);
-    return rc;
-}
-
 /* no WAL of ours to checkpoint (the server runs its own) */
 static int pg_checkpoint(int may_yield)
 {
@@ -833,10 +876,12 @@ static int pg_checkpoint(int may_yield)
 
 static void pg_checkpoint_yield(void) {}
 
-/* values are bound whole: workers keep results in memory */
+/* a worker's large result goes to a file on disk (the daemon may have no directory of its
+ * own with PostgreSQL): TMPDIR, else /var/tmp -- not /tmp, which may be RAM */
 static char *pg_spill_dir(void)
 {
-    return NULL;
+    const char *t = getenv("TMPDIR");
+    return strdup(t && *t ? t : "/var/tmp");
 }
 
 static store_rc pg_cancel(const char *id, int *was_running, char status_out[16], char kind_out[64])
@@ -892,6 +937,7 @@ static store_rc pg_purge(const char *id, char status_out[16])
     }
     PQclear(q);
     static const char *const del[] = {"DELETE FROM exports WHERE seq=$1::bigint",
+                                      "DELETE FROM value_parts WHERE seq=$1::bigint",
                                       "DELETE FROM summaries WHERE seq=$1::bigint",
                                       "DELETE FROM jobs WHERE seq=$1::bigint"};
     const char *sv[1] = {seq};
@@ -959,11 +1005,12 @@ static int pg_size(long long *bytes)
 
 #define PG_READ_AHEAD (256u * 1024u) /* bytes fetched per round trip */
 
+/* A value read across its parts (store.h "Values in parts") in one snapshot. */
 typedef struct pg_stream {
     PGconn *pg;        /* private: its REPEATABLE READ transaction is the snapshot */
-    const char *sql;   /* the slice query of the value's table */
-    char seq[24];
-    uint64_t size;
+    const char *sql;   /* the slice query of part 0's table */
+    char seq[24], what[8];
+    store_parts parts;
     unsigned char *buf; /* the last slice fetched: [buf_off, buf_off + buf_len) */
     uint64_t buf_off;
     size_t buf_len;
@@ -973,24 +1020,30 @@ static const char *SLICE_RESULT =
     "SELECT substring(result from $2::int for $3::int) FROM jobs WHERE seq=$1::bigint";
 static const char *SLICE_PACK =
     "SELECT substring(pack from $2::int for $3::int) FROM exports WHERE seq=$1::bigint";
+static const char *SLICE_PART =
+    "SELECT substring(data from $2::int for $3::int) FROM value_parts "
+    "WHERE seq=$1::bigint AND what=$4::smallint AND part=$5::int";
 
 static void pg_stream_close(store_stream *s)
 {
     pg_stream *ps = (pg_stream *)s;
     if (!ps) return;
     PQfinish(ps->pg);
+    store_parts_free(&ps->parts);
     free(ps->buf);
     free(ps);
 }
 
-/* Fetches n bytes at off (1-based in SQL) into dst on ps's connection; 0, or -1. */
-static int slice(pg_stream *ps, uint64_t off, size_t n, unsigned char *dst)
+/* Fetches n bytes at off of part k (within it) into dst on ps's connection; 0, or -1. */
+static int slice(pg_stream *ps, size_t k, uint64_t off, size_t n, unsigned char *dst)
 {
-    char o[24], l[24];
-    snprintf(o, sizeof o, "%llu", (unsigned long long)off + 1);
+    char o[24], l[24], p[24];
+    snprintf(o, sizeof o, "%llu", (unsigned long long)off + 1); /* 1-based in SQL */
     snprintf(l, sizeof l, "%zu", n);
-    const char *v[3] = {ps->seq, o, l};
-    PGresult *r = PQexecParams(ps->pg, ps->sql, 3, NULL, v, NULL, NULL, 1);
+    snprintf(p, sizeof p, "%zu", k);
+    const char *v[5] = {ps->seq, o, l, ps->what, p};
+    PGresult *r = PQexecParams(ps->pg, k ? SLICE_PART : ps->sql, k ? 5 : 3, NULL, v, NULL, NULL,
+                               1);
     int ok = ok_result(r) && PQntuples(r) == 1 && (size_t)PQgetlength(r, 0, 0) == n;
     if (ok) memcpy(dst, PQgetvalue(r, 0, 0), n);
     else gpd_log(GPD_LOG_ERROR, "postgresql stream read: %s", PQerrorMessage(ps->pg));
@@ -998,14 +1051,35 @@ static int slice(pg_stream *ps, uint64_t off, size_t n, unsigned char *dst)
     return ok ? 0 : -1;
 }
 
-/* A stream of a large value: its own connection and snapshot, the size read in it. */
-static store_rc open_private(const char *sql, const char *size_sql, const char *seq,
+/* The sizes of the value's parts, in ps's snapshot: part 0 by size_sql, the others from
+ * value_parts. 0, or -1. */
+static int read_parts(pg_stream *ps, const char *size_sql)
+{
+    const char *v[2] = {ps->seq, ps->what};
+    PGresult *r = PQexecParams(ps->pg, size_sql, 1, NULL, v, NULL, NULL, 0);
+    int ok = r && ok_result(r) && PQntuples(r) == 1 && !PQgetisnull(r, 0, 0) &&
+             !store_parts_add(&ps->parts, strtoull(PQgetvalue(r, 0, 0), NULL, 10));
+    PQclear(r);
+    r = ok ? PQexecParams(ps->pg, "SELECT octet_length(data) FROM value_parts "
+                                  "WHERE seq=$1::bigint AND what=$2::smallint ORDER BY part",
+                          2, NULL, v, NULL, NULL, 0)
+           : NULL;
+    ok = r && ok_result(r);
+    for (int i = 0; ok && i < PQntuples(r); i++)
+        ok = !store_parts_add(&ps->parts, strtoull(PQgetvalue(r, i, 0), NULL, 10));
+    PQclear(r);
+    return ok ? 0 : -1;
+}
+
+/* A stream of a large value: its own connection and snapshot, the parts' sizes read in it. */
+static store_rc open_private(const char *sql, const char *size_sql, const char *seq, int what,
                              store_stream **out)
 {
     pg_stream *ps = calloc(1, sizeof *ps);
     if (!ps) return STORE_ERROR;
     ps->sql = sql;
     snprintf(ps->seq, sizeof ps->seq, "%s", seq);
+    snprintf(ps->what, sizeof ps->what, "%d", what);
     ps->pg = connect_new();
     ps->buf = malloc(PG_READ_AHEAD);
     PGresult *b = ps->pg && ps->buf
@@ -1013,17 +1087,53 @@ static store_rc open_private(const char *sql, const char *size_sql, const char *
                       : NULL;
     int ok = b && ok_result(b);
     PQclear(b);
-    const char *v[1] = {seq};
-    PGresult *r = ok ? PQexecParams(ps->pg, size_sql, 1, NULL, v, NULL, NULL, 0) : NULL;
-    ok = r && ok_result(r) && PQntuples(r) == 1 && !PQgetisnull(r, 0, 0);
-    if (ok) ps->size = strtoull(PQgetvalue(r, 0, 0), NULL, 10);
-    PQclear(r);
-    if (!ok) {
+    if (!ok || read_parts(ps, size_sql)) {
         pg_stream_close((store_stream *)ps);
         return STORE_ERROR;
     }
     *out = (store_stream *)ps;
     return STORE_OK;
+}
+
+static uint64_t pg_stream_size(const store_stream *s)
+{
+    const pg_stream *ps = (const pg_stream *)s;
+    return ps->parts.end[ps->parts.n - 1];
+}
+
+static int pg_stream_read(store_stream *s, uint64_t off, void *dst, size_t n);
+
+/* A stream of at most small bytes read whole into *text, and closed. */
+static store_rc read_whole(store_stream *s, char **text, size_t *text_len)
+{
+    size_t size = (size_t)pg_stream_size(s);
+    char *buf = malloc(size + 1);
+    store_rc rc = buf && !pg_stream_read(s, 0, buf, size) ? STORE_OK : STORE_ERROR;
+    pg_stream_close(s);
+    if (rc != STORE_OK) {
+        free(buf);
+        return rc;
+    }
+    buf[size] = 0;
+    *text = buf;
+    *text_len = size;
+    return STORE_OK;
+}
+
+/* A value of one part of at most small bytes, read whole on this thread's connection. */
+static store_rc read_small(int is_pack, const char *seq, char **text, size_t *text_len)
+{
+    const char *w[1] = {seq};
+    PGresult *r = run(is_pack ? "SELECT pack FROM exports WHERE seq=$1::bigint"
+                              : "SELECT result FROM jobs WHERE seq=$1::bigint",
+                      1, w, NULL, NULL, 1);
+    store_rc rc = r && PQntuples(r) == 1 && !PQgetisnull(r, 0, 0) ? STORE_OK : STORE_ERROR;
+    if (rc == STORE_OK) {
+        *text_len = (size_t)PQgetlength(r, 0, 0);
+        if (!(*text = dup_val(r, 0, 0))) rc = STORE_ERROR;
+    }
+    PQclear(r);
+    return rc;
 }
 
 static store_rc pg_stream_open(const char *id, const char *what, size_t small, store_stream **out,
@@ -1037,9 +1147,12 @@ static store_rc pg_stream_open(const char *id, const char *what, size_t small, s
     if (!is_pack && strcmp(what, "result")) return STORE_ERROR;
     const char *v[1] = {id};
     /* octet_length of a TOASTed bytea reads its header, not the value */
-    PGresult *r = run(is_pack ? "SELECT j.status, j.seq, octet_length(e.pack) FROM jobs j "
-                                "LEFT JOIN exports e ON e.seq = j.seq WHERE j.id=$1"
-                              : "SELECT status, seq, octet_length(result) FROM jobs WHERE id=$1",
+    PGresult *r = run(is_pack ? "SELECT j.status, j.seq, octet_length(e.pack), EXISTS (SELECT 1 "
+                                "FROM value_parts p WHERE p.seq = j.seq AND p.what = 1) "
+                                "FROM jobs j LEFT JOIN exports e ON e.seq = j.seq WHERE j.id=$1"
+                              : "SELECT status, seq, octet_length(result), EXISTS (SELECT 1 "
+                                "FROM value_parts p WHERE p.seq = jobs.seq AND p.what = 0) "
+                                "FROM jobs WHERE id=$1",
                       1, v, NULL, NULL, 0);
     if (!r) return STORE_ERROR;
     if (!PQntuples(r)) {
@@ -1049,45 +1162,34 @@ static store_rc pg_stream_open(const char *id, const char *what, size_t small, s
     snprintf(status, 16, "%s", PQgetvalue(r, 0, 0));
     char seq[24];
     snprintf(seq, sizeof seq, "%s", PQgetvalue(r, 0, 1));
-    int none = PQgetisnull(r, 0, 2);
+    int none = PQgetisnull(r, 0, 2), parts = !strcmp(PQgetvalue(r, 0, 3), "t");
     uint64_t size = none ? 0 : strtoull(PQgetvalue(r, 0, 2), NULL, 10);
     PQclear(r);
     if (none) return STORE_OK; /* not finished, or no pack */
-    const char *sl = is_pack ? SLICE_PACK : SLICE_RESULT;
-    if (size > small)
-        return open_private(sl, is_pack ? "SELECT octet_length(pack) FROM exports WHERE "
-                                          "seq=$1::bigint"
-                                        : "SELECT octet_length(result) FROM jobs WHERE "
-                                          "seq=$1::bigint",
-                            seq, out);
-    const char *w[1] = {seq};
-    r = run(is_pack ? "SELECT pack FROM exports WHERE seq=$1::bigint"
-                    : "SELECT result FROM jobs WHERE seq=$1::bigint",
-            1, w, NULL, NULL, 1);
-    store_rc rc = r && PQntuples(r) == 1 && !PQgetisnull(r, 0, 0) ? STORE_OK : STORE_ERROR;
-    if (rc == STORE_OK) {
-        *text_len = (size_t)PQgetlength(r, 0, 0);
-        if (!(*text = dup_val(r, 0, 0))) rc = STORE_ERROR;
-    }
-    PQclear(r);
+    if (size <= small && !parts) return read_small(is_pack, seq, text, text_len);
+    store_rc rc = open_private(
+        is_pack ? SLICE_PACK : SLICE_RESULT,
+        is_pack ? "SELECT octet_length(pack) FROM exports WHERE seq=$1::bigint"
+                : "SELECT octet_length(result) FROM jobs WHERE seq=$1::bigint",
+        seq, is_pack ? STORE_VALUE_PACK : STORE_VALUE_RESULT, out);
+    if (rc != STORE_OK || pg_stream_size(*out) > small) return rc;
+    rc = read_whole(*out, text, text_len);
+    *out = NULL;
     return rc;
-}
-
-static uint64_t pg_stream_size(const store_stream *s)
-{
-    return ((const pg_stream *)s)->size;
 }
 
 static int pg_stream_read(store_stream *s, uint64_t off, void *dst, size_t n)
 {
     pg_stream *ps = (pg_stream *)s;
-    if (off > ps->size || n > ps->size - off) return -1;
+    if (off > pg_stream_size(s) || n > pg_stream_size(s) - off) return -1;
     unsigned char *d = dst;
     while (n > 0) {
-        if (off < ps->buf_off || off >= ps->buf_off + ps->buf_len) { /* fetch the next slice */
-            uint64_t left = ps->size - off;
+        if (off < ps->buf_off || off >= ps->buf_off + ps->buf_len) { /* the next slice */
+            uint64_t start;
+            size_t k = store_parts_find(&ps->parts, off, &start);
+            uint64_t left = ps->parts.end[k] - off; /* a slice stays within its part */
             size_t len = left < PG_READ_AHEAD ? (size_t)left : PG_READ_AHEAD;
-            if (slice(ps, off, len, ps->buf)) return -1;
+            if (slice(ps, k, off - start, len, ps->buf)) return -1;
             ps->buf_off = off;
             ps->buf_len = len;
         }

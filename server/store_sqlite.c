@@ -105,6 +105,10 @@ static const char *SCHEMA_SQL =
     /* the export pack of a succeeded job (core/export/gp_export.h), keyed by the job's seq so that
      * it can be read with incremental blob I/O */
     "CREATE TABLE IF NOT EXISTS exports(seq INTEGER PRIMARY KEY, pack BLOB NOT NULL);"
+    /* the parts after the first of a value over one part (store.h "Values in parts"): a rowid
+     * table, so that each part is written and read with incremental blob I/O */
+    "CREATE TABLE IF NOT EXISTS value_parts(seq INTEGER NOT NULL, what INTEGER NOT NULL,"
+    " part INTEGER NOT NULL, data BLOB NOT NULL, PRIMARY KEY(seq, what, part));"
     /* the summary of a succeeded job's result (store_get_summary), committed with it; a
      * table of its own so that databases written before it need no migration */
     "CREATE TABLE IF NOT EXISTS summaries(seq INTEGER PRIMARY KEY, summary TEXT NOT NULL,"
@@ -546,10 +550,7 @@ static store_rc sq_get_text(const char *id, const char *column, char **text, cha
     sqlite3 *db = conn();
     if (!db) return STORE_ERROR;
     const char *sql;
-    if (!strcmp(column, "result"))
-        sql = "SELECT j.status, coalesce(r.result, j.result) FROM jobs j "
-              "LEFT JOIN results r ON r.seq = j.seq WHERE j.id=?1";
-    else if (!strcmp(column, "spec"))
+    if (!strcmp(column, "spec"))
         sql = "SELECT status, spec FROM jobs WHERE id=?1";
     else if (!strcmp(column, "kind"))
         sql = "SELECT status, kind FROM jobs WHERE id=?1";
@@ -768,55 +769,80 @@ static int mark_succeeded(sqlite3 *db, const char *id, const char *progress_json
     return rc;
 }
 
-/* Writes v into `table`(seq, `column`) for row seq: inserted (or replaced) as zeroblob(len)
- * -- the row's last column, so SQLite keeps the zeros implicit and builds no record of len
- * bytes -- then filled with sqlite3_blob_write, STORE_PIECE bytes at a time, straight from
- * memory or read from the file into buf. Inside the caller's transaction. SQLite's code
- * (SQLITE_OK when done); a failed read of the file is SQLITE_IOERR with *read_errno set. */
-static int write_pieces(sqlite3 *db, const char *insert_sql, const char *table,
-                        const char *column, sqlite3_int64 seq, const store_text *v, char *buf,
-                        int *read_errno)
+/* Fills the blob table.column of row rowid (made as zeroblob(n)) with bytes [base, base + n)
+ * of v, STORE_PIECE at a time, straight from memory or read from the file into buf. SQLite's
+ * code; a failed read of the file is SQLITE_IOERR with *read_errno set. */
+static int fill_blob(sqlite3 *db, const char *table, const char *column, sqlite3_int64 rowid,
+                     const store_text *v, uint64_t base, uint64_t n, char *buf, int *read_errno)
 {
-    sqlite3_stmt *st = prep(db, insert_sql);
-    if (!st) return sqlite3_errcode(db);
-    sqlite3_bind_int64(st, 1, seq);
-    int rc = sqlite3_bind_zeroblob64(st, 2, v->len);
-    if (rc == SQLITE_OK) {
-        rc = sqlite3_step(st);
-        if (rc == SQLITE_DONE) rc = SQLITE_OK;
-    }
-    done(st);
-    if (rc != SQLITE_OK) return rc;
     sqlite3_blob *b = NULL;
-    rc = sqlite3_blob_open(db, "main", table, column, seq, 1, &b);
+    int rc = sqlite3_blob_open(db, "main", table, column, rowid, 1, &b);
     js_source src = store_text_source(v);
-    for (uint64_t off = 0; rc == SQLITE_OK && off < v->len; off += STORE_PIECE) {
-        size_t n = v->len - off < STORE_PIECE ? (size_t)(v->len - off) : STORE_PIECE;
-        const char *piece = v->mem ? v->mem + off : buf;
-        if (!v->mem && src.read(src.user, off, buf, n)) {
+    for (uint64_t off = 0; rc == SQLITE_OK && off < n; off += STORE_PIECE) {
+        size_t k = n - off < STORE_PIECE ? (size_t)(n - off) : STORE_PIECE;
+        const char *piece = v->mem ? v->mem + base + off : buf;
+        if (!v->mem && src.read(src.user, base + off, buf, k)) {
             *read_errno = errno ? errno : EIO;
             rc = SQLITE_IOERR;
             break;
         }
-        rc = sqlite3_blob_write(b, piece, (int)n, (int)off); /* len <= the length limit < 2^31 */
+        rc = sqlite3_blob_write(b, piece, (int)k, (int)off); /* a part < the length limit */
     }
     int crc = sqlite3_blob_close(b);
     return rc == SQLITE_OK ? crc : rc;
 }
 
-/* A value over SQLite's length limit (1e9 bytes by default) cannot be stored at all: 1 (with
- * the sizes in why), without trying; else 0. */
-static int too_big(sqlite3 *db, uint64_t rlen, const void *pack, size_t pack_len, gpd_err *why)
+/* Inserts one part as zeroblob(n) -- the row's last column, so SQLite keeps the zeros implicit
+ * and builds no record of n bytes: sql binds ?1 seq, ?2 the zeroblob and, for value_parts,
+ * ?3 what and ?4 part. SQLite's code, and the row's rowid. */
+static int insert_zeroblob(sqlite3 *db, const char *sql, sqlite3_int64 seq, int what, int part,
+                           uint64_t n, sqlite3_int64 *rowid)
 {
-    long long lim = sqlite3_limit(db, SQLITE_LIMIT_LENGTH, -1);
-    if (rlen <= (uint64_t)lim && !(pack && (long long)pack_len > lim)) return 0;
-    int is_pack = rlen <= (uint64_t)lim;
-    gpd_err_set(why, 500,
-                "the %s is %llu bytes, more than the job database can store in one value "
-                "(%lld bytes)",
-                is_pack ? "export pack" : "result",
-                (unsigned long long)(is_pack ? pack_len : rlen), lim);
-    return 1;
+    sqlite3_stmt *st = prep(db, sql);
+    if (!st) return sqlite3_errcode(db);
+    sqlite3_bind_int64(st, 1, seq);
+    int rc = sqlite3_bind_zeroblob64(st, 2, n);
+    if (rc == SQLITE_OK && sqlite3_bind_parameter_count(st) >= 4) {
+        sqlite3_bind_int(st, 3, what);
+        sqlite3_bind_int(st, 4, part);
+    }
+    if (rc == SQLITE_OK) {
+        rc = sqlite3_step(st);
+        if (rc == SQLITE_DONE) rc = SQLITE_OK;
+    }
+    *rowid = sqlite3_last_insert_rowid(db);
+    done(st);
+    return rc;
+}
+
+/* Writes value v (what: STORE_VALUE_*) of job seq: part 0 by home_sql into table.column (row
+ * seq), the others into value_parts (store.h "Values in parts"), each filled in place. Inside
+ * the caller's transaction. SQLite's code (SQLITE_OK when done). */
+static int write_value(sqlite3 *db, const char *home_sql, const char *table, const char *column,
+                       sqlite3_int64 seq, int what, const store_text *v, char *buf,
+                       int *read_errno)
+{
+    sqlite3_stmt *st = prep(db, "DELETE FROM value_parts WHERE seq=?1 AND what=?2");
+    if (!st) return sqlite3_errcode(db);
+    sqlite3_bind_int64(st, 1, seq);
+    sqlite3_bind_int(st, 2, what);
+    int rc = step_done(db, st) ? sqlite3_errcode(db) : SQLITE_OK;
+    done(st);
+    uint64_t part = store_part_size(sqlite3_limit(db, SQLITE_LIMIT_LENGTH, -1));
+    for (uint64_t base = 0, k = 0; rc == SQLITE_OK && (k == 0 || base < v->len);
+         base += part, k++) {
+        uint64_t n = v->len - base < part ? v->len - base : part;
+        sqlite3_int64 rowid = 0;
+        rc = insert_zeroblob(db,
+                             k ? "INSERT INTO value_parts(seq, what, part, data) "
+                                 "VALUES (?1, ?3, ?4, ?2)"
+                               : home_sql,
+                             seq, what, (int)k, n, &rowid);
+        if (rc == SQLITE_OK)
+            rc = fill_blob(db, k ? "value_parts" : table, k ? "data" : column, rowid, v, base, n,
+                           buf, read_errno);
+    }
+    return rc;
 }
 
 /* The end of store_succeed's transaction: COMMIT when every write passed, else the reason
@@ -865,14 +891,14 @@ static store_rc succeed_rows(sqlite3 *db, const char *id, sqlite3_int64 seq,
         *src = SQLITE_NOMEM;
         return STORE_ERROR;
     }
-    *src = write_pieces(db, "INSERT OR REPLACE INTO results(seq, result) VALUES (?1, ?2)",
-                        "results", "result", seq, result, buf, read_errno);
+    *src = write_value(db, "INSERT OR REPLACE INTO results(seq, result) VALUES (?1, ?2)",
+                       "results", "result", seq, STORE_VALUE_RESULT, result, buf, read_errno);
     free(buf);
     if (*src != SQLITE_OK) return STORE_ERROR;
     if (pack) {
         store_text p = {pack, -1, pack_len};
-        *src = write_pieces(db, "INSERT OR REPLACE INTO exports(seq, pack) VALUES (?1, ?2)",
-                            "exports", "pack", seq, &p, NULL, read_errno);
+        *src = write_value(db, "INSERT OR REPLACE INTO exports(seq, pack) VALUES (?1, ?2)",
+                           "exports", "pack", seq, STORE_VALUE_PACK, &p, NULL, read_errno);
         if (*src != SQLITE_OK) return STORE_ERROR;
     }
     if (summary) {
@@ -895,7 +921,6 @@ static store_rc sq_succeed(const char *id, const store_text *result, const char 
         gpd_err_set(why, 500, "no connection to the database");
         return STORE_ERROR;
     }
-    if (too_big(db, result->len, pack, pack_len, why)) return STORE_TOOBIG;
     char now[40];
     gpd_now_rfc3339(now, sizeof now);
     /* The result, the pack and the status change commit together: a job never shows
@@ -916,10 +941,16 @@ static store_rc sq_succeed(const char *id, const store_text *result, const char 
 
 /* ------------------------------------------------------------------ streams */
 
+/* A value read across its parts (store.h "Values in parts") in one snapshot: the private
+ * connection's read transaction, begun before part 0 is opened. */
 struct store_stream {
     sqlite3 *db;
-    sqlite3_blob *blob;
-    uint64_t size;
+    sqlite3_blob *blob;  /* the part being read (cur) */
+    size_t cur;
+    const char *table, *column; /* part 0's row: seq of table.column */
+    sqlite3_int64 seq;
+    sqlite3_int64 *rowid; /* of the other parts in value_parts (rowid[0] unused) */
+    store_parts parts;
 };
 
 /* Opens table.column of row seq on db; 0 on success, 1 when there is no such value. */
@@ -934,6 +965,101 @@ static int blob_open(sqlite3 *db, const char *table, const char *column, sqlite3
     sqlite3_blob_close(*out);
     *out = NULL;
     return 1;
+}
+
+/* The parts after part 0 of value `what` of job seq, on db (in its transaction): their rowids
+ * and sizes appended to ss. 0, or -1. */
+static int list_parts(sqlite3 *db, sqlite3_int64 seq, int what, store_stream *ss)
+{
+    sqlite3_stmt *st = NULL;
+    /* length() of a blob reads its record header, not its pages */
+    if (sqlite3_prepare_v2(db, "SELECT rowid, length(data) FROM value_parts "
+                               "WHERE seq=?1 AND what=?2 ORDER BY part",
+                           -1, &st, NULL) != SQLITE_OK)
+        return -1;
+    sqlite3_bind_int64(st, 1, seq);
+    sqlite3_bind_int(st, 2, what);
+    int rc;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        sqlite3_int64 *r = realloc(ss->rowid, (ss->parts.n + 1) * sizeof *r);
+        if (!r) break;
+        ss->rowid = r;
+        r[ss->parts.n] = sqlite3_column_int64(st, 0);
+        if (store_parts_add(&ss->parts, (uint64_t)sqlite3_column_int64(st, 1))) break;
+    }
+    sqlite3_finalize(st);
+    return rc == SQLITE_DONE ? 0 : -1;
+}
+
+/* Makes part k the open blob of ss; 0, or -1. */
+static int part_open(store_stream *ss, size_t k)
+{
+    if (ss->blob && ss->cur == k) return 0;
+    int rc;
+    if (ss->blob && k > 0 && ss->cur > 0)
+        rc = sqlite3_blob_reopen(ss->blob, ss->rowid[k]);
+    else {
+        sqlite3_blob_close(ss->blob);
+        ss->blob = NULL;
+        rc = sqlite3_blob_open(ss->db, "main", k ? "value_parts" : ss->table,
+                               k ? "data" : ss->column, k ? ss->rowid[k] : ss->seq, 0,
+                               &ss->blob);
+    }
+    if (rc != SQLITE_OK) {
+        gpd_log(GPD_LOG_ERROR, "sqlite stream part %zu: %s", k, sqlite3_errmsg(ss->db));
+        sqlite3_blob_close(ss->blob);
+        ss->blob = NULL;
+        return -1;
+    }
+    ss->cur = k;
+    return 0;
+}
+
+static void sq_stream_close(store_stream *s);
+static uint64_t sq_stream_size(const store_stream *s);
+static int sq_stream_read(store_stream *s, uint64_t off, void *dst, size_t n);
+
+/* The stream of table.column of row seq (part 0) and its other parts, on a private connection
+ * that lives as long as the stream, in one read transaction. */
+static store_rc open_private(const char *table, const char *column, sqlite3_int64 seq, int what,
+                             store_stream **out)
+{
+    char *path = path_copy();
+    store_stream *ss = path ? calloc(1, sizeof *ss) : NULL;
+    int rc = ss ? sqlite3_open_v2(path, &ss->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX,
+                                  NULL)
+                : SQLITE_NOMEM;
+    free(path);
+    if (!ss) return STORE_ERROR;
+    ss->table = table;
+    ss->column = column;
+    ss->seq = seq;
+    if (rc == SQLITE_OK) {
+        sqlite3_busy_timeout(ss->db, 5000);
+        /* the blob is read front to back once: a small page cache is enough */
+        rc = sqlite3_exec(ss->db, "PRAGMA cache_size=-256; BEGIN", NULL, NULL, NULL);
+    }
+    if (rc != SQLITE_OK || part_open(ss, 0) ||
+        store_parts_add(&ss->parts, (uint64_t)sqlite3_blob_bytes(ss->blob)) ||
+        !(ss->rowid = calloc(1, sizeof *ss->rowid)) || list_parts(ss->db, seq, what, ss)) {
+        gpd_log(GPD_LOG_ERROR, "sqlite stream open: %s", ss->db ? sqlite3_errmsg(ss->db) : "?");
+        sq_stream_close(ss);
+        return STORE_ERROR;
+    }
+    *out = ss;
+    return STORE_OK;
+}
+
+/* 1 when value `what` of job seq has parts after part 0 (on db, this thread's). */
+static int has_parts(sqlite3 *db, sqlite3_int64 seq, int what)
+{
+    sqlite3_stmt *st = prep(db, "SELECT 1 FROM value_parts WHERE seq=?1 AND what=?2 LIMIT 1");
+    if (!st) return 1; /* the stream finds out */
+    sqlite3_bind_int64(st, 1, seq);
+    sqlite3_bind_int(st, 2, what);
+    int rc = sqlite3_step(st);
+    done(st);
+    return rc != SQLITE_DONE;
 }
 
 /* A value of at most small bytes read whole (on this thread's connection; the blob closed at
@@ -951,36 +1077,26 @@ static int read_small(sqlite3_blob *b, uint64_t size, char **text, size_t *text_
     return 0;
 }
 
-static void sq_stream_close(store_stream *s);
-
-/* A large value streamed on a private connection that lives as long as the download. */
-static store_rc open_private(const char *table, const char *column, sqlite3_int64 seq,
-                             store_stream **out)
+/* A stream of at most small bytes read whole into *text, and closed. */
+static store_rc read_whole(store_stream *ss, char **text, size_t *text_len)
 {
-    char *path = path_copy();
-    store_stream *ss = path ? calloc(1, sizeof *ss) : NULL;
-    int rc = ss ? sqlite3_open_v2(path, &ss->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX,
-                                  NULL)
-                : SQLITE_NOMEM;
-    free(path);
-    if (!ss) return STORE_ERROR;
-    if (rc == SQLITE_OK) {
-        sqlite3_busy_timeout(ss->db, 5000);
-        /* the blob is read front to back once: a small page cache is enough */
-        sqlite3_exec(ss->db, "PRAGMA cache_size=-256", NULL, NULL, NULL);
+    size_t size = (size_t)ss->parts.end[ss->parts.n - 1];
+    char *buf = malloc(size + 1);
+    store_rc rc = buf && !sq_stream_read(ss, 0, buf, size) ? STORE_OK : STORE_ERROR;
+    sq_stream_close(ss);
+    if (rc != STORE_OK) {
+        free(buf);
+        return rc;
     }
-    if (rc != SQLITE_OK || blob_open(ss->db, table, column, seq, &ss->blob)) {
-        gpd_log(GPD_LOG_ERROR, "sqlite stream open: %s", ss->db ? sqlite3_errmsg(ss->db) : "?");
-        sq_stream_close(ss);
-        return STORE_ERROR;
-    }
-    ss->size = (uint64_t)sqlite3_blob_bytes(ss->blob);
-    *out = ss;
+    buf[size] = 0;
+    *text = buf;
+    *text_len = size;
     return STORE_OK;
 }
 
 static store_rc sq_stream_open(const char *id, const char *what, size_t small,
-                           store_stream **out, char **text, size_t *text_len, char status[16])
+                               store_stream **out, char **text, size_t *text_len,
+                               char status[16])
 {
     *out = NULL;
     *text = NULL;
@@ -1003,21 +1119,42 @@ static store_rc sq_stream_open(const char *id, const char *what, size_t small,
         if (is_pack || blob_open(db, "jobs", "result", seq, &b)) return STORE_OK; /* none */
         table = "jobs";
     }
+    int kind = is_pack ? STORE_VALUE_PACK : STORE_VALUE_RESULT;
     uint64_t size = (uint64_t)sqlite3_blob_bytes(b);
-    if (size <= small) rc = read_small(b, size, text, text_len) ? STORE_ERROR : STORE_OK;
+    if (size <= small && !has_parts(db, seq, kind)) { /* the common case: on this connection */
+        rc = read_small(b, size, text, text_len) ? STORE_ERROR : STORE_OK;
+        sqlite3_blob_close(b);
+        return rc;
+    }
     sqlite3_blob_close(b);
-    return size <= small ? rc : open_private(table, column, seq, out);
+    rc = open_private(table, column, seq, kind, out);
+    if (rc != STORE_OK || sq_stream_size(*out) > small) return rc;
+    rc = read_whole(*out, text, text_len);
+    *out = NULL;
+    return rc;
 }
 
 static uint64_t sq_stream_size(const store_stream *s)
 {
-    return s->size;
+    return s->parts.end[s->parts.n - 1];
 }
 
 static int sq_stream_read(store_stream *s, uint64_t off, void *dst, size_t n)
 {
-    if (off > s->size || n > s->size - off || n > INT_MAX) return -1;
-    return sqlite3_blob_read(s->blob, dst, (int)n, (int)off) == SQLITE_OK ? 0 : -1;
+    if (off > sq_stream_size(s) || n > sq_stream_size(s) - off) return -1;
+    char *d = dst;
+    while (n > 0) {
+        uint64_t start;
+        size_t k = store_parts_find(&s->parts, off, &start);
+        size_t m = s->parts.end[k] - off < n ? (size_t)(s->parts.end[k] - off) : n;
+        if (part_open(s, k) || m > INT_MAX ||
+            sqlite3_blob_read(s->blob, d, (int)m, (int)(off - start)) != SQLITE_OK)
+            return -1;
+        d += m;
+        off += m;
+        n -= m;
+    }
+    return 0;
 }
 
 static void sq_stream_close(store_stream *s)
@@ -1025,6 +1162,8 @@ static void sq_stream_close(store_stream *s)
     if (!s) return;
     sqlite3_blob_close(s->blob);
     sqlite3_close_v2(s->db);
+    store_parts_free(&s->parts);
+    free(s->rowid);
     free(s);
 }
 
@@ -1232,9 +1371,10 @@ static store_rc sq_purge(const char *id, char status_out[16])
     sqlite3_int64 seq = st ? sqlite3_column_int64(st, 1) : 0;
     done(st);
     if (rc == STORE_OK && !store_is_finished(status_out)) rc = STORE_CONFLICT;
-    /* the result, the pack and the summary first (keyed by the job's seq), then the row */
+    /* the result, the pack, their parts and the summary first (keyed by the job's seq), then the row */
     static const char *const del[] = {"DELETE FROM results WHERE seq=?1",
                                       "DELETE FROM exports WHERE seq=?1",
+                                      "DELETE FROM value_parts WHERE seq=?1",
                                       "DELETE FROM summaries WHERE seq=?1",
                                       "DELETE FROM jobs WHERE seq=?1"};
     for (size_t i = 0; rc == STORE_OK && i < sizeof del / sizeof *del; i++) {

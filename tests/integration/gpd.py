@@ -394,6 +394,18 @@ class Env:
         return pg_server().psql(text + ";\n", self.pg_dbs[path or self.db],
                                 {"p%d" % i: v for i, v in enumerate(params)})
 
+    def query_int(self, sql, path=None):
+        """One integer from a query on the jobs database: sqlite3 on the file, psql on
+        PostgreSQL."""
+        if not PG:
+            import sqlite3
+            con = sqlite3.connect(path or self.db)
+            v = con.execute(sql).fetchone()[0]
+            con.close()
+            return int(v)
+        self.db_url(path)
+        return int(pg_server().psql(sql + ";\n", self.pg_dbs[path or self.db]).strip())
+
     def close(self, keep=False):
         for d in self.daemons:
             d.kill9()

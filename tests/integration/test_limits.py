@@ -1,8 +1,9 @@
 """Limits of grainpackd against the real daemon: --job-timeout (a job that runs too long fails
 with error code "timeout"; a DELETE stays "cancelled"), the exclusive lock on the SQLite file (a
 second daemon on the same database refuses to start, the first keeps working), and a result
-the database cannot store (too big, or the disk full) fails its job with a reason instead of
-committing "succeeded" without a result or staying "running"."""
+the database cannot store (the disk full) fails its job with a reason instead of committing
+"succeeded" without a result or staying "running"; a result over the database's limit on one
+value is stored in parts and reads back the same."""
 import datetime
 import json
 import os
@@ -170,14 +171,48 @@ def run_unstorable(d, code, what):
     return e, h
 
 
-def test_result_too_big_fails(env):
-    # SQLite's length limit lowered to 20 kB (a testing hook): SMALL_2D's result is larger, so
-    # it cannot be stored -- the job fails saying so, it never shows succeeded without a result
+def result_and_exports(d, jid):
+    """The result (timings left out: they are the run's own), the csv and vtk exports and the
+    packing picture of job jid."""
+    st, _, body = d.request("GET", "/v1/jobs/%s/result" % jid, timeout=60)
+    assert st == 200, (st, body[:200])
+    res = json.loads(body)
+    res.pop("timings", None)
+    out = [res, len(body)]
+    for path in ("export?format=csv", "export?format=vtk", "svg?view=packing"):
+        st, _, b = d.request("GET", "/v1/jobs/%s/%s" % (jid, path), timeout=60)
+        assert st == 200, (path, st, b[:200])
+        out.append(b)
+    return out
+
+
+def test_result_over_value_limit_in_parts(env):
+    # the database's limit on one value lowered to 20 kB (a testing hook; 1 GB in SQLite and
+    # PostgreSQL): SMALL_2D's result and export pack are stored in parts and read back as one
+    # value -- the same result, exports and picture as a daemon whose limit they are under
+    ref = env.daemon(workers=1, db=os.path.join(env.dir, "ref.db"))
+    jid = ref.submit(gpd.SMALL_2D)
+    assert ref.wait(jid, timeout=60)["status"] == "succeeded"
+    want = result_and_exports(ref, jid)
+    assert ref.stop() == 0, ref.read_log()
     d = env.daemon(workers=1, env={"GRAINPACK_TEST_SQLITE_MAX_LENGTH": "20000"})
-    e, h = run_unstorable(d, "too_large", "too big")
-    assert "result" in e["message"] and "20000 bytes" in e["message"], e
-    # a result over SQLite's value limit is the job's problem, not the database's
-    assert h["status"] == "ok" and h["database"] == "ok", h
+    jid = d.submit(gpd.SMALL_2D)
+    j = d.wait(jid, timeout=60)
+    assert j["status"] == "succeeded", j
+    got = result_and_exports(d, jid)
+    size = got[1]
+    parts = env.query_int("SELECT count(*) FROM value_parts WHERE what = 0")
+    packs = env.query_int("SELECT count(*) FROM value_parts WHERE what = 1")
+    print("  result %d bytes: part 0 and %d more; pack: part 0 and %d more" % (size, parts, packs))
+    assert size > 3 * 20000 and parts == (size - 1) // (20000 - 1024), (size, parts)
+    assert packs >= 1, packs
+    assert got[0] == want[0], "the result read from parts differs"
+    for k, what in enumerate(("csv", "vtk", "svg"), start=2):
+        assert got[k] == want[k], "the %s from parts differs" % what
+    # a purge removes every part
+    st, _, b = d.request("DELETE", "/v1/jobs/%s?purge=1" % jid)
+    assert st == 204, (st, b)
+    assert env.query_int("SELECT count(*) FROM value_parts") == 0
     assert d.stop() == 0, d.read_log()
 
 
@@ -200,4 +235,4 @@ def test_disk_full_fails_visibly(env):
 if __name__ == "__main__":
     gpd.main([test_job_timeout, test_delete_is_cancelled_not_timeout,
               test_timeout_from_environment_and_zero, test_second_daemon_refused,
-              test_result_too_big_fails, test_disk_full_fails_visibly])
+              test_result_over_value_limit_in_parts, test_disk_full_fails_visibly])
