@@ -35,7 +35,7 @@
 
 static struct MHD_Daemon *daemon_ = NULL;
 static size_t max_body = 1 << 20;
-static double max_result_mb = 1024;
+static double max_result_mb = 8192;
 static long max_queued = 10000;
 static double started_at = 0;
 

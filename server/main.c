@@ -62,8 +62,8 @@ static void usage(FILE *f)
             "  --max-body BYTES       request body limit, 413 above [GRAINPACK_MAX_BODY]\n"
             "                         (default 1048576)\n"
             "  --max-result-mb MB     refuse (422 too_large) a spec whose result would be\n"
-            "                         larger, which bounds one job's memory\n"
-            "                         [GRAINPACK_MAX_RESULT_MB] (default 1024)\n"
+            "                         larger, which bounds the disk one job takes\n"
+            "                         [GRAINPACK_MAX_RESULT_MB] (default 8192)\n"
             "  --job-timeout S        a job whose run lasts longer fails with error code\n"
             "                         'timeout' (per run attempt; 0 = no limit)\n"
             "                         [GRAINPACK_JOB_TIMEOUT] (default 3600)\n"
@@ -281,7 +281,7 @@ int main(int argc, char **argv)
                    env_or("GRAINPACK_MAX_CONNECTIONS", "1024"),
                    env_or("GRAINPACK_TIMEOUT", "30"),
                    env_or("GRAINPACK_MAX_BODY", "1048576"),
-                   env_or("GRAINPACK_MAX_RESULT_MB", "1024"),
+                   env_or("GRAINPACK_MAX_RESULT_MB", "8192"),
                    env_or("GRAINPACK_JOB_TIMEOUT", "3600"),
                    env_or("GRAINPACK_RETAIN_DAYS", "0"),
                    env_or("GRAINPACK_MAX_QUEUED", "10000"),

@@ -39,7 +39,7 @@ def test_spec_errors(env):
         ("result too large", dict(base, particles=1000000, contour_points=512), 422,
          "too_large", "/particles"),
         # the same count spelled as a real is the same integer (api.md "Limits")
-        ("result too large, 1e6", json.dumps(dict(base, particles="N")).replace(
+        ("result too large, 1e6", json.dumps(dict(base, particles="N", contour_points=512)).replace(
             '"N"', "1e6").encode(), 422, "too_large", "/particles"),
         # size laws (issue #12)
         ("cov 0", dict(base, size={"cov": 0}), 422, "invalid_spec", "/size/cov"),
@@ -58,11 +58,11 @@ def test_spec_errors(env):
         # ~700,000 grains of 1-1.2 mm: within particles' bound, but the result is too large
         ("sieve result", dict(sieve_2d, contour_points=512, size=dict(
             sieve_2d["size"], sieve=[[1, 0], [1.2, 100]])), 422, "too_large", "/size/sieve"),
-        # 3D results are bounded too: ~3.5M tiled spheres with their contacts (~2.2 GB)
-        ("3D result", dict(gpd.SMALL_3D, box=[0.015] * 3, tiling=[16, 16, 16]), 422,
+        # 3D results are bounded too: ~14M tiled spheres with their contacts (~9 GB)
+        ("3D result", dict(gpd.SMALL_3D, box=[0.024] * 3, tiling=[16, 16, 16]), 422,
          "too_large", "/tiling"),
         # ... and the same bound read from a real spelling of the tiling
-        ("3D result, 16.0", json.dumps(dict(gpd.SMALL_3D, box=[0.015] * 3, tiling="T")).replace(
+        ("3D result, 16.0", json.dumps(dict(gpd.SMALL_3D, box=[0.024] * 3, tiling="T")).replace(
             '"T"', "[16.0, 1.6e1, 16]").encode(), 422, "too_large", "/tiling"),
         # E3's floor at 20 cells is above 0.002: refused at submit, not failed in the queue
         ("E3 floor", dict(base, particles=20, imc={"error": "E3", "threshold": 0.002}), 422,

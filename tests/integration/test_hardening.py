@@ -68,8 +68,8 @@ def test_submit_refusals(env):
         (9, "a 100 m box of 1-2 mm spheres", dict(D3, box=[100, 100, 100]), "too_large",
          "/box"),
         (9, "cov 0", dict(D2, size={"cov": 0}), "invalid_spec", "/size/cov"),
-        (6, "3D result of 3.5M tiled spheres with contacts", dict(
-            D3, box=[0.015] * 3, tiling=[16, 16, 16]), "too_large", "/tiling"),
+        (6, "3D result of 14M tiled spheres with contacts", dict(
+            D3, box=[0.024] * 3, tiling=[16, 16, 16]), "too_large", "/tiling"),
     ]
     for item, name, body, code, pointer in cases:
         raw = body if isinstance(body, bytes) else json.dumps(body).encode()
