@@ -3,8 +3,9 @@
  * tiling to 4 x 4 x 4 and to ~230,000 spheres, with the porosity and PSD errors next to the
  * timings; then a size ratio of 20 (1-20 mm, issue #6) the same way.
  * Usage: bench_spheres3d [threads] [seed] [--sample]. --sample: the paper's sample only, one
- * table row (wall and CPU seconds, steps, sphere-steps/s, S_c, porosity, PSD error), the row
- * bench/bench_peers.py reads. */
+ * table row (wall and CPU seconds, steps, sphere-steps/s, S_c, porosity, PSD error, z, and the
+ * DEM's time step at the end: below DT_SAFETY's when the stability check had to cut it), the
+ * row bench/bench_peers.py reads (by column name). */
 #include "gp_clock.h"
 #include "gp_dem3d.h"
 #include "gp_flip.h"
@@ -66,12 +67,12 @@ static int sample_row(int threads, unsigned long long seed)
         return 1;
     const gp_stats3d *S = &r->stats;
     printf("| code | threads | spheres | steps | wall s | CPU s | M sphere-steps/s | S_c | stop | "
-           "porosity | porosity error | max PSD error (pp) | z |\n"
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    printf("| grainpack | %d | %zu | %ld | %.3f | %.3f | %.2f | %.3g | %s%s%s | %.4f | %+.1e | %.2g | %.3f |\n",
+           "porosity | porosity error | max PSD error (pp) | z | dt (us) |\n"
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    printf("| grainpack | %d | %zu | %ld | %.3f | %.3f | %.2f | %.3g | %s%s%s | %.4f | %+.1e | %.2g | %.3f | %.2f |\n",
            threads, S->sample_particles, S->steps, r->t_total, cpu, dem_rate(r), S->stability,
            S->stop_reason, st ? ": " : "", st ? e.message : "", S->porosity,
-           S->porosity - S->porosity_target, psd_error(S), S->coordination_number);
+           S->porosity - S->porosity_target, psd_error(S), S->coordination_number, 1e6 * S->dt);
     gp_specimen3d_destroy(r);
     return st != GP_OK;
 }

@@ -44,9 +44,11 @@
 #define SERVO_GAIN 0.25 /* fraction of Eq. 10's displacement applied per step */
 #define NLEVEL 8        /* size levels of the cell grids (see rebuild) */
 #define FREE_GAP 0.05   /* free flight beyond this gap, times the smallest radius (see job_spheres) */
+#define DT_CUT 0.9      /* a cut time step: this fraction of the proven limit (see check_dt) */
 
 typedef struct blk_acc {
     double sum_f, sum_fn, ke, vmax2;
+    double lam;      /* the largest per-sphere bound on omega^2 (see stiffness_weights) */
     double move[2];  /* the two largest (|x - xref| + growth of the radius)^2 of the block */
     double wf[6], wk[6];
     size_t wn;
@@ -76,7 +78,7 @@ typedef struct worker_arg {
  * (one array per component, all in one block) so that the pair kernel reads and writes them
  * with unit stride and the compiler vectorises it. The contents are never kept across a
  * reserve: a rebuild reserves the spare list, then fills all of it. */
-enum { PS_FS = 0, PS_F = 3, PS_C = 6, PS_FN = 9, PS_PLANES = 10 };
+enum { PS_FS = 0, PS_F = 3, PS_C = 6, PS_FN = 9, PS_WI = 10, PS_WJ = 11, PS_PLANES = 12 };
 
 typedef struct pair_set {
     size_t cap;
@@ -84,6 +86,7 @@ typedef struct pair_set {
     double *buf;                   /* PS_PLANES planes of cap reals */
     double *fs[3], *F[3], *c[3];   /* shear spring, force on i, n x fs: planes of buf */
     double *fn;                    /* f_n (> 0 touching, -1 within free_gap, 0 beyond) */
+    double *wi, *wj;               /* the pair's share of omega^2's bound on i and on j */
     uint32_t *idx;                 /* the touching pairs of a step (pair_kernel) */
     size_t *adj;
 } pair_set;
@@ -115,6 +118,8 @@ static int pair_set_reserve(pair_set *p, size_t cap)
         p->c[a] = p->buf + (PS_C + a) * cap;
     }
     p->fn = p->buf + PS_FN * cap;
+    p->wi = p->buf + PS_WI * cap;
+    p->wj = p->buf + PS_WJ * cap;
     p->cap = cap;
     return 0;
 }
@@ -127,11 +132,18 @@ struct gp_dem3d {
     double *xref;              /* positions at the last rebuild */
     double *mtinv;             /* 1 / true mass (free flight) */
     /* one thread's sums per sphere while a step runs, in pair order (see step_serial): force
-     * (3n, starting from gravity), moment (3n), sum of f_n (n), a surface within free_gap (n) */
-    double *af, *at, *afn;
+     * (3n, starting from gravity), moment (3n), sum of f_n (n), the shares of the bound on
+     * omega^2 (n), a surface within free_gap (n) */
+    double *af, *at, *afn, *alam;
     unsigned char *anear;
     double rscale, rscale_ref, r0max, r0min;
     double E, ks_kn, tanphi, damping, g[3], dt, skin, free_gap;
+    double *sminv;             /* sqrt(minv) (the bound's off-diagonal share) */
+    double beta;               /* a contact's largest eigenvalue, times m_i / k_n (see header) */
+    int dt_guard;              /* cut dt when the bound fails (not params.dt_unguarded) */
+    double lam_max;            /* the bound on omega_max^2 at the last step */
+    double dt_ratio;           /* the largest fraction of the proven limit a step has used */
+    long dt_cuts;
     double wall[6];            /* positions: lo x, hi x, lo y, hi y, lo z, hi z */
     double servo_f[6], servo_v[6], servo_lim[6];
     double wall_f[6], wall_k[6];
@@ -285,7 +297,7 @@ void gp_dem3d_destroy(gp_dem3d *d)
     pool_stop(d);
     free(d->x); free(d->v); free(d->w); free(d->r0); free(d->r);
     free(d->m); free(d->minv); free(d->iinv); free(d->xref); free(d->mtinv);
-    free(d->af); free(d->at); free(d->afn); free(d->anear);
+    free(d->af); free(d->at); free(d->afn); free(d->alam); free(d->anear); free(d->sminv);
     free(d->raw); free(d->tnc);
     pair_set_free(&d->cur);
     pair_set_free(&d->spare);
@@ -331,6 +343,8 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
     d->af = malloc(3 * n * sizeof *d->af);
     d->at = malloc(3 * n * sizeof *d->at);
     d->afn = malloc(n * sizeof *d->afn);
+    d->alam = malloc(n * sizeof *d->alam);
+    d->sminv = malloc(n * sizeof *d->sminv);
     d->anear = malloc(n);
     d->off = calloc(n + 1, sizeof *d->off);
     d->ioff = calloc(n + 1, sizeof *d->ioff);
@@ -340,8 +354,8 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
     d->nblk = (n + BLK - 1) / BLK;
     d->blk = calloc(d->nblk, sizeof *d->blk);
     if (!d->x || !d->v || !d->w || !d->xref || !d->r0 || !d->r || !d->m || !d->minv || !d->iinv
-        || !d->mtinv || !d->af || !d->at || !d->afn || !d->anear || !d->off || !d->ioff || !d->fill
-        || !d->cell_of || !d->level || !d->blk) {
+        || !d->mtinv || !d->af || !d->at || !d->afn || !d->alam || !d->sminv || !d->anear
+        || !d->off || !d->ioff || !d->fill || !d->cell_of || !d->level || !d->blk) {
         gp_dem3d_destroy(d);
         return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (%zu spheres)", n);
     }
@@ -386,10 +400,15 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
         d->mtinv[i] = 1.0 / m;
         d->minv[i] = 1.0 / mi;
         d->iinv[i] = 1.0 / (0.4 * mi * r * r);
+        d->sminv[i] = sqrt(d->minv[i]);
         double t = sqrt(mi / (2 * d->E * r));
         if (t < tmin) tmin = t;
     }
     d->dt = safety * tmin;
+    /* a contact's largest eigenvalue times m_i / k_n: the normal mode (1), or the shear spring
+     * at the contact point, which moves by u + r theta: k_s (1/m + r^2/I) = k_s (1 + 2.5) / m */
+    d->beta = fmax(1.0, 3.5 * d->ks_kn);
+    d->dt_guard = !p->dt_unguarded;
     for (int w = 0; w < 6; w++)
         d->servo_lim[w] = NAN;
     d->need_rebuild = 1;
@@ -730,6 +749,22 @@ static void pair_adjacency(gp_dem3d *d, pair_set *P, size_t np)
     }
 }
 
+/* Each candidate's share of the bound on omega_max^2 (see the header): on sphere i,
+ * beta k_n (1/m_i + 1/sqrt(m_i m_j)), the contact's diagonal block and its off-diagonal block
+ * (block Gershgorin; the inertial, density-scaled masses), and the same on j. k_n from the
+ * full radii: the current ones are never larger (set_radius_scale), nor is the lever arm of
+ * the shear spring. Computed once per rebuild; a step adds the shares of the pairs that touch. */
+static void stiffness_weights(const gp_dem3d *d, pair_set *P, size_t np)
+{
+    for (size_t k = 0; k < np; k++) {
+        size_t i = P->pi[k], j = P->pj[k];
+        double ri = d->r0[i], rj = d->r0[j];
+        double kb = d->beta * (2 * d->E * ri * rj / (ri + rj)), off = d->sminv[i] * d->sminv[j];
+        P->wi[k] = kb * (d->minv[i] + off);
+        P->wj[k] = kb * (d->minv[j] + off);
+    }
+}
+
 /* Rebuilds the candidate pair list, sorted by (i, j); shear springs are carried over by
  * (i, j). Buffers are kept from one rebuild to the next (no allocation in the steady state):
  * the new list is built in the spare buffers, which then become the list in use. */
@@ -750,6 +785,7 @@ static gp_status rebuild(gp_dem3d *d, gp_error *err)
     if ((st = find_candidates(d, lv, reach, P, &np, err)))
         return st;
     carry_springs(d, P, np);
+    stiffness_weights(d, P, np);
     if (threaded(d)) /* one thread sums the forces in pair order (step_serial) */
         pair_adjacency(d, P, np);
     pair_set t = d->cur;
@@ -999,6 +1035,7 @@ typedef struct sphere_consts {
     v4d lo, hi; /* the walls: x-, y-, z-, -inf and x+, y+, z+, +inf (the idle lane never
                    touches a wall, nor leaves the box) */
     double dt, dm, dp, dscale, E2, gap, g[3];
+    double E2w;  /* 2 E times the most walls one sphere can touch on an axis (the bound) */
     int measure;
 } sphere_consts;
 
@@ -1008,7 +1045,10 @@ static sphere_consts sphere_consts_of(const gp_dem3d *d)
     sphere_consts k = {{W[0], W[2], W[4], -INFINITY}, {W[1], W[3], W[5], INFINITY}, d->dt,
                        1 - d->damping, 1 + d->damping,
                        d->rscale > d->rscale_ref ? d->rscale - d->rscale_ref : 0, 2 * d->E,
-                       d->free_gap, {d->g[0], d->g[1], d->g[2]}, d->measure};
+                       d->free_gap, {d->g[0], d->g[1], d->g[2]}, 2 * d->E, d->measure};
+    for (int a = 0; a < 3; a++) /* both walls of an axis on one sphere: a box below 2 r */
+        if (W[2 * a + 1] - W[2 * a] < 2 * d->r0max * d->rscale)
+            k.E2w = 4 * d->E;
     return k;
 }
 
@@ -1077,15 +1117,21 @@ VINLINE double wall_forces(const sphere_consts *k, v4d x, double ri, v4d *F, blk
 }
 
 /* Sphere i once its pair sums are complete (F: gravity and the pairs' forces, T: their
- * moments, sfn: their sum of f_n, near: a sphere within free_gap): the walls, S_c's sums,
- * local damping and the leapfrog step; the block's sums (acc) and two largest moves. */
+ * moments, sfn: their sum of f_n, lam: their shares of the bound on omega^2, near: a sphere
+ * within free_gap): the walls, S_c's sums, local damping and the leapfrog step; the block's
+ * sums (acc), its largest bound and two largest moves. */
 VINLINE void move_sphere(gp_dem3d *d, const sphere_consts *k, size_t i, v4d F, v4d T,
-                         double sfn, int near, blk_run *acc)
+                         double sfn, double lam, int near, blk_run *acc)
 {
     double *restrict xp = d->x + 3 * i, *restrict vp = d->v + 3 * i, *restrict wp = d->w + 3 * i;
     const double dt = k->dt, ri = d->r[i];
     v4d x = vload3(xp), v = vload3(vp), w = vload3(wp);
-    sfn += wall_forces(k, x, ri, &F, acc, &near);
+    double sw = wall_forces(k, x, ri, &F, acc, &near);
+    sfn += sw;
+    /* the walls' block is diagonal: 2 E ri times the walls it touches on one axis, at most
+     * one unless the box is narrower than a sphere (k->E2w) */
+    lam += sw > 0 ? k->E2w * ri * d->minv[i] : 0;
+    acc->s.lam = lam > acc->s.lam ? lam : acc->s.lam;
     if (k->measure) /* read only after a run: summed on its last step */
         acc->s.sum_f += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
     if (k->measure)
@@ -1140,13 +1186,16 @@ static size_t step_serial(gp_dem3d *d)
     const double *restrict r = d->r, *restrict pfn = P->fn;
     const double *restrict Fx = P->F[0], *restrict Fy = P->F[1], *restrict Fz = P->F[2];
     const double *restrict cx = P->c[0], *restrict cy = P->c[1], *restrict cz = P->c[2];
+    const double *restrict wi = P->wi, *restrict wj = P->wj;
     double *restrict af = d->af, *restrict at = d->at, *restrict afn = d->afn;
+    double *restrict alam = d->alam;
     for (size_t i = 0; i < d->n; i++) { /* gravity on the true mass */
         for (int a = 0; a < 3; a++) {
             af[3 * i + a] = d->m[i] * sk.g[a];
             at[3 * i + a] = 0;
         }
         afn[i] = 0;
+        alam[i] = 0;
         d->anear[i] = 0;
     }
     size_t nc = pair_kernel(d, 0, d->np, P->idx, 1), c = 0;
@@ -1157,7 +1206,7 @@ static size_t step_serial(gp_dem3d *d)
         for (size_t i = i0; i < i1; i++) {
             double f0 = af[3 * i], f1 = af[3 * i + 1], f2 = af[3 * i + 2];
             double t0 = at[3 * i], t1 = at[3 * i + 1], t2 = at[3 * i + 2];
-            double sfn = afn[i], ri = r[i];
+            double sfn = afn[i], ri = r[i], lam = alam[i];
             for (size_t end = ioff[i + 1]; c < nc && idx[c] < end; c++) { /* i's own */
                 size_t k = idx[c], j = pj[k];
                 double rj = r[j];
@@ -1167,9 +1216,11 @@ static size_t step_serial(gp_dem3d *d)
                 at[3 * j] += rj * cx[k]; at[3 * j + 1] += rj * cy[k]; at[3 * j + 2] += rj * cz[k];
                 sfn += pfn[k];
                 afn[j] += pfn[k];
+                lam += wi[k];
+                alam[j] += wj[k];
             }
-            move_sphere(d, &sk, i, (v4d){f0, f1, f2, 0}, (v4d){t0, t1, t2, 0}, sfn, d->anear[i],
-                        &acc);
+            move_sphere(d, &sk, i, (v4d){f0, f1, f2, 0}, (v4d){t0, t1, t2, 0}, sfn, lam,
+                        d->anear[i], &acc);
         }
         blk_end(&acc, d->blk + b);
     }
@@ -1192,7 +1243,7 @@ static void job_spheres(gp_dem3d *d, int tid, int nt)
 {
     const sphere_consts sk = sphere_consts_of(d);
     const pair_set *P = &d->cur;
-    const double *restrict pfn = P->fn;
+    const double *restrict pfn = P->fn, *restrict wi = P->wi, *restrict wj = P->wj;
     const double *restrict Fx = P->F[0], *restrict Fy = P->F[1], *restrict Fz = P->F[2];
     const double *restrict cx = P->c[0], *restrict cy = P->c[1], *restrict cz = P->c[2];
     const size_t *restrict adj = d->adj, *restrict off = d->off;
@@ -1203,7 +1254,7 @@ static void job_spheres(gp_dem3d *d, int tid, int nt)
         for (size_t i = i0; i < i1; i++) {
             double ri = d->r[i], m = d->m[i];
             double f0 = m * sk.g[0], f1 = m * sk.g[1], f2 = m * sk.g[2];
-            double t0 = 0, t1 = 0, t2 = 0, sfn = 0;
+            double t0 = 0, t1 = 0, t2 = 0, sfn = 0, lam = 0;
             int near = 0;
             for (size_t e = off[i]; e < off[i + 1]; e++) {
                 size_t k = adj[e] >> 1;
@@ -1214,13 +1265,16 @@ static void job_spheres(gp_dem3d *d, int tid, int nt)
                 }
                 if (adj[e] & 1) { /* i is the pair's j: the force on it is -F */
                     f0 -= Fx[k]; f1 -= Fy[k]; f2 -= Fz[k];
+                    lam += wj[k];
                 } else {
                     f0 += Fx[k]; f1 += Fy[k]; f2 += Fz[k];
+                    lam += wi[k];
                 }
                 t0 += ri * cx[k]; t1 += ri * cy[k]; t2 += ri * cz[k];
                 sfn += fn;
             }
-            move_sphere(d, &sk, i, (v4d){f0, f1, f2, 0}, (v4d){t0, t1, t2, 0}, sfn, near, &acc);
+            move_sphere(d, &sk, i, (v4d){f0, f1, f2, 0}, (v4d){t0, t1, t2, 0}, sfn, lam, near,
+                        &acc);
         }
         blk_end(&acc, d->blk + b);
     }
@@ -1242,6 +1296,24 @@ static size_t step(gp_dem3d *d)
 
 void gp_dem3d_set_cancel(gp_dem3d *d, const volatile int *cancel) { d->cancel = cancel; }
 
+/* The stability check after a step (see the header): lam bounds omega_max^2 over the
+ * contacts of the step; leapfrog with local damping c is stable while omega dt sqrt(1 + c)
+ * < 2. Above, the guard cuts dt to DT_CUT of the limit for the steps that follow (a single
+ * step beyond it cannot blow up: instability needs the growth of many). lam is a maximum
+ * over spheres, the same bits for any thread count, so is the cut. */
+static void check_dt(gp_dem3d *d, double lam)
+{
+    d->lam_max = lam;
+    double wc = sqrt(lam * (1 + d->damping)); /* omega sqrt(1 + c) */
+    double ratio = 0.5 * wc * d->dt;
+    if (ratio > d->dt_ratio)
+        d->dt_ratio = ratio;
+    if (d->dt_guard && ratio >= 1) {
+        d->dt = DT_CUT * 2 / wc;
+        d->dt_cuts++;
+    }
+}
+
 gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err)
 {
     for (long s = 0; s < nsteps; s++) {
@@ -1258,7 +1330,7 @@ gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err)
                 return st;
         }
         size_t nc = step(d), wn = 0;
-        double sf = 0, sfn = 0, ke = 0, vm = 0;
+        double sf = 0, sfn = 0, ke = 0, vm = 0, lam = 0;
         double wf[6] = {0}, wk[6] = {0};
         double move[2] = {0, 0};
         int bad = 0;
@@ -1266,6 +1338,7 @@ gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err)
             const blk_acc *a = d->blk + b;
             sf += a->sum_f; sfn += a->sum_fn; ke += a->ke;
             if (a->vmax2 > vm) vm = a->vmax2;
+            if (a->lam > lam) lam = a->lam;
             top2(move, a->move[0]);
             top2(move, a->move[1]);
             wn += a->wn; bad |= a->bad;
@@ -1311,6 +1384,7 @@ gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err)
          * skin) */
         if (sqrt(move[0]) + sqrt(move[1]) >= d->skin)
             d->need_rebuild = 1;
+        check_dt(d, lam);
     }
     return GP_OK;
 }
@@ -1327,6 +1401,9 @@ void gp_dem3d_get_state(const gp_dem3d *d, gp_dem3d_state *s)
     s->contacts = d->ncontacts;
     s->wall_contacts = d->wall_n;
     s->rebuilds = d->rebuilds;
+    s->omega_bound = sqrt(d->lam_max);
+    s->dt_ratio = d->dt_ratio;
+    s->dt_cuts = d->dt_cuts;
 }
 
 void gp_dem3d_spheres(const gp_dem3d *d, double *xyzr)

@@ -17,8 +17,9 @@
  *     (what a specimen is) does not change; only how fast it is reached. A sphere with no
  *     surface within 0.05 x the smallest radius flies with its true mass and no damping
  *     (free flight: fines fall at g, not at g scaled down; see gp_dem3d.c);
- *   - time step dt = dt_safety * min_i sqrt(m_i / (2 E R_i)) (2 E R_i is the stiffest contact a
- *     sphere of radius R_i can have: with a wall or a much larger sphere);
+ *   - time step dt = dt_safety * min_i sqrt(m_i / (2 E R_i)) (m_i the inertial mass: density
+ *     scaled), checked after every step against a proven bound on the fastest vibration of the
+ *     contacts of that step, shear and rotation included (below); dt is cut when it fails;
  *   - contact detection: a Verlet list of candidate pairs i < j (a half list: each pair once),
  *     those with a gap below skin + the free-flight gap, sorted by (i, j); rebuilt only when
  *     some sphere has moved (or grown) more than skin / 2 since the last rebuild, from
@@ -39,6 +40,41 @@
  *     in the scalar order; no FMA). Layout: the pair list is a structure of arrays (i, j,
  *     f_n, and one array per component of the spring, the force on i and n x f_s).
  * Units SI. Walls 0..5: x-, x+, y-, y+, z-, z+.
+ *
+ * Stability of the time step. Linearised about a state, the spheres' translations u_i and
+ * rotations theta_i obey M q'' = -K q, M = diag(m_i I, I_i I) (the integrator's masses:
+ * m_i, I_i = 0.4 m_i R_i^2 density-scaled, R_i the full radius), K = sum over contacts of
+ * PSD terms: a pair (n from i to j) adds k_n (n.(u_i - u_j))^2 + k_s |P D|^2 to 2 x energy,
+ * D = u_i - u_j + r_i theta_i x n + r_j theta_j x n the contact-point displacement, P = I - n n^T
+ * (the shear spring is incremental: after a step it holds -k_s P D of the step's motion); a
+ * wall adds 2 E R_i (e.u_i)^2. Left out, and why no harm: the geometric stiffness of the normal
+ * force (-f_n / |O_i O_j| P on the relative translation: negative semi-definite, it can only
+ * lower omega_max, Weyl), the turn of the spring with the contact (order |f_s| / |O_i O_j| <=
+ * tan(phi) k_n delta / |O_i O_j|: below 1e-3 k_n at a packing's overlaps), Coulomb slip (a
+ * projection onto the friction cone: never stiffer).
+ * The bound: in mass-scaled coordinates a contact's block on sphere i has the eigenvalues
+ * k_n / m_i (normal) and k_s (1 / m_i + r_i^2 / I_i) = 3.5 k_s / m_i (twice: a tangential slide
+ * of the contact point, shared by u and theta), so its norm is lam_ci = beta k_n / m_i, beta =
+ * max(1, 3.5 k_s / k_n) (1.75 for k_s = k_n / 2: shear with rotation is sqrt(1.75) = 1.32 times
+ * faster than the normal mode); the pair's off-diagonal block has norm sqrt(lam_ci lam_cj)
+ * (exactly: normal and shear parts act on orthogonal subspaces). Block Gershgorin with unit
+ * weights: omega_max^2 = lam_max(M^-1/2 K M^-1/2) <= max_i [sum_c beta k_n (1/m_i +
+ * 1/sqrt(m_i m_j)) + 2 E R_i n_w / m_i], n_w the most walls touched on one axis (the walls'
+ * block is diagonal). k_n is taken at the full radii (never smaller than at the current ones).
+ * On packings of this DEM the bound is 1.5-1.6 x the true omega_max: 1.52-1.59 on 50-150
+ * spheres (test_dem3d, GSL's eigensolver on the full 6N x 6N K and M), 1.6 on the paper's
+ * relaxed sample (Lanczos; a direction-aware 6 x 6 block bound would gain only 10 %).
+ * The integrator: leapfrog (v += a dt, then x += v dt; the spring sees the motion of the step)
+ * is stable for omega dt < 2. Local damping multiplies a force component by 1 + c where it
+ * brakes (f v < 0); in leapfrog's fastest mode (the sign flips every step) every component
+ * brakes on every step, so it acts as a stiffness raised by 1 + c and the limit becomes
+ * omega dt < 2 / sqrt(1 + c) (0.77 x at the relaxation's c = 0.7; test_dem3d shows both sides).
+ * So after each step the largest per-sphere bound lam (a max over spheres: the same bits for
+ * any thread count) is checked: omega dt sqrt(1 + c) / 2 = sqrt(lam (1 + c)) dt / 2 < 1; when
+ * it is not, dt is cut to 0.9 of the limit for the steps that follow (the step that found it
+ * cannot blow up alone; params.dt_unguarded turns the cut off, for the tests). Every contact
+ * is covered on the step it acts (the shares are summed over the pairs that touch), so the
+ * check does not depend on the skin either.
  *
  * Ownership: gp_dem3d_create copies the spheres; the gp_dem3d owns its state and its worker
  * threads until gp_dem3d_destroy. Lists handed out (gp_dem3d_contacts, gp_dem3d_find_pairs)
@@ -62,9 +98,11 @@ typedef struct gp_dem3d_params {
     double friction_deg; /* sphere-sphere friction */
     double damping;      /* local damping coefficient in [0, 1) */
     double gravity[3];   /* m/s^2 */
-    double dt_safety;    /* fraction of the critical time step; 0 = 0.2 */
+    double dt_safety;    /* dt = dt_safety min_i sqrt(m_i / (2 E R_i)) (see the time step
+                            above; the check may cut it); 0 = 0.2 */
     double scaled_radius;/* density scaling radius (m); 0 = none */
     double skin;         /* Verlet skin (m); 0 = 0.2 * smallest radius */
+    int dt_unguarded;    /* nonzero: never cut dt (tests of the stability bound) */
     int threads;         /* 0 = 1 */
 } gp_dem3d_params;
 
@@ -107,6 +145,10 @@ typedef struct gp_dem3d_state {
     size_t contacts;         /* sphere-sphere contacts */
     size_t wall_contacts;
     long rebuilds;
+    double omega_bound;      /* the bound on omega_max at the last step (rad/s; see the header) */
+    double dt_ratio;         /* the largest omega_bound dt sqrt(1 + c) / 2 of any step (< 1: all
+                                steps within the proven limit) */
+    long dt_cuts;            /* how often dt was cut (gp_dem3d_dt is the current step) */
 } gp_dem3d_state;
 
 void gp_dem3d_get_state(const gp_dem3d *d, gp_dem3d_state *s);

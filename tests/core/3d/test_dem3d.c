@@ -2,6 +2,8 @@
 #include "gp_dem3d.h"
 #include "gp_test.h"
 
+#include <gsl/gsl_eigen.h>
+#include <gsl/gsl_matrix.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -287,7 +289,7 @@ static void test_skin_independent(void)
             s[4 * i + a] = 0.02 + 0.02 * (double)c[a] + 0.001 * (double)(lcg(&st) % 1000) / 1000.0;
     }
     double lo[3] = {0, 0, 0}, hi[3] = {0.2, 0.2, 0.2};
-    double *out[4];
+    double *out[4], wb[4], ratio[4];
     long reb[4];
     size_t ncon[4];
     static const double skin[4] = {0.0001, 0.004, 0.004, 0.004};
@@ -314,6 +316,8 @@ static void test_skin_independent(void)
         gp_dem3d_get_state(d, &ds);
         reb[t] = ds.rebuilds;
         ncon[t] = ds.contacts;
+        wb[t] = ds.omega_bound;
+        ratio[t] = ds.dt_ratio;
         out[t] = malloc(4 * n * sizeof *out[t]);
         gp_dem3d_spheres(d, out[t]);
         check_contacts_brute(d, out[t], n);
@@ -325,6 +329,10 @@ static void test_skin_independent(void)
     CHECK(memcmp(out[1], out[2], 4 * n * sizeof(double)) == 0);
     CHECK(memcmp(out[1], out[3], 4 * n * sizeof(double)) == 0);
     CHECK(ncon[0] == ncon[1] && ncon[1] == ncon[2] && ncon[2] == ncon[3]);
+    /* the stability bound too: a max over spheres of sums in pair order, over touching pairs */
+    CHECK(wb[0] > 0 && ratio[0] > 0);
+    for (int t = 1; t < 4; t++)
+        CHECK(wb[t] == wb[0] && ratio[t] == ratio[0]);
     for (int t = 0; t < 4; t++)
         free(out[t]);
     free(s);
@@ -375,6 +383,270 @@ static void test_kernel_lanes(void)
     free(s);
 }
 
+/* ---- the stability bound (gp_dem3d.h, "Stability of the time step") ---- */
+
+/* A packing made by the DEM itself: n polydisperse spheres (radii 2-7 mm, density scaling at
+ * 4.5 mm, so about half of them are scaled) dropped from a loose lattice onto the floor of a
+ * 45 mm box and pressed by a servo lid, without friction (so that it comes to rest with no
+ * shear force: a DEM started from it is in equilibrium, its shear springs at zero); the
+ * spheres (x, y, z, r) into s and the box height into *top. */
+#define SETTLE_LID 20.0   /* N: ~10 kPa on the lid */
+#define SETTLE_STEPS 60000 /* S_c below 1e-4 at 50-150 spheres */
+static void settled_packing(size_t n, uint64_t seed, double *s, double *top)
+{
+    uint64_t st = seed;
+    const double L = 0.045;
+    size_t per = 3; /* spheres per lattice row: 15 mm apart */
+    for (size_t i = 0; i < n; i++) {
+        s[4 * i + 3] = 0.002 + 0.005 * (double)(lcg(&st) % 1000) / 1000.0;
+        size_t c[3] = {i % per, (i / per) % per, i / (per * per)};
+        for (int a = 0; a < 3; a++)
+            s[4 * i + a] = 0.0075 + 0.015 * (double)c[a] + 0.0005 * (double)(lcg(&st) % 1000) / 1000.0;
+    }
+    double hi[3] = {L, L, 0.0075 + 0.015 * (double)(n / (per * per) + 1)};
+    gp_dem3d_params p = base();
+    p.scaled_radius = 0.0045;
+    p.friction_deg = 0;
+    p.damping = 0.7;
+    gp_dem3d *d = in_box(&p, s, n, hi);
+    if (!d)
+        return;
+    gp_error e;
+    gp_dem3d_set_servo(d, 5, SETTLE_LID, 0.5);
+    CHECK(gp_dem3d_run(d, SETTLE_STEPS, &e) == GP_OK);
+    gp_dem3d_state ds;
+    gp_dem3d_get_state(d, &ds);
+    printf("settled %zu: S_c %.2g contacts %zu\n", n, ds.stability, ds.contacts);
+    gp_dem3d_spheres(d, s);
+    *top = gp_dem3d_wall(d, 5);
+    gp_dem3d_destroy(d);
+}
+
+/* the inertial mass of a sphere of radius r: density-scaled below rs (gp_dem3d.h) */
+static double inertial_mass(const gp_dem3d_params *p, double r)
+{
+    double rs = p->scaled_radius, m = 4.0 / 3.0 * M_PI * r * r * r * p->density;
+    return rs > r ? 4.0 / 3.0 * M_PI * rs * rs * rs * p->density * r / rs : m;
+}
+
+/* adds k v v^T to K (6n x 6n), v given on the degrees of freedom a[0..na-1] */
+static void add_outer(gsl_matrix *K, double k, const size_t *a, const double *v, int na)
+{
+    for (int x = 0; x < na; x++)
+        for (int y = 0; y < na; y++)
+            *gsl_matrix_ptr(K, a[x], a[y]) += k * v[x] * v[y];
+}
+
+/* The true omega_max of the DEM's contacts now: K built from its contact list (normal
+ * springs k_n n n^T on the relative translation; two shear springs k_s on the contact point's
+ * tangential displacement u_i - u_j + r_i theta_i x n + r_j theta_j x n; frictionless walls
+ * 2 E r along their normal), M from the density-scaled masses and moments 0.4 m r^2, and GSL's
+ * symmetric eigensolver on M^-1/2 K M^-1/2. */
+static double true_omega_max(const gp_dem3d_params *p, gp_dem3d *d, const double *s, size_t n)
+{
+    gp_contact3d *c;
+    size_t nc;
+    gp_error e;
+    if (gp_dem3d_contacts(d, &c, &nc, &e) != GP_OK)
+        return NAN;
+    size_t N = 6 * n;
+    gsl_matrix *K = gsl_matrix_calloc(N, N);
+    for (size_t k = 0; k < nc; k++) {
+        size_t i = c[k].i;
+        const double *nv = c[k].normal;
+        double ri = s[4 * i + 3];
+        if (c[k].j < 0) { /* wall: normal only */
+            int a = (int)(-1 - c[k].j) / 2;
+            size_t dof = 6 * i + (size_t)a;
+            double one = 1;
+            add_outer(K, 2 * p->young * ri, &dof, &one, 1);
+            continue;
+        }
+        size_t j = (size_t)c[k].j;
+        double rj = s[4 * j + 3], kn = 2 * p->young * ri * rj / (ri + rj), ks = p->ks_kn * kn;
+        size_t dof[12];
+        for (int x = 0; x < 6; x++) {
+            dof[x] = 6 * i + (size_t)x;
+            dof[6 + x] = 6 * j + (size_t)x;
+        }
+        double v[12] = {nv[0], nv[1], nv[2], 0, 0, 0, -nv[0], -nv[1], -nv[2], 0, 0, 0};
+        add_outer(K, kn, dof, v, 12);
+        /* two unit tangents t: t.D = t.(u_i - u_j) + r_i (n x t).theta_i + r_j (n x t).theta_j */
+        double t1[3] = {-nv[1], nv[0], 0};
+        if (fabs(nv[2]) > 0.9) {
+            t1[0] = 0; t1[1] = -nv[2]; t1[2] = nv[1];
+        }
+        double l = sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
+        for (int a = 0; a < 3; a++)
+            t1[a] /= l;
+        double t2[3] = {nv[1] * t1[2] - nv[2] * t1[1], nv[2] * t1[0] - nv[0] * t1[2],
+                        nv[0] * t1[1] - nv[1] * t1[0]};
+        const double *tt[2] = {t1, t2};
+        for (int q = 0; q < 2; q++) {
+            const double *t = tt[q];
+            double nt[3] = {nv[1] * t[2] - nv[2] * t[1], nv[2] * t[0] - nv[0] * t[2],
+                            nv[0] * t[1] - nv[1] * t[0]};
+            for (int a = 0; a < 3; a++) {
+                v[a] = t[a];
+                v[3 + a] = ri * nt[a];
+                v[6 + a] = -t[a];
+                v[9 + a] = rj * nt[a];
+            }
+            add_outer(K, ks, dof, v, 12);
+        }
+    }
+    free(c);
+    for (size_t i = 0; i < n; i++) { /* M^-1/2 K M^-1/2 */
+        double r = s[4 * i + 3], m = inertial_mass(p, r), I = 0.4 * m * r * r;
+        for (size_t x = 0; x < 6; x++) {
+            double f = 1 / sqrt(x < 3 ? m : I);
+            gsl_vector_view row = gsl_matrix_row(K, 6 * i + x), col = gsl_matrix_column(K, 6 * i + x);
+            gsl_vector_scale(&row.vector, f);
+            gsl_vector_scale(&col.vector, f);
+        }
+    }
+    gsl_vector *ev = gsl_vector_alloc(N);
+    gsl_eigen_symm_workspace *w = gsl_eigen_symm_alloc(N);
+    gsl_eigen_symm(K, ev, w);
+    double lmax = gsl_vector_max(ev);
+    gsl_eigen_symm_free(w);
+    gsl_vector_free(ev);
+    gsl_matrix_free(K);
+    return sqrt(lmax);
+}
+
+/* The bound is an upper bound, and not a loose one: on packings of 50, 100 and 150 spheres
+ * made by the DEM (density scaling active, walls, friction) the bound the DEM checks after
+ * a step is >= the true omega_max of the same contacts and <= 2 x it (<= 4 x in omega^2). */
+static void test_dt_bound(void)
+{
+    static const size_t sizes[3] = {50, 100, 150};
+    for (int t = 0; t < 3; t++) {
+        size_t n = sizes[t];
+        double *s = malloc(4 * n * sizeof *s), top = 0;
+        settled_packing(n, 100 + (uint64_t)t, s, &top);
+        gp_dem3d_params p = base();
+        p.scaled_radius = 0.0045;
+        double hi[3] = {0.045, 0.045, top};
+        gp_dem3d *d = in_box(&p, s, n, hi);
+        if (!d) {
+            free(s);
+            return;
+        }
+        gp_error e;
+        CHECK(gp_dem3d_run(d, 1, &e) == GP_OK); /* the contacts of the packing, and the bound */
+        gp_dem3d_state st;
+        gp_dem3d_get_state(d, &st);
+        double w = true_omega_max(&p, d, s, n), ratio = st.omega_bound / w;
+        printf("dt bound: %zu spheres, %zu contacts + %zu wall contacts: bound %.4g rad/s, true "
+               "omega_max %.4g, ratio %.3f\n", n, st.contacts, st.wall_contacts, st.omega_bound, w,
+               ratio);
+        CHECK(st.contacts > n); /* a packing: z > 2 */
+        CHECK(ratio >= 1);
+        CHECK(ratio <= 2);
+        gp_dem3d_destroy(d);
+        free(s);
+    }
+}
+
+/* peak kinetic energy of a run of d (J); HUGE_VAL when it diverged (a sphere left the box) */
+static double peak_kinetic(gp_dem3d *d, long steps)
+{
+    double peak = 0;
+    gp_error e;
+    for (long k = 0; k < steps; k += 10) {
+        if (gp_dem3d_run(d, 10, &e) != GP_OK)
+            return HUGE_VAL;
+        gp_dem3d_state st;
+        gp_dem3d_get_state(d, &st);
+        if (!(st.kinetic <= peak)) peak = st.kinetic;
+    }
+    return peak;
+}
+
+/* The criterion sits on the right side of the real threshold. A packing of 100 spheres in
+ * equilibrium, with its true omega_max (eigensolver), run from rest at fixed steps, unguarded:
+ * without damping it is stable at 0.9 x 2 / omega and blows up at 1.1 x; with the relaxation's
+ * local damping c = 0.7 the limit is 2 / (omega sqrt(1 + c)), 0.77 x lower: stable at 0.95 x
+ * it, blown up at 1.1 x it and at 0.9 x 2 / omega (the undamped criterion would pass that step).
+ * At the step the bound allows (0.9 x 2 / (omega_bound sqrt(1 + c))) it is stable; with the
+ * guard on, a start at 1.2 x the limit is cut back on the first step and stays stable. */
+static void test_dt_threshold(void)
+{
+    size_t n = 100;
+    double *s = malloc(4 * n * sizeof *s), top = 0;
+    settled_packing(n, 101, s, &top);
+    gp_dem3d_params p = base();
+    p.scaled_radius = 0.0045;
+    double hi[3] = {0.045, 0.045, top}, tmin = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        double r = s[4 * i + 3];
+        tmin = fmin(tmin, sqrt(inertial_mass(&p, r) / (2 * p.young * r)));
+    }
+    gp_dem3d *d = in_box(&p, s, n, hi);
+    gp_error e;
+    CHECK(d && gp_dem3d_run(d, 1, &e) == GP_OK);
+    gp_dem3d_state st;
+    gp_dem3d_get_state(d, &st);
+    double w = true_omega_max(&p, d, s, n), wb = st.omega_bound;
+    gp_dem3d_destroy(d);
+    /* step (times the true limit 2 / (omega_true sqrt(1 + c)); -1: the bound's), damping c,
+     * guard off, expected to blow up */
+    const struct { double f, c; int unguarded, blows; } runs[7] = {
+        {0.9, 0.0, 1, 0},  {1.1, 0.0, 1, 1}, {0.95, 0.7, 1, 0}, {1.1, 0.7, 1, 1},
+        {0.9 * sqrt(1.7), 0.7, 1, 1}, {-1, 0.7, 1, 0}, {1.2, 0.7, 0, 0}};
+    double ref = 0;
+    for (int k = 0; k < 7; k++) {
+        double c = runs[k].c;
+        p.damping = c;
+        p.dt_unguarded = runs[k].unguarded;
+        double dt = 2 / sqrt(1 + c) * (runs[k].f > 0 ? runs[k].f / w : 0.9 / wb);
+        p.dt_safety = dt / tmin;
+        d = in_box(&p, s, n, hi);
+        if (!d)
+            break;
+        CHECK_REL(gp_dem3d_dt(d), dt, 1e-12);
+        double ke = peak_kinetic(d, 400);
+        gp_dem3d_get_state(d, &st);
+        printf("dt threshold: omega_max dt = %.3f, c = %.1f (limit %.3f), %s: peak kinetic %.3g J, "
+               "cuts %ld\n", dt * w, c, 2 / sqrt(1 + c), runs[k].unguarded ? "unguarded" : "guarded",
+               ke, st.dt_cuts);
+        if (k == 0)
+            ref = ke; /* stable and undamped: the most energy a stable run keeps */
+        if (runs[k].blows)
+            CHECK(ke > 1e6 * ref || !isfinite(ke));
+        else
+            CHECK(isfinite(ke));
+        if (k == 5) { /* the allowed step: stable, and below the true limit */
+            CHECK(ke <= ref);
+            CHECK(dt * w * sqrt(1 + c) < 2);
+            CHECK(st.dt_ratio < 1 && st.dt_cuts == 0);
+        }
+        if (k == 6) { /* guarded: cut on the first step, then within the true limit */
+            CHECK(st.dt_cuts >= 1);
+            CHECK(gp_dem3d_dt(d) * w * sqrt(1 + c) < 2);
+            CHECK(ke <= ref);
+            /* and the cut is the same with threads: the same dt, the same bits */
+            double *x1 = malloc(4 * n * sizeof *x1), *x3 = malloc(4 * n * sizeof *x3);
+            gp_dem3d_spheres(d, x1);
+            p.threads = 3;
+            gp_dem3d *d3 = in_box(&p, s, n, hi);
+            if (d3) {
+                peak_kinetic(d3, 400);
+                gp_dem3d_spheres(d3, x3);
+                CHECK(gp_dem3d_dt(d3) == gp_dem3d_dt(d));
+                CHECK(memcmp(x1, x3, 4 * n * sizeof *x1) == 0);
+                gp_dem3d_destroy(d3);
+            }
+            p.threads = 1;
+            free(x1);
+            free(x3);
+        }
+        gp_dem3d_destroy(d);
+    }
+    free(s);
+}
+
 static void test_solid_volume(void)
 {
     /* a sphere cut in half by a wall, and one whole */
@@ -394,5 +666,7 @@ int main(void)
     test_skin_independent();
     test_kernel_lanes();
     test_solid_volume();
+    test_dt_bound();
+    test_dt_threshold();
     return gp_test_summary();
 }
