@@ -19,7 +19,8 @@ and prints one table, a row a job:
   peak MB  the daemon's largest VmRSS sampled every 0.2 s during the job (VmHWM cannot be
            reset between rows), split into the build (the core's phases) and the result
            phase (writing the text, the export pack, storing); HWM: VmHWM so far;
-  idle MB  VmRSS once the job is stored (the freed heap handed back or not);
+  idle MB  RssAnon once the job is stored (the freed heap handed back or not; file pages the
+           kernel maps, such as the database's shared WAL index, are not counted);
   result   MB of GET /result (10^6 bytes, streamed and counted, not kept) and bytes a grain;
   sha256   the first 12 hex digits of the SHA-256 of GET /result with the value of its "timings"
            member (seconds, the one part that varies run to run) written as null: the same spec
@@ -173,7 +174,7 @@ def main():
             print("  %s ..." % name, file=sys.stderr, flush=True)
             res = run_job(base, pid, spec)
             time.sleep(1.0)  # the worker's malloc_trim after the job
-            res["idle"] = vm(pid, "VmRSS")
+            res["idle"] = vm(pid, "RssAnon")
             if "error" not in res:
                 res.update(describe(base, res["id"], spec["particles"]))
             table.append((name, res))
