@@ -186,25 +186,40 @@ def result_and_exports(d, jid):
     return out
 
 
+# 700 grains of 128 contour points: a result of ~4.8 MB, past the 4 MiB at which a worker writes
+# it to a temporary file, from which the store reads each part
+SPILLED_2D = dict(gpd.SMALL_2D, particles=700, contour_points=128, outputs=["grains", "odec"])
+
+
 def test_result_over_value_limit_in_parts(env):
-    # the database's limit on one value lowered to 20 kB (a testing hook; 1 GB in SQLite and
-    # PostgreSQL): SMALL_2D's result and export pack are stored in parts and read back as one
-    # value -- the same result, exports and picture as a daemon whose limit they are under
+    # the database's limit on one value lowered (a testing hook; 1 GB in SQLite and
+    # PostgreSQL): a result and export pack in memory (20 kB a part) and one from its temporary
+    # file (1 MB a part) are stored in parts and read back as one value -- the same result,
+    # exports and picture as a daemon whose limit they are under
     ref = env.daemon(workers=1, db=os.path.join(env.dir, "ref.db"))
-    jid = ref.submit(gpd.SMALL_2D)
-    assert ref.wait(jid, timeout=60)["status"] == "succeeded"
-    want = result_and_exports(ref, jid)
+    jids = [ref.submit(s) for s in (gpd.SMALL_2D, SPILLED_2D)]
+    want = []
+    for jid in jids:
+        assert ref.wait(jid, timeout=120)["status"] == "succeeded"
+        want.append(result_and_exports(ref, jid))
     assert ref.stop() == 0, ref.read_log()
-    d = env.daemon(workers=1, env={"GRAINPACK_TEST_SQLITE_MAX_LENGTH": "20000"})
-    jid = d.submit(gpd.SMALL_2D)
-    j = d.wait(jid, timeout=60)
+    for k, (spec, limit) in enumerate(((gpd.SMALL_2D, 20000), (SPILLED_2D, 1000000))):
+        d = env.daemon(workers=1, db=os.path.join(env.dir, "parts%d.db" % k),
+                       env={"GRAINPACK_TEST_SQLITE_MAX_LENGTH": str(limit)})
+        check_in_parts(env, d, spec, limit, want[k], os.path.join(env.dir, "parts%d.db" % k))
+
+
+def check_in_parts(env, d, spec, limit, want, path):
+    jid = d.submit(spec)
+    j = d.wait(jid, timeout=120)
     assert j["status"] == "succeeded", j
     got = result_and_exports(d, jid)
     size = got[1]
-    parts = env.query_int("SELECT count(*) FROM value_parts WHERE what = 0")
-    packs = env.query_int("SELECT count(*) FROM value_parts WHERE what = 1")
+    parts = env.query_int("SELECT count(*) FROM value_parts WHERE what = 0", path)
+    packs = env.query_int("SELECT count(*) FROM value_parts WHERE what = 1", path)
     print("  result %d bytes: part 0 and %d more; pack: part 0 and %d more" % (size, parts, packs))
-    assert size > 3 * 20000 and parts == (size - 1) // (20000 - 1024), (size, parts)
+    assert size > 3 * limit and parts == (size - 1) // (limit - 1024), (size, parts)
+    assert spec is not SPILLED_2D or size > 4 * 2 ** 20, size  # past the spill threshold
     assert packs >= 1, packs
     assert got[0] == want[0], "the result read from parts differs"
     for k, what in enumerate(("csv", "vtk", "svg"), start=2):
@@ -212,7 +227,7 @@ def test_result_over_value_limit_in_parts(env):
     # a purge removes every part
     st, _, b = d.request("DELETE", "/v1/jobs/%s?purge=1" % jid)
     assert st == 204, (st, b)
-    assert env.query_int("SELECT count(*) FROM value_parts") == 0
+    assert env.query_int("SELECT count(*) FROM value_parts", path) == 0
     assert d.stop() == 0, d.read_log()
 
 
