@@ -198,6 +198,22 @@ void store_parts_free(store_parts *p)
     p->n = 0;
 }
 
+store_rc store_stream_read_whole(store_stream *s, char **text, size_t *text_len)
+{
+    size_t size = (size_t)store_stream_size(s);
+    char *buf = malloc(size + 1);
+    store_rc rc = buf && !store_stream_read(s, 0, buf, size) ? STORE_OK : STORE_ERROR;
+    store_stream_close(s);
+    if (rc != STORE_OK) {
+        free(buf);
+        return rc;
+    }
+    buf[size] = 0;
+    *text = buf;
+    *text_len = size;
+    return STORE_OK;
+}
+
 /* ---- the last failed write, for /v1/health ---- */
 static pthread_mutex_t werr_mu = PTHREAD_MUTEX_INITIALIZER;
 static struct {

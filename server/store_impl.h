@@ -84,6 +84,9 @@ int store_parts_add(store_parts *p, uint64_t len);
 /* The part holding byte off (< the value's size), and its first byte in *start. */
 size_t store_parts_find(const store_parts *p, uint64_t off, uint64_t *start);
 void store_parts_free(store_parts *p);
+/* Reads stream s (of at most a few hundred KB: a value in parts that store_stream_open was
+ * asked to return whole) into *text (malloc'ed, NUL-terminated), and closes it. */
+store_rc store_stream_read_whole(store_stream *s, char **text, size_t *text_len);
 
 /* Calls the hook of store_on_cancel, if any (store_pg's listener). */
 void store_cancel_seen(const char *id);

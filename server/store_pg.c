@@ -725,6 +725,17 @@ static store_rc pg_requeue(const char *id)
                        id, 2, NULL, NULL);
 }
 
+/* Runs a write that must change exactly one row (the parameters as run's); STORE_OK, or
+ * STORE_ERROR (logged by run). */
+static store_rc write_row(const char *sql, int n, const char *const *vals, const int *lens,
+                          const int *fmts)
+{
+    PGresult *r = run(sql, n, vals, lens, fmts, 0);
+    long changes = changed(r);
+    PQclear(r);
+    return changes == 1 ? STORE_OK : STORE_ERROR;
+}
+
 /* A value to write in parts (store.h "Values in parts"): its source, the part size, and a
  * buffer of one part where the source is a file (libpq binds a parameter from memory). */
 typedef struct pg_value {
@@ -764,12 +775,10 @@ static store_rc write_parts(const char *seq, int what, pg_value *pv)
         snprintf(k, sizeof k, "%llu", (unsigned long long)part);
         const char *v[4] = {seq, w, k, bytes};
         int lens[4] = {0, 0, 0, blen}, fmts[4] = {0, 0, 0, 1};
-        r = run("INSERT INTO value_parts(seq, what, part, data) "
-                "VALUES ($1::bigint, $2::smallint, $3::int, $4::bytea)",
-                4, v, lens, fmts, 0);
-        long n = changed(r);
-        PQclear(r);
-        if (n != 1) return STORE_ERROR;
+        if (write_row("INSERT INTO value_parts(seq, what, part, data) "
+                      "VALUES ($1::bigint, $2::smallint, $3::int, $4::bytea)",
+                      4, v, lens, fmts))
+            return STORE_ERROR;
     }
     return STORE_OK;
 }
@@ -786,24 +795,18 @@ static store_rc succeed_extras(const char *seq, pg_value *result, pg_value *pack
         if (part_bytes(pack, 0, &bytes, &blen)) return STORE_ERROR;
         const char *v[2] = {seq, bytes};
         int lens[2] = {0, blen}, fmts[2] = {0, 1};
-        PGresult *r = run("INSERT INTO exports(seq, pack) VALUES ($1::bigint, $2::bytea) "
-                          "ON CONFLICT (seq) DO UPDATE SET pack = EXCLUDED.pack",
-                          2, v, lens, fmts, 0);
-        long n = changed(r);
-        PQclear(r);
-        if (n != 1) return STORE_ERROR;
-        rc = write_parts(seq, STORE_VALUE_PACK, pack);
+        rc = write_row("INSERT INTO exports(seq, pack) VALUES ($1::bigint, $2::bytea) "
+                       "ON CONFLICT (seq) DO UPDATE SET pack = EXCLUDED.pack",
+                       2, v, lens, fmts);
+        if (rc == STORE_OK) rc = write_parts(seq, STORE_VALUE_PACK, pack);
     }
     if (rc == STORE_OK && summary) {
         const char *v[3] = {seq, summary, arrays};
         int lens[3] = {0, (int)slen, 0}, fmts[3] = {0, 0, 0};
-        PGresult *r = run("INSERT INTO summaries(seq, summary, arrays) VALUES ($1::bigint, $2, $3) "
-                          "ON CONFLICT (seq) DO UPDATE SET summary = EXCLUDED.summary, "
-                          "arrays = EXCLUDED.arrays",
-                          3, v, lens, fmts, 0);
-        long n = changed(r);
-        PQclear(r);
-        if (n != 1) return STORE_ERROR;
+        rc = write_row("INSERT INTO summaries(seq, summary, arrays) VALUES ($1::bigint, $2, $3) "
+                       "ON CONFLICT (seq) DO UPDATE SET summary = EXCLUDED.summary, "
+                       "arrays = EXCLUDED.arrays",
+                       3, v, lens, fmts);
     }
     return rc;
 }
@@ -1101,24 +1104,6 @@ static uint64_t pg_stream_size(const store_stream *s)
     return ps->parts.end[ps->parts.n - 1];
 }
 
-static int pg_stream_read(store_stream *s, uint64_t off, void *dst, size_t n);
-
-/* A stream of at most small bytes read whole into *text, and closed. */
-static store_rc read_whole(store_stream *s, char **text, size_t *text_len)
-{
-    size_t size = (size_t)pg_stream_size(s);
-    char *buf = malloc(size + 1);
-    store_rc rc = buf && !pg_stream_read(s, 0, buf, size) ? STORE_OK : STORE_ERROR;
-    pg_stream_close(s);
-    if (rc != STORE_OK) {
-        free(buf);
-        return rc;
-    }
-    buf[size] = 0;
-    *text = buf;
-    *text_len = size;
-    return STORE_OK;
-}
 
 /* A value of one part of at most small bytes, read whole on this thread's connection. */
 static store_rc read_small(int is_pack, const char *seq, char **text, size_t *text_len)
@@ -1173,7 +1158,7 @@ static store_rc pg_stream_open(const char *id, const char *what, size_t small, s
                 : "SELECT octet_length(result) FROM jobs WHERE seq=$1::bigint",
         seq, is_pack ? STORE_VALUE_PACK : STORE_VALUE_RESULT, out);
     if (rc != STORE_OK || pg_stream_size(*out) > small) return rc;
-    rc = read_whole(*out, text, text_len);
+    rc = store_stream_read_whole(*out, text, text_len);
     *out = NULL;
     return rc;
 }

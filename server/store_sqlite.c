@@ -1017,7 +1017,6 @@ static int part_open(store_stream *ss, size_t k)
 
 static void sq_stream_close(store_stream *s);
 static uint64_t sq_stream_size(const store_stream *s);
-static int sq_stream_read(store_stream *s, uint64_t off, void *dst, size_t n);
 
 /* The stream of table.column of row seq (part 0) and its other parts, on a private connection
  * that lives as long as the stream, in one read transaction. */
@@ -1077,23 +1076,6 @@ static int read_small(sqlite3_blob *b, uint64_t size, char **text, size_t *text_
     return 0;
 }
 
-/* A stream of at most small bytes read whole into *text, and closed. */
-static store_rc read_whole(store_stream *ss, char **text, size_t *text_len)
-{
-    size_t size = (size_t)ss->parts.end[ss->parts.n - 1];
-    char *buf = malloc(size + 1);
-    store_rc rc = buf && !sq_stream_read(ss, 0, buf, size) ? STORE_OK : STORE_ERROR;
-    sq_stream_close(ss);
-    if (rc != STORE_OK) {
-        free(buf);
-        return rc;
-    }
-    buf[size] = 0;
-    *text = buf;
-    *text_len = size;
-    return STORE_OK;
-}
-
 static store_rc sq_stream_open(const char *id, const char *what, size_t small,
                                store_stream **out, char **text, size_t *text_len,
                                char status[16])
@@ -1129,7 +1111,7 @@ static store_rc sq_stream_open(const char *id, const char *what, size_t small,
     sqlite3_blob_close(b);
     rc = open_private(table, column, seq, kind, out);
     if (rc != STORE_OK || sq_stream_size(*out) > small) return rc;
-    rc = read_whole(*out, text, text_len);
+    rc = store_stream_read_whole(*out, text, text_len);
     *out = NULL;
     return rc;
 }
