@@ -84,6 +84,19 @@ static int sample_row(int threads, unsigned long long seed)
 static const gp_sieve_row WIDE[4] = {{0.001, 0}, {0.005, 1}, {0.010, 10}, {0.020, 100}};
 static const double WIDE_CASES[3][2] = {{0.1, 0.46}, {0.1, 0.42}, {0.15, 0.42}};
 
+/* the size-ratio-20 case b: its box and porosity, seed 1, no outputs */
+static void wide_spec(gp_spec3d *w, int b, int threads)
+{
+    gp_spec3d_defaults(w);
+    w->threads = threads;
+    w->seed = 1;
+    w->box[0] = w->box[1] = w->box[2] = WIDE_CASES[b][0];
+    w->sieve = WIDE;
+    w->nsieve = 4;
+    w->porosity = WIDE_CASES[b][1];
+    w->outputs = 0;
+}
+
 /* one row of --phases: the build of s, per phase */
 static void phase_row(const char *name, const gp_spec3d *s)
 {
@@ -123,14 +136,7 @@ static int phases_table(int threads)
     }
     for (int b = 0; b < 3; b++) {
         gp_spec3d w;
-        gp_spec3d_defaults(&w);
-        w.threads = threads;
-        w.seed = 1;
-        w.box[0] = w.box[1] = w.box[2] = WIDE_CASES[b][0];
-        w.sieve = WIDE;
-        w.nsieve = 4;
-        w.porosity = WIDE_CASES[b][1];
-        w.outputs = 0;
+        wide_spec(&w, b, threads);
         char name[64];
         snprintf(name, sizeof name, "1-20 mm, %.2f m, %.2f", WIDE_CASES[b][0], WIDE_CASES[b][1]);
         phase_row(name, &w);
@@ -222,14 +228,7 @@ int main(int argc, char **argv)
            "max PSD error (pp) | stop |\n|---|---|---|---|---|---|---|---|---|---|\n");
     for (int b = 0; b < 3; b++) {
         gp_spec3d w;
-        gp_spec3d_defaults(&w);
-        w.threads = s.threads;
-        w.seed = 1;
-        w.box[0] = w.box[1] = w.box[2] = WIDE_CASES[b][0];
-        w.sieve = WIDE;
-        w.nsieve = 4;
-        w.porosity = WIDE_CASES[b][1];
-        w.outputs = 0;
+        wide_spec(&w, b, s.threads);
         gp_specimen3d *q = NULL;
         gp_status sq = gp_specimen3d_build(&w, NULL, NULL, NULL, &q, &e);
         if (!q) {
