@@ -53,6 +53,13 @@
  * locally (gp_voronoi_try_move); update the objective for the changed cells; accept if the
  * error does not increase (plateaus are crossed), otherwise roll the tessellation back.
  *
+ * Seed numbering: generated seeds (init uniform or Halton) are renumbered along a Hilbert curve
+ * over the container's bounding box before the tessellation is built, so that neighbouring
+ * cells have nearby indices and everything stored per cell (cells, neighbour lists, bins, AD
+ * values) lies close in memory: a step touches ~9 neighbouring cells, and in draw order these
+ * were scattered (3x fewer steps/s at N = 100,000 than at 1,000). Cell i of the result is the
+ * i-th seed along the curve; seeds given by the caller (params.seeds) keep their order.
+ *
  * Determinism: the same container, N and params (seed included) give the same tessellation bit
  * for bit. Thread-safety: one run per call, no shared state.
  */
@@ -85,7 +92,7 @@ typedef struct gp_imc_params {
     int classes_size;    /* number of area classes, 0 = automatic */
     int classes_orient;  /* number of orientation classes, 0 = automatic */
     uint64_t seed;       /* random seed (stream 0 of gp_rng) */
-    const gp_vec2 *seeds;/* optional: n initial seeds instead of init (copied) */
+    const gp_vec2 *seeds;/* optional: n initial seeds instead of init (copied; cell i is seeds[i]) */
 } gp_imc_params;
 
 /* AD with its default threshold, 1e6 steps, uniform start, automatic classes, lognormal cov

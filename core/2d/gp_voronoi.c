@@ -36,7 +36,9 @@
  *
  * - Each cell owns a heap buffer (grown, never shrunk). A move computes the new cells into spare
  *   buffers from a pool and swaps pointers; rollback swaps them back (bit-exact, O(1) per cell),
- *   commit returns the old buffers to the pool. After warm-up a step does not allocate.
+ *   commit copies the new cells into the cells' own buffers and returns the spares to the pool,
+ *   so that a cell's data stays where the build put it (in index order: see gp_voronoi_commit).
+ *   After warm-up a step does not allocate.
  *
  * Tags: every polygon edge carries a tag: >= 0 the seed whose bisector it lies on, -1 a keyhole
  * bridge, TAG_B + k side k of the box B, otherwise container edge -tag - 2.
@@ -2282,10 +2284,44 @@ gp_status gp_voronoi_try_move(gp_voronoi *v, size_t i, gp_vec2 pu, gp_error *err
     return GP_OK;
 }
 
+/* dst = src (contents, not capacities); -1 with dst unchanged when out of memory */
+static int cell_copy(vcell *dst, const vcell *src)
+{
+    if (cell_reserve(dst, src->nv, src->nparts, src->nnb + src->nce)) return -1;
+    memcpy(dst->v, src->v, (size_t)src->nv * sizeof(gp_vec2));
+    memcpy(dst->tag, src->tag, (size_t)src->nv * sizeof(int32_t));
+    memcpy(dst->poff, src->poff, (size_t)(src->nparts + 1) * sizeof(int32_t));
+    if (src->nnb + src->nce > 0) /* a lone cell has none, and maybe no list (NULL) */
+        memcpy(dst->nb, src->nb, (size_t)(src->nnb + src->nce) * sizeof(int32_t));
+    dst->nv = src->nv;
+    dst->nparts = src->nparts;
+    dst->seed_part = src->seed_part;
+    dst->nnb = src->nnb;
+    dst->nce = src->nce;
+    dst->convex = src->convex;
+    dst->area = src->area;
+    dst->orient = src->orient;
+    return 0;
+}
+
+/* The new cells are copied back into the cells' own buffers and the spares go back to the
+ * pool. Why not keep the spares (a pointer swap): the pool is LIFO, so after a few accepted
+ * moves per cell every cell would live in buffers last used by some random cell far away, and
+ * the memory order the caller set up by numbering the seeds along a space-filling curve
+ * (gp_imc.c) would be lost; a copy of ~9 cells of ~300 bytes costs far less than the cache
+ * misses. When a copy cannot grow a buffer, that cell keeps its spare (as before). */
 void gp_voronoi_commit(gp_voronoi *v)
 {
     if (!v || !v->pending) return;
-    for (uint32_t k = 0; k < v->nchg; k++) pool_put(v, v->chg_old[k]);
+    for (uint32_t k = 0; k < v->nchg; k++) {
+        uint32_t j = v->chg[k];
+        vcell *own = v->chg_old[k], *fresh = v->cell[j], *spare = own;
+        if (cell_copy(own, fresh) == 0) {
+            v->cell[j] = own;
+            spare = fresh;
+        }
+        if (pool_put(v, spare)) cell_free(spare); /* the pool could not grow: drop the spare */
+    }
     v->nchg = 0;
     v->pending = 0;
 }

@@ -38,6 +38,10 @@
  * gp_voronoi_create() of the same seeds gives, and a rolled-back move restores everything bit
  * for bit.
  *
+ * Memory. Each cell's data (polygon, tags, neighbour lists) keeps its place for the life of the
+ * object (a committed move copies the new cells back): cells numbered so that neighbours have
+ * nearby indices (gp_imc.h numbers its seeds along a Hilbert curve) stay close in memory.
+ *
  * Coordinates. Internally everything is relative to the container's bounding box (origin at its
  * lower-left corner, tolerances relative to its size), so the unit square scaled by 1e-6 or 1e6
  * behaves identically. Output coordinates are the caller's.

@@ -2,8 +2,8 @@
  * with the paper's E3 and with the default Anderson-Darling objective (whose value is recomputed
  * here from the cells with an independent lognormal CDF and sort), a specimen that E3 passes
  * and the AD objective does not, the error floor, the hard cases (they converge or stop with a
- * reason, never hang), determinism, cancellation, and the report against an independent
- * recount of the final tessellation. */
+ * reason, never hang), determinism, cancellation, the report against an independent
+ * recount of the final tessellation, and the seeds' numbering along a Hilbert curve. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -262,6 +262,91 @@ static void rebuild_matches(const char *name, const gp_vec2 *outer, size_t no,
     free(s);
 }
 
+/* The Hilbert index of (x, y) on a 2^16 grid, by the state table of Hacker's Delight (Warren,
+ * fig. 16-8): an implementation independent of gp_imc.c's bit-twiddling one, with the same
+ * convention (from (0, 0), first up the y axis, ending at (2^16 - 1, 0)). */
+static uint64_t hilbert_table(uint32_t x, uint32_t y)
+{
+    uint64_t s = 0;
+    uint32_t state = 0;
+    for (int i = 15; i >= 0; i--) {
+        uint32_t row = 4 * state | 2 * ((x >> i) & 1) | ((y >> i) & 1);
+        s = (s << 2) | ((0x361E9CB4u >> (2 * row)) & 3);
+        state = (0x8FE65831u >> (2 * row)) & 3;
+    }
+    return s;
+}
+
+/* Generated seeds come numbered along a Hilbert curve over the container's bounding box
+ * (gp_imc.c, hilbert_sort): their curve indices, recomputed here, never decrease; consecutive
+ * seeds lie close (in draw order they would lie ~0.5 apart in a unit square; along the curve
+ * ~1 / sqrt(N)), and Voronoi neighbours have close indices. The caller's seeds keep their
+ * order. No step is taken, so the seeds are the initial ones. */
+static void seed_order(const char *name, const gp_vec2 *outer, size_t no, const gp_vec2 *const *holes,
+                       const size_t *nh, size_t nholes, size_t n, int init)
+{
+    gp_imc_params p;
+    gp_imc_params_defaults(&p);
+    p.max_steps = 0;
+    p.threshold = 1e-12;
+    p.init = init;
+    gp_voronoi *v = NULL;
+    gp_imc_run(outer, no, holes, nh, nholes, n, &p, NULL, NULL, NULL, &v, NULL, NULL);
+    CHECK(v != NULL);
+    if (!v) return;
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    for (size_t k = 0; k < no; k++) {
+        x0 = fmin(x0, outer[k].x), y0 = fmin(y0, outer[k].y);
+        x1 = fmax(x1, outer[k].x), y1 = fmax(y1, outer[k].y);
+    }
+    double scale = 65536.0 / fmax(x1 - x0, y1 - y0), step = 0.0;
+    uint64_t prev = 0;
+    int monotone = 1;
+    for (size_t i = 0; i < n; i++) {
+        gp_vec2 s = gp_voronoi_seed(v, i);
+        double fx = fmin(fmax((s.x - x0) * scale, 0.0), 65535.0);
+        double fy = fmin(fmax((s.y - y0) * scale, 0.0), 65535.0);
+        uint64_t h = hilbert_table((uint32_t)fx, (uint32_t)fy);
+        monotone &= i == 0 || h >= prev;
+        prev = h;
+        if (i > 0) {
+            gp_vec2 r = gp_voronoi_seed(v, i - 1);
+            step += hypot(s.x - r.x, s.y - r.y);
+        }
+    }
+    /* mean |i - j| over neighbour pairs: N / 3 for a random numbering */
+    static size_t nb[256];
+    double gap = 0.0, pairs = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        size_t k = gp_voronoi_neighbours(v, i, nb, 256);
+        for (size_t q = 0; q < k; q++) gap += fabs((double)nb[q] - (double)i);
+        pairs += (double)k;
+    }
+    step /= (double)(n - 1) * sqrt(gp_voronoi_container_area(v) / (double)n); /* in cell sizes */
+    gap /= pairs;
+    printf("%s: curve order %s, mean step %.2f cell sizes, mean neighbour index gap %.1f of %zu\n", name,
+           monotone ? "yes" : "NO", step, gap, n);
+    CHECK(monotone);
+    CHECK(step < 2.0);
+    CHECK(gap < 0.05 * (double)n);
+    /* the caller's seeds are kept as given: a reversed copy stays reversed */
+    gp_vec2 *s = malloc(n * sizeof *s);
+    for (size_t i = 0; i < n; i++) s[i] = gp_voronoi_seed(v, n - 1 - i);
+    p.seeds = s;
+    gp_voronoi *w = NULL;
+    gp_imc_run(outer, no, holes, nh, nholes, n, &p, NULL, NULL, NULL, &w, NULL, NULL);
+    CHECK(w != NULL);
+    int same = w != NULL;
+    for (size_t i = 0; same && i < n; i++) {
+        gp_vec2 a = gp_voronoi_seed(w, i);
+        same = memcmp(&a, &s[i], sizeof a) == 0;
+    }
+    CHECK(same);
+    gp_voronoi_destroy(w);
+    gp_voronoi_destroy(v);
+    free(s);
+}
+
 int main(void)
 {
     /* --- the paper's two configurations (Mollon & Zhao §3.3.3) and N = 2000 --- */
@@ -353,6 +438,16 @@ int main(void)
         CHECK(r.stop_reason == GP_IMC_STOP_MAX_STEPS || r.stop_reason == GP_IMC_STOP_THRESHOLD);
         gp_voronoi_destroy(v);
         gp_imc_report_free(&r);
+    }
+
+    /* --- seeds numbered along a Hilbert curve (memory locality), the caller's kept --- */
+    {
+        gp_vec2 L[6] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+        gp_vec2 strip[4] = {{0, 0}, {10, 0}, {10, 1}, {0, 1}};
+        seed_order("order: square, uniform", SQ, 4, NULL, NULL, 0, 5000, 0);
+        seed_order("order: square, Halton", SQ, 4, NULL, NULL, 0, 5000, 1);
+        seed_order("order: L-shape", L, 6, NULL, NULL, 0, 3000, 0);
+        seed_order("order: 10:1 strip", strip, 4, NULL, NULL, 0, 3000, 0);
     }
 
     /* --- determinism: same seed, same tessellation bit for bit; another seed differs --- */
