@@ -141,8 +141,6 @@ struct gp_dem3d {
     double *sminv;             /* sqrt(minv) (the bound's off-diagonal share) */
     double beta;               /* a contact's largest eigenvalue, times m_i / k_n (see header) */
     int dt_guard;              /* cut dt when the bound fails (not params.dt_unguarded) */
-    int dt_per_damping;        /* dt follows the damping: dt sqrt(1 + c) = dt_und (params) */
-    double dt_und;             /* dt sqrt(1 + c), c the damping in force (dt_per_damping) */
     double lam_max;            /* the bound on omega_max^2 at the last step */
     double dt_ratio;           /* the largest fraction of the proven limit a step has used */
     long dt_cuts;
@@ -406,11 +404,7 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
         double t = sqrt(mi / (2 * d->E * r));
         if (t < tmin) tmin = t;
     }
-    /* dt_per_damping: the safety is dt sqrt(1 + c) / tmin, the same fraction of the damped
-     * limit omega dt sqrt(1 + c) < 2 for any damping c (see the header) */
-    d->dt_per_damping = p->dt_per_damping != 0;
-    d->dt_und = safety * tmin;
-    d->dt = d->dt_per_damping ? d->dt_und / sqrt(1 + d->damping) : d->dt_und;
+    d->dt = safety * tmin;
     /* a contact's largest eigenvalue times m_i / k_n: the normal mode (1), or the shear spring
      * at the contact point, which moves by u + r theta: k_s (1/m + r^2/I) = k_s (1 + 2.5) / m */
     d->beta = fmax(1.0, 3.5 * d->ks_kn);
@@ -430,15 +424,7 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
 
 double gp_dem3d_dt(const gp_dem3d *d) { return d->dt; }
 void gp_dem3d_set_friction(gp_dem3d *d, double deg) { d->tanphi = tan(deg * M_PI / 180); }
-/* with dt_per_damping the step follows c: dt_und (the last cut's included) over sqrt(1 + c) */
-void gp_dem3d_set_damping(gp_dem3d *d, double c)
-{
-    d->damping = c;
-    if (d->dt_per_damping)
-        d->dt = d->dt_und / sqrt(1 + c);
-}
-
-void gp_dem3d_reset_dt_ratio(gp_dem3d *d) { d->dt_ratio = 0; }
+void gp_dem3d_set_damping(gp_dem3d *d, double c) { d->damping = c; }
 double gp_dem3d_wall(const gp_dem3d *d, int w) { return d->wall[w]; }
 
 void gp_dem3d_set_radius_scale(gp_dem3d *d, double s)
@@ -1324,7 +1310,6 @@ static void check_dt(gp_dem3d *d, double lam)
         d->dt_ratio = ratio;
     if (d->dt_guard && ratio >= 1) {
         d->dt = DT_CUT * 2 / wc;
-        d->dt_und = d->dt * sqrt(1 + d->damping); /* a later damping keeps the cut's fraction */
         d->dt_cuts++;
     }
 }

@@ -18,10 +18,8 @@
  *     surface within 0.05 x the smallest radius flies with its true mass and no damping
  *     (free flight: fines fall at g, not at g scaled down; see gp_dem3d.c);
  *   - time step dt = dt_safety * min_i sqrt(m_i / (2 E R_i)) (m_i the inertial mass: density
- *     scaled; with params.dt_per_damping divided by sqrt(1 + c), c the damping in force, so
- *     that each damping gets the same share of its own limit, below), checked after every
- *     step against a proven bound on the fastest vibration of the contacts of that step,
- *     shear and rotation included (below); dt is cut when it fails;
+ *     scaled), checked after every step against a proven bound on the fastest vibration of the
+ *     contacts of that step, shear and rotation included (below); dt is cut when it fails;
  *   - contact detection: a Verlet list of candidate pairs i < j (a half list: each pair once),
  *     those with a gap below skin + the free-flight gap, sorted by (i, j); rebuilt only when
  *     some sphere has moved (or grown) more than skin / 2 since the last rebuild, from
@@ -77,11 +75,6 @@
  * cannot blow up alone; params.dt_unguarded turns the cut off, for the tests). Every contact
  * is covered on the step it acts (the shares are summed over the pairs that touch), so the
  * check does not depend on the skin either.
- * The fraction of the limit used, sqrt(lam) dt sqrt(1 + c) / 2, depends on c only through
- * dt sqrt(1 + c): with params.dt_per_damping that product is held fixed (dt_und; a cut sets
- * it too) and dt = dt_und / sqrt(1 + c) at every change of c, so a phase with less damping
- * (0.2 against the relaxation's 0.7) steps sqrt(1.7 / 1.2) = 1.19 x longer at the same
- * fraction of its limit for the same contacts.
  *
  * Ownership: gp_dem3d_create copies the spheres; the gp_dem3d owns its state and its worker
  * threads until gp_dem3d_destroy. Lists handed out (gp_dem3d_contacts, gp_dem3d_find_pairs)
@@ -110,10 +103,6 @@ typedef struct gp_dem3d_params {
     double scaled_radius;/* density scaling radius (m); 0 = none */
     double skin;         /* Verlet skin (m); 0 = 0.2 * smallest radius */
     int dt_unguarded;    /* nonzero: never cut dt (tests of the stability bound) */
-    int dt_per_damping;  /* nonzero: the step follows the damping c in force (this one, then
-                            each gp_dem3d_set_damping): dt = dt_safety min_i sqrt(m_i / (2 E
-                            R_i)) / sqrt(1 + c), the same fraction of the damped limit for any
-                            c (see "Stability" above); 0: dt does not depend on c */
     int threads;         /* 0 = 1 */
 } gp_dem3d_params;
 
@@ -127,9 +116,6 @@ void gp_dem3d_destroy(gp_dem3d *d);
 
 double gp_dem3d_dt(const gp_dem3d *d);
 void gp_dem3d_set_friction(gp_dem3d *d, double friction_deg);
-/* With params.dt_per_damping this also sets dt = dt_und / sqrt(1 + damping), dt_und =
- * dt sqrt(1 + c) before the change (the step's fraction of the damped limit is kept, a cut's
- * included); otherwise dt stays. */
 void gp_dem3d_set_damping(gp_dem3d *d, double damping);
 /* Current radii are the full radii times s (in (0, 1]); masses stay those of the full radii. */
 void gp_dem3d_set_radius_scale(gp_dem3d *d, double s);
@@ -166,9 +152,6 @@ typedef struct gp_dem3d_state {
 } gp_dem3d_state;
 
 void gp_dem3d_get_state(const gp_dem3d *d, gp_dem3d_state *s);
-/* Starts state.dt_ratio afresh (0): the largest fraction of the limit from the next step on,
- * e.g. one phase's own. */
-void gp_dem3d_reset_dt_ratio(gp_dem3d *d);
 /* Current x, y, z, r (current radii) into xyzr[4n]. */
 void gp_dem3d_spheres(const gp_dem3d *d, double *xyzr);
 

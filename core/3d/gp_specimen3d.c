@@ -50,8 +50,7 @@
 #define STABILITY GP_SPEC3D_STABILITY /* Eq. 7: 0.01 % */
 #define GROW_FROM 0.6            /* initial radius scale of the placement */
 /* durations, in units of sqrt(d50 / g) (see where tu is computed; the paper's sieve has ~860
- * steps per unit at the relaxation's dt, ~720 at the deposition's, and these are its former
- * step counts at ~860) */
+ * steps per unit, and these are its former step counts) */
 #define GROW_T 1.75              /* growth of the radii */
 #define SETTLE_T 1.2             /* deposition ends after this ... */
 #define SETTLE_SC 5e-2           /* ... or when S_c is below this */
@@ -70,19 +69,13 @@
 #define POROSITY_SLACK 0.003     /* the wall may end this far from the target porosity (the
                                     tolerance is 0.005): above, where the packing jams without
                                     friction; below, following a packing that settles away */
-#define DT_SAFETY 0.4            /* of sqrt(m / 2 E R), m density-scaled, at the relaxation's
-                                    damping c = 0.7. The DEM checks every step against a proven
-                                    bound on omega_max (shear and rotation included) and the
-                                    limit omega dt < 2 / sqrt(1 + c) of leapfrog with local
-                                    damping c (gp_dem3d.h). The other phases (c = the
-                                    material's 0.2) get the same fraction of their own limit:
-                                    dt = DT_SAFETY sqrt((1 + 0.7) / (1 + c)) of sqrt(m / 2 E R)
-                                    (params.dt_per_damping), 1.19 x longer. On the paper's
-                                    sample (seeds 0-9) the steps use at most 0.80-0.92 of the
-                                    limit in deposition, 0.89-0.95 in compaction and 0.90-0.97
-                                    in relaxation (0.98 in the small sample of test_specimen3d),
-                                    never cut; at 0.43 relaxation already needs a cut on some
-                                    seeds */
+#define DT_SAFETY 0.4            /* of sqrt(m / 2 E R), m density-scaled. The DEM checks every
+                                    step against a proven bound on omega_max (shear and rotation
+                                    included) and the limit omega dt < 2 / sqrt(1 + c) of
+                                    leapfrog with local damping c (gp_dem3d.h); on the paper's
+                                    sample (seeds 0, 1, 2, 7) the steps use at most 0.90-0.94
+                                    of that limit, in relaxation (c = 0.7); 0.43 already needs
+                                    a cut of dt on some seeds */
 #define COMPACTION_STRESS 1.0    /* top-wall stress, times the geostatic stress at the bottom */
 /* local damping during relaxation (the static state does not depend on it; Sc <= 1e-4 comes
  * ~2x sooner than at 0.2) */
@@ -399,7 +392,6 @@ static gp_status relax_tiled(const gp_spec3d *spec, const gp_dem3d_params *dp, p
             break;
     }
     if (!st) {
-        S->dt_cuts += ds.dt_cuts; /* (flipped walls are image spheres: stiffer than walls) */
         S->tiled_stability = ds.stability;
         gp_dem3d_spheres(dem, tiled);
         st = gp_dem3d_contacts(dem, tcon, ntcon, err);
@@ -489,7 +481,6 @@ typedef struct build_run {
     double area, sigma0;     /* the top wall's area and servo stress (phase 1 on) */
     int pushed;              /* the top wall has pressed on grains */
     int reached;             /* the top wall reached b_z (or stalled within POROSITY_SLACK) */
-    long phase_start;        /* the DEM's steps when the current phase began */
     gp_status outcome;       /* GP_OK, GP_ERR_INFEASIBLE or GP_ERR_NOT_CONVERGED */
     const char *reason;      /* stats.stop_reason */
     /* phase 2 */
@@ -631,8 +622,7 @@ static gp_status start_dem(build_run *R)
     dp->scaled_radius = fmax(0.5 * diam[n / 2], 0.5 * diam[0] / MAX_SCALED_RATIO);
     dp->skin = 0.5 * diam[n - 1]; /* the smallest radius (rebuilds against candidates; results
                                      do not depend on it) */
-    dp->dt_safety = DT_SAFETY * sqrt(1 + RELAX_DAMPING); /* over sqrt(1 + c) in force */
-    dp->dt_per_damping = 1;
+    dp->dt_safety = DT_SAFETY;
     R->res->stats.scaled_radius = dp->scaled_radius;
     dp->threads = spec->threads > 0 ? spec->threads : 1;
     for (size_t i = 0; i < n; i++)
@@ -646,9 +636,8 @@ static gp_status start_dem(build_run *R)
     /* Every duration of the protocol is a multiple of the skeleton's time sqrt(d50 / g) (d50 the
      * median diameter by weight: the grains that carry the load), the time a grain takes to
      * fall its own size. In steps this unit is ~860 for the paper's sieve and ~2300 for a size
-     * ratio of 20 (at the relaxation's dt; 1.19 x fewer at the deposition's, tu), where dt
-     * follows the small grains: counted in steps, the windows that judge progress were too
-     * short there, and the deposit never had the time to settle. */
+     * ratio of 20, where dt follows the small grains: counted in steps, the windows that judge
+     * progress were too short there, and the deposit never had the time to settle. */
     double d50 = diam[n - 1];
     double tot = 0, acc = 0;
     for (size_t i = 0; i < n; i++)
@@ -667,26 +656,8 @@ static gp_status start_dem(build_run *R)
     R->ladder_steps = CHUNK * (long)ceil(LADDER_T * tu / CHUNK);
     R->stall_steps = CHUNK * (long)ceil(STALL_T * tu / CHUNK);
     R->lid_speed = LID_SPEED * sqrt(GRAVITY * d50);
-    /* the cap counts steps of the relaxation's (shortest) dt, as when every phase had it */
-    double c_relax = fmax(spec->material.damping, RELAX_DAMPING);
-    double tu_relax = tu * sqrt((1 + c_relax) / (1 + spec->material.damping));
-    R->max_steps = spec->max_steps > 0 ? spec->max_steps : (long)fmax(400000, MAX_T * tu_relax);
+    R->max_steps = spec->max_steps > 0 ? spec->max_steps : (long)fmax(400000, MAX_T * tu);
     return GP_OK;
-}
-
-/* the end of DEM phase k (0 deposition, 1 compaction, 2 relaxation): its time step, steps and
- * largest fraction of the stability limit into the stats; the next phase's fraction starts
- * afresh */
-static void end_phase(build_run *R, int k)
-{
-    gp_stats3d *S = &R->res->stats;
-    gp_dem3d_get_state(R->dem, &R->ds);
-    S->phase_dt[k] = gp_dem3d_dt(R->dem);
-    S->phase_steps[k] = R->ds.steps - R->phase_start;
-    S->phase_dt_ratio[k] = R->ds.dt_ratio;
-    S->dt_cuts = R->ds.dt_cuts;
-    R->phase_start = R->ds.steps;
-    gp_dem3d_reset_dt_ratio(R->dem);
 }
 
 /* the radii grow to full size under gravity (GROW_T), then the deposit settles (SETTLE_T, or
@@ -719,7 +690,6 @@ static gp_status deposit(build_run *R)
         if (ds->stability < SETTLE_SC)
             break;
     }
-    end_phase(R, 0);
     R->res->t_deposition = gp_clock_seconds() - t_phase;
     return GP_OK;
 }
@@ -825,7 +795,6 @@ static gp_status compact(build_run *R)
     }
     S->deposition_porosity = 1 - vs / (area * (isnan(h_touch) ? gp_dem3d_wall(dem, 5) : h_touch));
     S->compaction_friction_deg = phi;
-    end_phase(R, 1);
     R->res->t_compaction = gp_clock_seconds() - t_phase;
     return GP_OK;
 }
@@ -882,7 +851,6 @@ static gp_status relax(build_run *R)
                 }
             }
         }
-        end_phase(R, 2);
         if (R->outcome == GP_OK && !(ds->wall_force[5] > 0)) {
             /* the wall never touched a grain above b_z: the deposit is denser than the target;
              * or (pass 1) the packing settled further than POROSITY_SLACK */
@@ -909,10 +877,6 @@ static gp_status collect_sample(build_run *R)
     gp_dem3d_get_state(dem, &R->ds);
     S->stability = R->ds.stability;
     S->steps = R->ds.steps;
-    /* stats.dt is the relaxation's step (an export's relaxation runs at it), also where the
-     * protocol ended before relaxing */
-    if (!R->reached)
-        gp_dem3d_set_damping(dem, fmax(R->spec->material.damping, RELAX_DAMPING));
     S->dt = gp_dem3d_dt(dem);
     S->stop_reason = R->reason;
     gp_dem3d_spheres(dem, R->xyzr);

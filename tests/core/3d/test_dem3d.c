@@ -647,78 +647,6 @@ static void test_dt_threshold(void)
     free(s);
 }
 
-/* params.dt_per_damping: dt = dt_safety tmin / sqrt(1 + c) for the damping c in force, at
- * the start and after gp_dem3d_set_damping, so that on the same contacts every damping uses
- * the same fraction of its limit sqrt(lam (1 + c)) dt / 2 (the DEM's dt_ratio, compared over
- * one step from the same settled packing at c = 0.2 and at 0.7); without it the step ignores
- * c. A guarded start at 1.2 x the bound's limit is cut to 0.9 of it, and a change of c after
- * the cut keeps that 0.9 of the new limit. */
-static void test_dt_per_damping(void)
-{
-    size_t n = 100;
-    double *s = malloc(4 * n * sizeof *s), top = 0;
-    settled_packing(n, 102, s, &top);
-    gp_dem3d_params p = base();
-    p.scaled_radius = 0.0045;
-    p.dt_safety = 0.5;
-    p.dt_per_damping = 1;
-    double hi[3] = {0.045, 0.045, top}, tmin = INFINITY;
-    for (size_t i = 0; i < n; i++) {
-        double r = s[4 * i + 3];
-        tmin = fmin(tmin, sqrt(inertial_mass(&p, r) / (2 * p.young * r)));
-    }
-    gp_error e;
-    double ratio[2] = {0, 0};
-    for (int k = 0; k < 2; k++) { /* 0: c = 0.2 throughout; 1: set to 0.7 before the step */
-        gp_dem3d *d = in_box(&p, s, n, hi);
-        if (!d)
-            break;
-        CHECK_REL(gp_dem3d_dt(d), 0.5 * tmin / sqrt(1.2), 1e-12);
-        if (k == 1) {
-            gp_dem3d_set_damping(d, 0.7);
-            CHECK_REL(gp_dem3d_dt(d), 0.5 * tmin / sqrt(1.7), 1e-12);
-        }
-        CHECK(gp_dem3d_run(d, 1, &e) == GP_OK);
-        gp_dem3d_state st;
-        gp_dem3d_get_state(d, &st);
-        ratio[k] = st.dt_ratio;
-        CHECK_REL(st.dt_ratio, st.omega_bound * gp_dem3d_dt(d) * sqrt(k ? 1.7 : 1.2) / 2, 1e-12);
-        CHECK(st.dt_cuts == 0);
-        gp_dem3d_reset_dt_ratio(d);
-        gp_dem3d_get_state(d, &st);
-        CHECK(st.dt_ratio == 0);
-        gp_dem3d_destroy(d);
-    }
-    printf("dt per damping: fraction of the limit %.4f at c = 0.2, %.4f at c = 0.7\n", ratio[0],
-           ratio[1]);
-    CHECK(ratio[0] > 0.1 && ratio[0] < 1);
-    CHECK_REL(ratio[0], ratio[1], 1e-9);
-    /* without dt_per_damping the step stays what dt_safety made it */
-    p.dt_per_damping = 0;
-    gp_dem3d *d = in_box(&p, s, n, hi);
-    if (d) {
-        gp_dem3d_set_damping(d, 0.7);
-        CHECK_REL(gp_dem3d_dt(d), 0.5 * tmin, 1e-12);
-        gp_dem3d_destroy(d);
-    }
-    /* a cut, then a change of damping: 0.9 of the limit before and after */
-    p.dt_per_damping = 1;
-    p.dt_safety = 0.5 * 1.2 / ratio[0]; /* 1.2 x the limit at c = 0.2 */
-    d = in_box(&p, s, n, hi);
-    if (d) {
-        gp_dem3d_state st;
-        CHECK(gp_dem3d_run(d, 1, &e) == GP_OK);
-        gp_dem3d_get_state(d, &st);
-        CHECK(st.dt_cuts == 1);
-        CHECK_REL(st.dt_ratio, 1.2, 1e-9);
-        CHECK_REL(gp_dem3d_dt(d) * st.omega_bound * sqrt(1.2) / 2, 0.9, 1e-12);
-        gp_dem3d_set_damping(d, 0.7);
-        CHECK_REL(gp_dem3d_dt(d) * st.omega_bound * sqrt(1.7) / 2, 0.9, 1e-12);
-        gp_dem3d_destroy(d);
-    }
-    free(s);
-}
-
 static void test_solid_volume(void)
 {
     /* a sphere cut in half by a wall, and one whole */
@@ -740,6 +668,5 @@ int main(void)
     test_solid_volume();
     test_dt_bound();
     test_dt_threshold();
-    test_dt_per_damping();
     return gp_test_summary();
 }
