@@ -55,7 +55,7 @@
  * Checkpoints (SQLite): a commit of a large result leaves hundreds of MB in the WAL; SQLite's
  * automatic checkpoint would copy them into the database on the connection that commits next
  * (a worker, or an HTTP thread), holding it for seconds. So no connection checkpoints by
- * itself (wal_autocheckpoint off); a commit that leaves the WAL over STORE_WAL_KICK_PAGES pages
+ * itself (wal_autocheckpoint off); a commit that leaves the WAL over STORE_WAL_KICK_BYTES
  * calls the store_on_wal_grown hook instead, and the maintenance thread (maint.h) checkpoints:
  * a PASSIVE pass that copies the frames without blocking writers or readers, then a TRUNCATE
  * that does not wait (store_checkpoint); it waits for idle workers and gives way to a claim.
@@ -267,9 +267,10 @@ int store_checkpoint(int may_yield);
 void store_checkpoint_yield(void);
 
 /* fn() is called (on the committing thread, which must not wait for it) after a commit that
- * left the WAL over STORE_WAL_KICK_PAGES pages (SQLite; never on PostgreSQL): a checkpoint is
- * due (store_reclaim). NULL: none. */
-#define STORE_WAL_KICK_PAGES 1000 /* SQLite's own autocheckpoint threshold: ~4 MB */
+ * left the WAL over STORE_WAL_KICK_BYTES (SQLite; never on PostgreSQL): a checkpoint is due
+ * (store_reclaim). NULL: none. */
+#define STORE_WAL_KICK_BYTES (4 << 20) /* SQLite's own autocheckpoint threshold, 1000 pages of
+                                          its default 4 KB */
 void store_on_wal_grown(void (*fn)(void));
 
 /* The jobs in the store by kind and status (one GROUP BY over an index): fn is called once

@@ -78,6 +78,7 @@ static void conn_destroy(void *p)
 }
 
 #define STORE_JOURNAL_LIMIT "67108864" /* 64 MB */
+#define STORE_PAGE_SIZE "32768"        /* of a new database (store_init) */
 
 static const char *SCHEMA_SQL =
     "CREATE TABLE IF NOT EXISTS jobs("
@@ -139,12 +140,14 @@ static char *path_copy(void)
 
 /* Replaces SQLite's automatic checkpoint on every connection (store.h, "Checkpoints"): a
  * commit that left the WAL large only tells the maintenance thread. */
+static long wal_kick_pages = STORE_WAL_KICK_BYTES / 4096; /* of the database's page size */
+
 static int wal_grown(void *user, sqlite3 *db, const char *name, int pages)
 {
     (void)user;
     (void)db;
     (void)name;
-    if (pages >= STORE_WAL_KICK_PAGES) store_wal_grown_seen();
+    if (pages >= __atomic_load_n(&wal_kick_pages, __ATOMIC_RELAXED)) store_wal_grown_seen();
     return SQLITE_OK;
 }
 
@@ -284,10 +287,17 @@ static int sq_open(const char *path)
     if (!db) return -1;
     char *em = NULL;
     /* A new database gives the space of purged jobs back (store_reclaim): auto_vacuum can only
-     * be chosen before the first table, and before WAL mode writes the file's first page.
-     * WAL is persistent in the file; set it once here. */
+     * be chosen before the first table, and before WAL mode writes the file's first page; so
+     * can the page size. 32 KB pages: a result is tens to thousands of MB, written and read
+     * as a chain of pages, and SQLite's cost is per page -- a 10,000-grain result and its pack
+     * (90 MB) commit in ~0.3 s instead of ~0.6 s with the default 4 KB, while a small commit
+     * (a progress update) costs the same. 64 KB gains little more, and the peak memory of a
+     * store grew with it (test_store_write: +22 MB against +7 MB at 32 KB and none at 16 KB,
+     * for a 34 MB result). An older database keeps its pages. WAL is persistent in the file;
+     * set it once here. */
     int fresh = query_long(db, "SELECT count(*) FROM sqlite_master") == 0;
-    if ((fresh && sqlite3_exec(db, "PRAGMA auto_vacuum=INCREMENTAL;", NULL, NULL, &em) !=
+    if ((fresh && sqlite3_exec(db, "PRAGMA page_size=" STORE_PAGE_SIZE "; "
+                                   "PRAGMA auto_vacuum=INCREMENTAL;", NULL, NULL, &em) !=
                       SQLITE_OK) ||
         sqlite3_exec(db, "PRAGMA journal_mode=WAL;", NULL, NULL, &em) != SQLITE_OK ||
         sqlite3_exec(db, SCHEMA_SQL, NULL, NULL, &em) != SQLITE_OK) {
@@ -298,6 +308,8 @@ static int sq_open(const char *path)
     if (add_brief_column(db)) return -1;
     __atomic_store_n(&schema_made, 1, __ATOMIC_RELEASE);
     test_page_cap(db);
+    long psz = query_long(db, "PRAGMA page_size");
+    if (psz > 0) __atomic_store_n(&wal_kick_pages, STORE_WAL_KICK_BYTES / psz, __ATOMIC_RELAXED);
     auto_vacuum = query_long(db, "PRAGMA auto_vacuum") == 2;
     if (!auto_vacuum)
         gpd_log(GPD_LOG_WARN,
