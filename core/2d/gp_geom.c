@@ -1008,6 +1008,13 @@ static int mic_make(const mic_poly *P, const mic_src *src, double x, double y, d
 gp_status gp_max_inscribed_circle(const gp_vec2 *p, size_t n, double tol, gp_vec2 *center,
                                   double *radius, gp_error *err)
 {
+    return gp_max_inscribed_circle_from(p, n, tol, NULL, center, radius, err);
+}
+
+gp_status gp_max_inscribed_circle_from(const gp_vec2 *p, size_t n, double tol,
+                                       const gp_vec2 *guess, gp_vec2 *center, double *radius,
+                                       gp_error *err)
+{
     if (!p || n < 3 || !center || !radius)
         return gp_error_set(err, GP_ERR_INVALID, "max_inscribed_circle: need n >= 3 vertices");
     if (!all_finite(p, n) || isnan(tol))
@@ -1057,6 +1064,8 @@ gp_status gp_max_inscribed_circle(const gp_vec2 *p, size_t n, double tol, gp_vec
     gp_vec2 cen;
     if (gp_poly_centroid(p, n, &cen, NULL) == GP_OK)
         mic_make(&P, NULL, cen.x - o.x, cen.y - o.y, 0.0, best.e1, tol, &best, &c);
+    if (guess && finite2(*guess)) /* a good one prunes most of the grid below at once */
+        mic_make(&P, NULL, guess->x - o.x, guess->y - o.y, 0.0, best.e1, tol, &best, &c);
 
     gp_status st = GP_OK;
     mic_heap H = {NULL, 0, 0};
@@ -1174,18 +1183,10 @@ size_t gp_min_caliper_edge(const gp_vec2 *h, size_t m, double eps2, int squared)
     return best_k;
 }
 
-gp_status gp_min_caliper(const gp_vec2 *p, size_t n, double *width, double *angle_rad,
-                         double *length, gp_error *err)
+/* The minimum caliper of a convex hull h[0 .. m - 1] (m >= 3; shifted in place to h[0]) */
+static void caliper_of_hull(gp_vec2 *h, size_t m, double *width, double *angle_rad,
+                            double *length)
 {
-    if (!p || n == 0) return gp_error_set(err, GP_ERR_INVALID, "min_caliper: need n >= 1 points");
-    if (!all_finite(p, n)) return gp_error_set(err, GP_ERR_INVALID, "min_caliper: non-finite vertex");
-    gp_vec2 *h = malloc(n * sizeof *h);
-    if (!h) return gp_error_set(err, GP_ERR_NOMEM, "min_caliper: out of memory");
-    size_t m = gp_convex_hull(p, n, h);
-    if (m < 3) {
-        free(h);
-        return gp_error_set(err, GP_ERR_DEGENERATE, "min_caliper: points are collinear");
-    }
     const gp_vec2 o = h[0];
     for (size_t i = 0; i < m; i++) {
         h[i].x -= o.x;
@@ -1205,12 +1206,39 @@ gp_status gp_min_caliper(const gp_vec2 *p, size_t n, double *width, double *angl
         if (dt < lmin) lmin = dt;
         if (dt > lmax) lmax = dt;
     }
-    free(h);
     double ang = gp_axis_angle(ex, ey);
     if (width) *width = wmax;
     if (angle_rad) *angle_rad = ang;
     if (length) *length = lmax - lmin;
+}
+
+static gp_status min_caliper(const gp_vec2 *p, size_t n, int star, double *width,
+                             double *angle_rad, double *length, gp_error *err)
+{
+    if (!p || n == 0) return gp_error_set(err, GP_ERR_INVALID, "min_caliper: need n >= 1 points");
+    if (!all_finite(p, n)) return gp_error_set(err, GP_ERR_INVALID, "min_caliper: non-finite vertex");
+    gp_vec2 *h = malloc(n * sizeof *h);
+    if (!h) return gp_error_set(err, GP_ERR_NOMEM, "min_caliper: out of memory");
+    size_t m = star ? gp_convex_hull_star(p, n, h) : gp_convex_hull(p, n, h);
+    if (m < 3) {
+        free(h);
+        return gp_error_set(err, GP_ERR_DEGENERATE, "min_caliper: points are collinear");
+    }
+    caliper_of_hull(h, m, width, angle_rad, length);
+    free(h);
     return GP_OK;
+}
+
+gp_status gp_min_caliper(const gp_vec2 *p, size_t n, double *width, double *angle_rad,
+                         double *length, gp_error *err)
+{
+    return min_caliper(p, n, 0, width, angle_rad, length, err);
+}
+
+gp_status gp_min_caliper_star(const gp_vec2 *p, size_t n, double *width, double *angle_rad,
+                              double *length, gp_error *err)
+{
+    return min_caliper(p, n, 1, width, angle_rad, length, err);
 }
 
 /* ------------------------------------------------------------------------------------------ */

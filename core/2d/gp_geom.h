@@ -82,6 +82,13 @@ int gp_poly_overlap(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t nb);
  * - gp_max_inscribed_circle: r <= r_true <= r + tol (up to ~1e-15 of the size in rounding);
  *   the centre is strictly inside. */
 
+/* gp_max_inscribed_circle with one more first guess of the centre (NULL: none), such as the
+ * centre of a disc known to be inside: the same guarantee whatever the guess (it is only
+ * evaluated), but a guess near the pole lets the search discard most cells at once. */
+gp_status gp_max_inscribed_circle_from(const gp_vec2 *p, size_t n, double tol,
+                                       const gp_vec2 *guess, gp_vec2 *center, double *radius,
+                                       gp_error *err);
+
 /* Axis-aligned bounding box of n >= 1 points. GP_ERR_INVALID for n == 0 or non-finite input. */
 gp_status gp_poly_bbox(const gp_vec2 *p, size_t n, gp_vec2 *lo, gp_vec2 *hi, gp_error *err);
 
@@ -115,5 +122,11 @@ double gp_axis_angle(double ex, double ey);
  * undefined (a polygon, but maybe not the hull); non-finite input falls back to
  * gp_convex_hull. */
 size_t gp_convex_hull_star(const gp_vec2 *p, size_t n, gp_vec2 *h);
+
+/* gp_min_caliper of a polygon star-shaped about an interior point (gp_convex_hull_star's
+ * condition: a Fourier grain's contour): the same result from the O(n) hull (a 128-point
+ * grain: ~6x fewer instructions than the sorting hull). Undefined for other polygons. */
+gp_status gp_min_caliper_star(const gp_vec2 *p, size_t n, double *width, double *angle_rad,
+                              double *length, gp_error *err);
 
 #endif /* GP_GEOM_H */

@@ -197,14 +197,10 @@ static gp_status perimeters(const gp_vec2 *p, size_t n, int star, double *P, dou
     return GP_OK;
 }
 
-gp_status gp_shape_describe_ex(const gp_vec2 *contour, size_t n, const gp_odec_params *params,
-                               const gp_odec_disc *discs, size_t ndiscs,
-                               const gp_shape_curve *curve, gp_shape_result *out,
-                               gp_error *err)
+/* the inputs of gp_shape_describe_ex, checked */
+static gp_status check_inputs(const gp_vec2 *contour, size_t n, const gp_odec_disc *discs,
+                              size_t ndiscs, const gp_shape_curve *curve, gp_error *err)
 {
-    if (!out)
-        return gp_error_set(err, GP_ERR_INVALID, "shape: out is NULL");
-    memset(out, 0, sizeof *out);
     if (!contour)
         return gp_error_set(err, GP_ERR_INVALID, "shape: contour is NULL");
     if (n < 3)
@@ -213,27 +209,21 @@ gp_status gp_shape_describe_ex(const gp_vec2 *contour, size_t n, const gp_odec_p
         if (!isfinite(contour[i].x) || !isfinite(contour[i].y))
             return gp_error_set(err, GP_ERR_INVALID, "shape: contour point %zu is not finite", i);
     }
-    if (discs && ndiscs == 0)
-        discs = NULL;
-    if (discs) {
-        for (size_t k = 0; k < ndiscs; k++) {
-            if (!(discs[k].r > 0) || !isfinite(discs[k].r))
-                return gp_error_set(err, GP_ERR_INVALID, "shape: disc %zu has no radius", k);
-        }
+    for (size_t k = 0; discs && k < ndiscs; k++) {
+        if (!(discs[k].r > 0) || !isfinite(discs[k].r))
+            return gp_error_set(err, GP_ERR_INVALID, "shape: disc %zu has no radius", k);
     }
-    if (curve) {
-        gp_status st = check_curve(curve, err);
-        if (st != GP_OK)
-            return st;
-    }
-    double area = gp_poly_area(contour, n);
-    if (!(area > 0))
-        return gp_error_set(err, GP_ERR_DEGENERATE, "shape: the contour has no area");
-    double req = sqrt(area / GP_PI);
+    return curve ? check_curve(curve, err) : GP_OK;
+}
 
-    /* elongation, orientation */
+/* elongation and orientation, by the minimum caliper (star: the contour is star-shaped, its
+ * hull is taken in O(n)) */
+static gp_status describe_axes(const gp_vec2 *contour, size_t n, int star, gp_shape_result *out,
+                               gp_error *err)
+{
     double S, ang, L;
-    gp_status st = gp_min_caliper(contour, n, &S, &ang, &L, err);
+    gp_status st = star ? gp_min_caliper_star(contour, n, &S, &ang, &L, err)
+                        : gp_min_caliper(contour, n, &S, &ang, &L, err);
     if (st != GP_OK)
         return st;
     if (!(L > 0))
@@ -247,10 +237,23 @@ gp_status gp_shape_describe_ex(const gp_vec2 *contour, size_t n, const gp_odec_p
     if (deg > 90.0)
         deg -= 180.0;
     out->orientation_deg = deg;
+    return GP_OK;
+}
 
-    /* circles */
-    st = gp_max_inscribed_circle(contour, n, GP_SHAPE_INSC_TOL * req, &out->insc_center,
-                                 &out->r_insc, err);
+/* The inscribed and enclosing circles and circularity. The largest ODEC disc lies inside the
+ * contour: its centre is the inscribed circle's first guess, which lets the search discard
+ * most of its grid at once (the result is as exact whatever the guess). */
+static gp_status describe_circles(const gp_vec2 *contour, size_t n, double req,
+                                  const gp_odec_disc *discs, size_t ndiscs,
+                                  gp_shape_result *out, gp_error *err)
+{
+    size_t big = 0;
+    for (size_t k = 1; k < ndiscs; k++)
+        if (discs[k].r > discs[big].r)
+            big = k;
+    gp_vec2 guess = {discs[big].x, discs[big].y};
+    gp_status st = gp_max_inscribed_circle_from(contour, n, GP_SHAPE_INSC_TOL * req, &guess,
+                                                &out->insc_center, &out->r_insc, err);
     if (st != GP_OK)
         return st;
     st = gp_min_enclosing_circle(contour, n, &out->circ_center, &out->r_circ, err);
@@ -259,29 +262,16 @@ gp_status gp_shape_describe_ex(const gp_vec2 *contour, size_t n, const gp_odec_p
     if (!(out->r_insc > 0) || !(out->r_circ > 0))
         return gp_error_set(err, GP_ERR_DEGENERATE, "shape: degenerate inscribed/enclosing circle");
     out->circularity = sqrt(out->r_insc / out->r_circ);
+    return GP_OK;
+}
 
-    /* roundness */
-    gp_odec_result od;
-    memset(&od, 0, sizeof od);
-    if (!discs) {
-        st = gp_odec_build(contour, n, params, &od, err);
-        if (st != GP_OK)
-            return st;
-        discs = od.discs;
-        ndiscs = od.ndiscs;
-    }
-    double sr = 0;
-    for (size_t k = 0; k < ndiscs; k++)
-        sr += discs[k].r;
-    gp_odec_result_free(&od);
-    if (ndiscs == 0)
-        return gp_error_set(err, GP_ERR_DEGENERATE,
-                            "shape: no ODEC disc fits the contour (roundness undefined)");
-    out->ndiscs = ndiscs;
-    out->mean_disc_radius = sr / (double)ndiscs;
-    out->roundness = out->mean_disc_radius / out->r_insc;
-
-    /* regularity */
+/* P and P_conv: of the curve at max(n, GP_SHAPE_PERIMETER_POINTS) angles when there is one,
+ * else of the contour; and the regularity */
+static gp_status describe_regularity(const gp_vec2 *contour, size_t n,
+                                     const gp_shape_curve *curve, gp_shape_result *out,
+                                     gp_error *err)
+{
+    gp_status st;
     if (curve) {
         size_t np = n > GP_SHAPE_PERIMETER_POINTS ? n : GP_SHAPE_PERIMETER_POINTS;
         gp_vec2 *pts = malloc(np * sizeof *pts);
@@ -291,18 +281,60 @@ gp_status gp_shape_describe_ex(const gp_vec2 *contour, size_t n, const gp_odec_p
         if (st == GP_OK)
             st = perimeters(pts, np, 1, &out->perimeter, &out->perimeter_convex, err);
         free(pts);
-        if (st != GP_OK)
-            return st;
         out->perimeter_points = np;
     } else {
         st = perimeters(contour, n, 0, &out->perimeter, &out->perimeter_convex, err);
-        if (st != GP_OK)
-            return st;
         out->perimeter_points = n;
     }
+    if (st != GP_OK)
+        return st;
     out->regularity =
         gp_shape_regularity(out->perimeter, out->perimeter_convex, &out->regularity_capped);
     return GP_OK;
+}
+
+gp_status gp_shape_describe_ex(const gp_vec2 *contour, size_t n, const gp_odec_params *params,
+                               const gp_odec_disc *discs, size_t ndiscs,
+                               const gp_shape_curve *curve, gp_shape_result *out,
+                               gp_error *err)
+{
+    if (!out)
+        return gp_error_set(err, GP_ERR_INVALID, "shape: out is NULL");
+    memset(out, 0, sizeof *out);
+    if (discs && ndiscs == 0)
+        discs = NULL;
+    gp_status st = check_inputs(contour, n, discs, ndiscs, curve, err);
+    if (st != GP_OK)
+        return st;
+    double area = gp_poly_area(contour, n);
+    if (!(area > 0))
+        return gp_error_set(err, GP_ERR_DEGENERATE, "shape: the contour has no area");
+    if ((st = describe_axes(contour, n, curve != NULL, out, err)) != GP_OK)
+        return st;
+    gp_odec_result od;
+    memset(&od, 0, sizeof od);
+    if (!discs) {
+        if ((st = gp_odec_build(contour, n, params, &od, err)) != GP_OK)
+            return st;
+        discs = od.discs;
+        ndiscs = od.ndiscs;
+    }
+    if (ndiscs == 0)
+        st = gp_error_set(err, GP_ERR_DEGENERATE,
+                          "shape: no ODEC disc fits the contour (roundness undefined)");
+    else
+        st = describe_circles(contour, n, sqrt(area / GP_PI), discs, ndiscs, out, err);
+    /* roundness (Wadell, by ODEC): the discs' mean radius over the inscribed radius */
+    double sr = 0;
+    for (size_t k = 0; k < ndiscs; k++)
+        sr += discs[k].r;
+    gp_odec_result_free(&od);
+    if (st != GP_OK)
+        return st;
+    out->ndiscs = ndiscs;
+    out->mean_disc_radius = sr / (double)ndiscs;
+    out->roundness = out->mean_disc_radius / out->r_insc;
+    return describe_regularity(contour, n, curve, out, err);
 }
 
 gp_status gp_shape_describe(const gp_vec2 *contour, size_t n, const gp_odec_params *params,

@@ -75,7 +75,8 @@ gp_status gp_shape_describe(const gp_vec2 *contour, size_t n, const gp_odec_para
 
 /* As gp_shape_describe, but P and P_conv from curve evaluated at
  * max(n, GP_SHAPE_PERIMETER_POINTS) equally spaced angles. contour may be NULL: then the
- * n-point contour is evaluated from curve too (theta_i = 2 pi i / n, as gp_fourier_contour).
+ * n-point contour is evaluated from curve too (theta_i = 2 pi i / n, as gp_fourier_contour);
+ * a contour given must be star-shaped (gp_shape_describe_ex).
  * GP_ERR_NOT_STAR if r <= 0 at an evaluated angle. */
 gp_status gp_shape_describe_fourier(const gp_vec2 *contour, size_t n, const gp_shape_curve *curve,
                                     const gp_odec_params *params, gp_shape_result *out,
@@ -83,7 +84,9 @@ gp_status gp_shape_describe_fourier(const gp_vec2 *contour, size_t n, const gp_s
 
 /* The general form: discs (ndiscs > 0) is an ODEC already built for contour (then params is
  * not used; roundness = mean disc radius / R_insc); discs == NULL builds it with params.
- * curve == NULL takes the perimeters from contour. */
+ * curve == NULL takes the perimeters from contour. With a curve, the contour must be
+ * star-shaped about an interior point (the curve's own points, or points on its rays: a
+ * Fourier grain): its hull is then taken in O(n) (gp_min_caliper_star). */
 gp_status gp_shape_describe_ex(const gp_vec2 *contour, size_t n, const gp_odec_params *params,
                                const gp_odec_disc *discs, size_t ndiscs,
                                const gp_shape_curve *curve, gp_shape_result *out,

@@ -369,7 +369,8 @@ static void fill_one(fill_job *j, worker_ctx *w, size_t i, double *tf)
         g->cell_fraction = cell_area > 0.0 ? fr.area / cell_area : 0.0;
         g->target_met = g->cell_fraction >= j->spec->solid_fraction * (1.0 - 1e-9);
         double w, ang, len;
-        g->orientation_deg = gp_min_caliper(g->contour, g->ncontour, &w, &ang, &len, NULL) == GP_OK
+        g->orientation_deg = gp_min_caliper_star(g->contour, g->ncontour, &w, &ang, &len,
+                                                 NULL) == GP_OK
                                  ? ang * DEG : 0.0;
         grain_curve *c = &j->curve[i];
         c->centre = fr.centre;

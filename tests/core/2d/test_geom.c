@@ -208,7 +208,7 @@ static void test_hull(void)
 }
 
 /* gp_convex_hull_star against gp_convex_hull (the monotone chain with a sort, an independent
- * algorithm): the same vertices in the same order on random star-shaped polygons (sorted
+ * algorithm), and gp_min_caliper_star against gp_min_caliper: the same vertices in the same order on random star-shaped polygons (sorted
  * angles, random radii; some with radii on a coarse grid or points on the edges of a square,
  * so collinear runs occur; both orientations; some far from the origin), and the fallback. */
 static int hull_star_same(const gp_vec2 *p, size_t n, int reverse)
@@ -216,7 +216,13 @@ static int hull_star_same(const gp_vec2 *p, size_t n, int reverse)
     gp_vec2 q[200], h1[200], h2[200];
     for (size_t i = 0; i < n; i++) q[i] = reverse ? p[n - 1 - i] : p[i];
     size_t m1 = gp_convex_hull(q, n, h1), m2 = gp_convex_hull_star(q, n, h2);
-    return m1 >= 3 && m1 == m2 && memcmp(h1, h2, m1 * sizeof *h1) == 0;
+    /* and gp_min_caliper_star, on that hull, the bits of gp_min_caliper (checked below against
+     * an angle sweep) */
+    double c1[3], c2[3];
+    int cal = gp_min_caliper(q, n, c1, c1 + 1, c1 + 2, NULL) == GP_OK &&
+              gp_min_caliper_star(q, n, c2, c2 + 1, c2 + 2, NULL) == GP_OK &&
+              memcmp(c1, c2, sizeof c1) == 0;
+    return m1 >= 3 && m1 == m2 && memcmp(h1, h2, m1 * sizeof *h1) == 0 && cal;
 }
 
 static void test_hull_star(void)
