@@ -16,8 +16,9 @@ Starts grainpackd (one worker, a temporary database) and runs, one job at a time
   1M          (with --million) 1,000,000 grains (outputs odec)
 and prints one table, a row a job:
   s        seconds from submit to status succeeded, as a client sees it (polling every 0.05 s);
-  daemon s finished_at - created_at of the job object: the same span as the daemon stamps it
-           (milliseconds), without the client's poll and round trips;
+  daemon s finished_at - created_at of the job object, the daemon's own stamps (milliseconds):
+           finished_at is taken as the final store begins, so s - daemon s is that store's
+           commit plus the client's poll;
   peak MB  the daemon's largest VmRSS sampled every 0.05 s during the job (VmHWM cannot be
            reset between rows), split into the build (the core's phases) and the result
            phase (writing the text, the export pack, storing); HWM: VmHWM so far;
