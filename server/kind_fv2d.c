@@ -396,6 +396,26 @@ static void cell_w(gpd_jw *w, size_t i, const gp_cell2d *cl)
     gpd_jw_end_object(w);
 }
 
+/* the arrays' items for gpd_jw_items, in blocks of ~450 KB of text (a grain of 128 points with
+ * its discs and descriptors is ~7 KB; a cell less) */
+#define GRAINS_BLOCK 64
+typedef struct items_ctx {
+    const gp_specimen2d *s;
+    unsigned out;
+} items_ctx;
+
+static void grain_item(gpd_jw *w, size_t i, const void *user)
+{
+    const items_ctx *c = user;
+    grain_w(w, i, &c->s->grains[i], c->out);
+}
+
+static void cell_item(gpd_jw *w, size_t i, const void *user)
+{
+    const items_ctx *c = user;
+    cell_w(w, i, &c->s->cells[i]);
+}
+
 /* the result without its arrays: kind, seed, outputs, container, stats, warnings, timings */
 static json_t *head_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json_t *spec_json)
 {
@@ -428,18 +448,18 @@ json_t *gpd_result_2d_write(const gp_specimen2d *s, const gp_spec2d *spec,
     gpd_jw_members(w, head);
     /* the arrays, written as they are read from the specimen; the writer stops by itself at
      * the cancel flag (a grain is ~300 numbers at 128 contour points) */
+    items_ctx c = {s, out};
+    int nt = spec->threads > 0 ? spec->threads : 1; /* the job's: the same bytes whatever */
     if (out & (GP_OUT2_GRAINS | GP_OUT2_ODEC | GP_OUT2_DESCRIPTORS)) {
         gpd_jw_key(w, "grains");
         gpd_jw_begin_array(w);
-        for (size_t i = 0; i < s->ngrains && w->state == GPD_JW_OK; i++)
-            grain_w(w, i, &s->grains[i], out);
+        gpd_jw_items(w, s->ngrains, grain_item, &c, nt, GRAINS_BLOCK);
         gpd_jw_end_array(w);
     }
     if ((out & GP_OUT2_CELLS) && s->cells) {
         gpd_jw_key(w, "cells");
         gpd_jw_begin_array(w);
-        for (size_t i = 0; i < s->ncells && w->state == GPD_JW_OK; i++)
-            cell_w(w, i, &s->cells[i]);
+        gpd_jw_items(w, s->ncells, cell_item, &c, nt, GRAINS_BLOCK);
         gpd_jw_end_array(w);
     }
     gpd_jw_end_object(w);

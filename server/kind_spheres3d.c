@@ -103,6 +103,24 @@ static void contact_w(gpd_jw *w, const gp_contact3d *c)
     gpd_jw_end_object(w);
 }
 
+/* the arrays' items for gpd_jw_items, in blocks of ~400 KB of text (a sphere is ~100 B, a
+ * contact ~200 B) */
+#define ITEMS_BLOCK 4096
+
+static void sphere_item(gpd_jw *w, size_t i, const void *user)
+{
+    const gp_specimen3d *s = user;
+    gpd_jw_begin_array(w);
+    for (int k = 0; k < 4; k++) gpd_jw_real(w, s->spheres[4 * i + k]);
+    gpd_jw_end_array(w);
+}
+
+static void contact_item(gpd_jw *w, size_t i, const void *user)
+{
+    const gp_specimen3d *s = user;
+    contact_w(w, &s->contacts[i]);
+}
+
 /* the result without its arrays: kind, seed, outputs, box, sample_box, tiling, stats, timings */
 static json_t *head_3d(const gp_specimen3d *s, const gp_spec3d *spec, const json_t *spec_json)
 {
@@ -133,21 +151,17 @@ static json_t *result(const void *specimen, const void *spec_, const json_t *spe
     gpd_jw_begin_object(w);
     gpd_jw_members(w, head);
     /* the arrays, written as they are read; the writer stops by itself at the cancel flag */
+    int nt = spec->threads > 0 ? spec->threads : 1; /* the job's: the same bytes whatever */
     if ((out & GP_OUT3_SPHERES) && s->spheres) {
         gpd_jw_key(w, "spheres");
         gpd_jw_begin_array(w);
-        for (size_t i = 0; i < s->count && w->state == GPD_JW_OK; i++) {
-            gpd_jw_begin_array(w);
-            for (int k = 0; k < 4; k++) gpd_jw_real(w, s->spheres[4 * i + k]);
-            gpd_jw_end_array(w);
-        }
+        gpd_jw_items(w, s->count, sphere_item, s, nt, ITEMS_BLOCK);
         gpd_jw_end_array(w);
     }
     if ((out & GP_OUT3_CONTACTS) && s->contacts) {
         gpd_jw_key(w, "contacts");
         gpd_jw_begin_array(w);
-        for (size_t i = 0; i < s->ncontacts && w->state == GPD_JW_OK; i++)
-            contact_w(w, &s->contacts[i]);
+        gpd_jw_items(w, s->ncontacts, contact_item, s, nt, ITEMS_BLOCK / 2);
         gpd_jw_end_array(w);
     }
     gpd_jw_end_object(w);

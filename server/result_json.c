@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -531,4 +532,149 @@ void gpd_jw_members(gpd_jw *w, const json_t *o)
         gpd_jw_key(w, key);
         gpd_jw_json(w, v);
     }
+}
+
+/* ---- the elements of an array, formatted on several threads ----
+ * Rounds of `nt` blocks: in round r, thread t writes block r nt + t into its own writer (an
+ * array's elements: "[" then the items, the "[" dropped when appended); at the round's barrier
+ * the caller's thread appends the round's blocks in order, while the others already write the
+ * next round into the other half of the writers (two sets, by the round's parity, so a set is
+ * never written while it is appended). Every thread waits at every round's barrier, so a stop
+ * (cancel, out of memory, a failed file write) only skips the work that is left. */
+typedef struct items_run {
+    gpd_jw *w;
+    size_t n, block, nblocks, rounds;
+    int nt;
+    gpd_jw_item_fn item;
+    const void *user;
+    gpd_jw *sub; /* 2 nt writers */
+    pthread_barrier_t bar;
+    pthread_mutex_t mu; /* the start: the threads wait for go, then read nt and rounds */
+    pthread_cond_t cv;
+    int go;
+    int stop;    /* atomic: the caller's writer stopped */
+} items_run;
+
+typedef struct items_arg {
+    items_run *run;
+    int t;
+} items_arg;
+
+static void items_block(items_run *R, size_t r, int t)
+{
+    size_t b = r * (size_t)R->nt + (size_t)t;
+    gpd_jw *s = &R->sub[(r & 1) * (size_t)R->nt + (size_t)t];
+    s->b.len = 0;
+    s->depth = 0;
+    s->nonempty = 0;
+    s->after_key = 0;
+    if (b >= R->nblocks || __atomic_load_n(&R->stop, __ATOMIC_RELAXED)) return;
+    if (gpd_cancel_raised(s->cancel)) { /* at each block too: a block may be fewer pieces */
+        s->state = GPD_JW_CANCELLED;
+        return;
+    }
+    gpd_jw_begin_array(s);
+    size_t i1 = (b + 1) * R->block < R->n ? (b + 1) * R->block : R->n;
+    for (size_t i = b * R->block; i < i1 && s->state == GPD_JW_OK; i++)
+        R->item(s, i, R->user);
+}
+
+/* the caller's thread: round r's blocks after the "[" of each, each a run of elements */
+static void items_append(items_run *R, size_t r)
+{
+    gpd_jw *w = R->w;
+    for (int t = 0; t < R->nt && w->state == GPD_JW_OK; t++) {
+        gpd_jw *s = &R->sub[(r & 1) * (size_t)R->nt + (size_t)t];
+        if (s->state != GPD_JW_OK) {
+            w->state = s->state;
+            break;
+        }
+        if (s->b.len <= 1) continue; /* past the last block */
+        if (separate(w)) break;
+        put(w, s->b.buf + 1, s->b.len - 1);
+    }
+    if (w->state != GPD_JW_OK) __atomic_store_n(&R->stop, 1, __ATOMIC_RELAXED);
+}
+
+static void items_loop(items_run *R, int t)
+{
+    for (size_t r = 0; r < R->rounds; r++) {
+        items_block(R, r, t);
+        pthread_barrier_wait(&R->bar);
+        if (t == 0) items_append(R, r);
+    }
+}
+
+static void *items_thread(void *p)
+{
+    items_arg *a = p;
+    items_run *R = a->run;
+    pthread_mutex_lock(&R->mu);
+    while (!R->go) pthread_cond_wait(&R->cv, &R->mu);
+    pthread_mutex_unlock(&R->mu);
+    items_loop(R, a->t);
+    return NULL;
+}
+
+/* The threads that could be started (R->nt at most) run with the caller's; 0, or -1 when
+ * the run could not be set up (nothing written: the caller writes alone). */
+static int items_threaded(items_run *R)
+{
+    int nt = R->nt, rc = -1, started = 1;
+    R->sub = calloc(2 * (size_t)nt, sizeof *R->sub);
+    pthread_t *th = calloc((size_t)nt, sizeof *th);
+    items_arg *args = calloc((size_t)nt, sizeof *args);
+    if (R->sub && th && args) {
+        pthread_mutex_init(&R->mu, NULL);
+        pthread_cond_init(&R->cv, NULL);
+        for (; started < nt; started++) {
+            args[started] = (items_arg){R, started};
+            if (pthread_create(&th[started], NULL, items_thread, &args[started]) != 0) break;
+        }
+        /* as many as started: the blocks are dealt to them */
+        R->nt = started;
+        R->rounds = (R->nblocks + (size_t)started - 1) / (size_t)started;
+        for (int k = 0; k < 2 * started; k++) {
+            gpd_jw_init(&R->sub[k], R->w->cancel);
+            R->sub[k].pause_s = R->w->pause_s;
+        }
+        rc = pthread_barrier_init(&R->bar, NULL, (unsigned)started) == 0 ? 0 : -1;
+        if (rc) R->rounds = 0; /* the threads then end at once */
+        pthread_mutex_lock(&R->mu);
+        R->go = 1;
+        pthread_cond_broadcast(&R->cv);
+        pthread_mutex_unlock(&R->mu);
+        if (rc == 0) items_loop(R, 0);
+        for (int k = 1; k < started; k++) pthread_join(th[k], NULL);
+        if (rc == 0) pthread_barrier_destroy(&R->bar);
+        for (int k = 0; k < 2 * started; k++) gpd_jw_free(&R->sub[k]);
+        pthread_cond_destroy(&R->cv);
+        pthread_mutex_destroy(&R->mu);
+    }
+    free(R->sub);
+    free(th);
+    free(args);
+    return rc;
+}
+
+void gpd_jw_items(gpd_jw *w, size_t n, gpd_jw_item_fn item, const void *user, int threads,
+                  size_t block)
+{
+    if (block < 1) block = 1;
+    size_t nblocks = (n + block - 1) / block;
+    int nt = threads < 1 ? 1 : threads;
+    if ((size_t)nt > nblocks) nt = (int)nblocks;
+    if (nt > 1 && w->state == GPD_JW_OK) {
+        items_run R;
+        memset(&R, 0, sizeof R);
+        R.w = w;
+        R.n = n;
+        R.block = block;
+        R.nblocks = nblocks;
+        R.nt = nt;
+        R.item = item;
+        R.user = user;
+        if (items_threaded(&R) == 0) return;
+    }
+    for (size_t i = 0; i < n && w->state == GPD_JW_OK; i++) item(w, i, user);
 }

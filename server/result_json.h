@@ -119,6 +119,18 @@ void gpd_jw_json(gpd_jw *w, const json_t *v);
 /* Each member of object o (in its order) as key and value of the object being written. */
 void gpd_jw_members(gpd_jw *w, const json_t *o);
 
+/* The elements i = 0 .. n - 1 of the array being written, element i written by
+ * item(w, i, user) (one value each), formatted by up to `threads` threads in blocks of `block`
+ * items, each into a writer of its own, and appended in order: the same bytes as the loop
+ * over item on w alone, whatever `threads` and `block`. Each thread's writer reads the cancel
+ * flag at each block and every GPD_JW_CANCEL_EVERY of its own pieces. The items must only
+ * read what they are given (they run at once). Memory: 2 x threads blocks of text besides
+ * w's; a round of blocks costs a barrier (a few us), so a block should be some 100 KB of
+ * text (a 2D grain is ~7 KB, a sphere ~100 B). */
+typedef void (*gpd_jw_item_fn)(gpd_jw *w, size_t i, const void *user);
+void gpd_jw_items(gpd_jw *w, size_t n, gpd_jw_item_fn item, const void *user, int threads,
+                  size_t block);
+
 /* The head of a result: {"kind": kind, "seed": seed, "outputs": the spec's outputs (when it
  * has them)}, a new object to which a kind adds its other small members (stats, timings) before
  * writing its members (gpd_jw_members) and then its per-item arrays; NULL on out of memory. */

@@ -5,7 +5,8 @@
  * written before the writer; the two texts must be the same bytes. Reals are also read back
  * with strtod and compared bit for bit; the cancel flag must stop the writing within
  * GPD_JW_CANCEL_EVERY pieces; a 2D specimen's result must carry its geometry bit for bit and
- * stop at the flag.
+ * stop at the flag; the arrays written on several threads (gpd_jw_items) must be the bytes of
+ * the plain loop.
  */
 #include <limits.h>
 #include <math.h>
@@ -312,6 +313,86 @@ static void test_cancel(void)
     __atomic_store_n((int *)&flag, 0, __ATOMIC_RELAXED);
 }
 
+/* gpd_jw_items: element i is {"i": i, "x": [reals]} (a few dozen pieces) */
+static void item_obj(gpd_jw *w, size_t i, const void *user)
+{
+    const double *k = user;
+    gpd_jw_begin_object(w);
+    gpd_jw_key(w, "i");
+    gpd_jw_integer(w, (long long)i);
+    gpd_jw_key(w, "x");
+    gpd_jw_begin_array(w);
+    for (size_t c = 0; c < 1 + i % 29; c++) gpd_jw_real(w, *k * (double)(i + c) / 3.0);
+    gpd_jw_end_array(w);
+    gpd_jw_end_object(w);
+}
+
+/* [before? , items 0 .. n - 1, after?] written by gpd_jw_items on `threads` threads (0: the
+ * plain loop), spilled into a file past `spill_at` bytes when it is > 0 */
+static char *items_text(size_t n, int threads, size_t block, int before, int after,
+                        size_t spill_at, size_t *len)
+{
+    static const double k = 0.7;
+    gpd_jw w;
+    gpd_jw_init(&w, NULL);
+    if (spill_at) gpd_jw_spill(&w, "/tmp", spill_at);
+    gpd_jw_begin_array(&w);
+    if (before) gpd_jw_string(&w, "before");
+    if (threads == 0)
+        for (size_t i = 0; i < n; i++) item_obj(&w, i, &k);
+    else
+        gpd_jw_items(&w, n, item_obj, &k, threads, block);
+    if (after) gpd_jw_null(&w);
+    gpd_jw_end_array(&w);
+    return gpd_jw_take(&w, len);
+}
+
+/* The blocks written by several threads make the loop's bytes: every item count around the
+ * block size, 1 to 5 threads (5: blocks of one item), with and without elements before and after, in memory and
+ * spilled; and a raised flag stops them, with no text. */
+static void test_items(void)
+{
+    enum { B = 64 };
+    const size_t ns[] = {0, 1, B - 1, B, B + 1, 3 * B, 1000, 5003};
+    int bad = 0, cases = 0;
+    for (size_t a = 0; a < sizeof ns / sizeof ns[0]; a++) {
+        for (int ends = 0; ends < 4; ends++) {
+            size_t l0 = 0;
+            char *want = items_text(ns[a], 0, B, ends & 1, ends & 2, 0, &l0);
+            for (int t = 1; t <= 5; t++) {
+                size_t l1 = 0;
+                char *got = items_text(ns[a], t, t == 5 ? 1 : B, ends & 1, ends & 2,
+                                       t == 3 ? 4096 : 0, &l1);
+                bad += !want || !got || l0 != l1 || memcmp(want, got, l0) != 0;
+                cases++;
+                free(got);
+            }
+            free(want);
+        }
+    }
+    CHECK(cases == 8 * 4 * 5 && bad == 0);
+    /* valid JSON with every element in order */
+    size_t len = 0;
+    char *text = items_text(5003, 3, B, 1, 1, 0, &len);
+    json_error_t e;
+    json_t *r = text ? json_loadb(text, len, 0, &e) : NULL;
+    CHECK(json_array_size(r) == 5005);
+    CHECK(json_integer_value(json_object_get(json_array_get(r, 5003), "i")) == 5002);
+    json_decref(r);
+    free(text);
+
+    /* the flag up from the start: no element, no text */
+    static const double k = 0.7;
+    volatile int flag = 1;
+    gpd_jw w;
+    gpd_jw_init(&w, &flag);
+    gpd_jw_begin_array(&w);
+    gpd_jw_items(&w, 100000, item_obj, &k, 3, B);
+    gpd_jw_end_array(&w);
+    CHECK(w.state == GPD_JW_CANCELLED && w.b.len == 1); /* "[": each block reads the flag */
+    CHECK(gpd_jw_take(&w, NULL) == NULL);
+}
+
 /* a synthetic 2D specimen of n grains of NP points each (one shared contour, odd values) */
 enum { NP = 64 };
 static gp_vec2 contour[NP];
@@ -392,6 +473,15 @@ static void test_result_2d(void)
         it = json_object_iter_next(r, it);
     }
     CHECK(order && it && !strcmp(json_object_iter_key(it), "grains"));
+    /* on three threads, the same bytes */
+    spec.threads = 3;
+    gpd_jw_init(&w, NULL);
+    json_decref(gpd_result_2d_write(&s, &spec, sj, &w));
+    size_t len3 = 0;
+    char *text3 = gpd_jw_take(&w, &len3);
+    CHECK(text3 && len3 == len && memcmp(text3, text, len) == 0);
+    free(text3);
+    spec.threads = 0;
     /* the tree form the tests use is the same text parsed */
     json_t *r2 = gpd_result_2d(&s, &spec, sj, NULL);
     CHECK(json_equal(r, r2));
@@ -421,6 +511,7 @@ int main(void)
     test_integers();
     test_nesting();
     test_cancel();
+    test_items();
     test_result_2d();
     return gp_test_summary();
 }
