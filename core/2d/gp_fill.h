@@ -100,4 +100,13 @@ gp_status gp_fill_cell(gp_fill_workspace *ws, const gp_vec2 *cell, size_t ncell,
                        const double *phases, gp_vec2 *contour, gp_fill_result *res,
                        gp_error *err);
 
+/* gp_fill_cell starting from `start` (may be NULL: gp_fill_cell), the result of an earlier
+ * fill of the same cell with the same phases and spectrum to a lower fraction (a refill,
+ * aiming higher): in a convex cell the search only goes on from that grain's phases and
+ * rotation (stage B of the header; at least as large a grain as start's), a tenth of a cold
+ * search's evaluations. A non-convex cell runs the whole search. */
+gp_status gp_fill_cell_from(gp_fill_workspace *ws, const gp_vec2 *cell, size_t ncell,
+                            const double *phases, const gp_fill_result *start,
+                            gp_vec2 *contour, gp_fill_result *res, gp_error *err);
+
 #endif /* GP_FILL_H */
