@@ -518,8 +518,9 @@ static json_t *brief(const json_t *spec, const json_t *stats)
 #define IMC_MOVES_GUESS 4   /* moves a cell until the default threshold (a guess: the IMC runs
                                until it converges; its own rate takes over as it runs) */
 #define COST_FILL_S 0.85e-3 /* filling a grain of 128 points ... */
-#define REFILL_SHARE 0.4    /* ... and the refill pass (law on the cells), a guess: it refills
-                               the cells that reached the fraction (measured 0.16 to 0.47) */
+#define REFILL_SHARE 0.3    /* ... and the refill passes (law on the cells), a guess: they
+                               refill the cells that reached the fraction, each from its grain
+                               (bench_specimen2d fill: 0.24 to 0.37 of the first pass) */
 #define COST_ODEC_S 0.3e-3  /* its ODEC discs (0.2 to 0.46 of its filling, measured) */
 #define COST_DESC_S 0.3e-3  /* its descriptors */
 /* the shape (issue #17), timed through the daemon (one worker) on a shared, loaded 2-core
