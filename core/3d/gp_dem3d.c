@@ -41,7 +41,7 @@
 #endif
 
 #define BLK 64          /* spheres per reduction block (fixed: results do not depend on threads) */
-#define SERVO_GAIN 0.25 /* fraction of Eq. 10's displacement applied per step */
+#define SERVO_GAIN 0.25 /* fraction of Eq. 10's displacement applied per step (of servo_dt) */
 #define NLEVEL 8        /* size levels of the cell grids (see rebuild) */
 #define FREE_GAP 0.05   /* free flight beyond this gap, times the smallest radius (see job_spheres) */
 #define DT_CUT 0.9      /* a cut time step: this fraction of the proven limit (see check_dt) */
@@ -141,11 +141,14 @@ struct gp_dem3d {
     double *sminv;             /* sqrt(minv) (the bound's off-diagonal share) */
     double beta;               /* a contact's largest eigenvalue, times m_i / k_n (see header) */
     int dt_guard;              /* cut dt when the bound fails (not params.dt_unguarded) */
+    double dt_exp;             /* params.dt_damping_exp: dt (1 + c)^dt_exp = dt_und */
+    double dt_und;             /* dt (1 + c)^dt_exp, c the damping in force */
     double lam_max;            /* the bound on omega_max^2 at the last step */
     double dt_ratio;           /* the largest fraction of the proven limit a step has used */
     long dt_cuts;
     double wall[6];            /* positions: lo x, hi x, lo y, hi y, lo z, hi z */
     double servo_f[6], servo_v[6], servo_lim[6];
+    double servo_dt;           /* SERVO_GAIN per step of this dt (0: per step, whatever dt) */
     double wall_f[6], wall_k[6];
     size_t wall_n;
     /* candidate pairs (i < j), sorted */
@@ -404,7 +407,11 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
         double t = sqrt(mi / (2 * d->E * r));
         if (t < tmin) tmin = t;
     }
-    d->dt = safety * tmin;
+    /* dt_damping_exp e: the step at damping c is dt_und / (1 + c)^e (e = 0.5: the same
+     * fraction of the damped limit omega dt sqrt(1 + c) < 2 for any c; see the header) */
+    d->dt_exp = p->dt_damping_exp > 0 ? p->dt_damping_exp : 0;
+    d->dt_und = safety * tmin;
+    d->dt = d->dt_exp > 0 ? d->dt_und / pow(1 + d->damping, d->dt_exp) : d->dt_und;
     /* a contact's largest eigenvalue times m_i / k_n: the normal mode (1), or the shear spring
      * at the contact point, which moves by u + r theta: k_s (1/m + r^2/I) = k_s (1 + 2.5) / m */
     d->beta = fmax(1.0, 3.5 * d->ks_kn);
@@ -424,7 +431,15 @@ gp_status gp_dem3d_create(const gp_dem3d_params *p, const double *xyzr, size_t n
 
 double gp_dem3d_dt(const gp_dem3d *d) { return d->dt; }
 void gp_dem3d_set_friction(gp_dem3d *d, double deg) { d->tanphi = tan(deg * M_PI / 180); }
-void gp_dem3d_set_damping(gp_dem3d *d, double c) { d->damping = c; }
+/* with dt_damping_exp the step follows c: dt_und (the last cut's included) / (1 + c)^e */
+void gp_dem3d_set_damping(gp_dem3d *d, double c)
+{
+    d->damping = c;
+    if (d->dt_exp > 0)
+        d->dt = d->dt_und / pow(1 + c, d->dt_exp);
+}
+
+void gp_dem3d_reset_dt_ratio(gp_dem3d *d) { d->dt_ratio = 0; }
 double gp_dem3d_wall(const gp_dem3d *d, int w) { return d->wall[w]; }
 
 void gp_dem3d_set_radius_scale(gp_dem3d *d, double s)
@@ -441,6 +456,8 @@ void gp_dem3d_set_servo(gp_dem3d *d, int w, double force, double vmax)
     d->servo_f[w] = force > 0 ? force : 0;
     d->servo_v[w] = vmax;
 }
+
+void gp_dem3d_set_servo_dt(gp_dem3d *d, double dt_ref) { d->servo_dt = dt_ref > 0 ? dt_ref : 0; }
 
 void gp_dem3d_set_servo_limit(gp_dem3d *d, int w, double pos)
 {
@@ -1310,6 +1327,8 @@ static void check_dt(gp_dem3d *d, double lam)
         d->dt_ratio = ratio;
     if (d->dt_guard && ratio >= 1) {
         d->dt = DT_CUT * 2 / wc;
+        /* a later damping keeps the cut's share */
+        d->dt_und = d->dt_exp > 0 ? d->dt * pow(1 + d->damping, d->dt_exp) : d->dt;
         d->dt_cuts++;
     }
 }
@@ -1367,7 +1386,10 @@ gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err)
             if (d->servo_f[w] <= 0)
                 continue;
             double lim = d->servo_v[w] * d->dt;
-            double mv = wk[w] > 0 ? SERVO_GAIN * (d->servo_f[w] - wf[w]) / wk[w] : lim;
+            /* a rate in time (servo_dt): a longer step moves the wall further, so that the
+             * protocol's windows, which are in time, see the same wall whatever dt */
+            double gain = d->servo_dt > 0 ? SERVO_GAIN * d->dt / d->servo_dt : SERVO_GAIN;
+            double mv = wk[w] > 0 ? gain * (d->servo_f[w] - wf[w]) / wk[w] : lim;
             if (mv > lim) mv = lim;
             if (mv < -lim) mv = -lim;
             d->wall[w] += (w & 1) ? -mv : mv;

@@ -18,8 +18,10 @@
  *     surface within 0.05 x the smallest radius flies with its true mass and no damping
  *     (free flight: fines fall at g, not at g scaled down; see gp_dem3d.c);
  *   - time step dt = dt_safety * min_i sqrt(m_i / (2 E R_i)) (m_i the inertial mass: density
- *     scaled), checked after every step against a proven bound on the fastest vibration of the
- *     contacts of that step, shear and rotation included (below); dt is cut when it fails;
+ *     scaled; with params.dt_damping_exp e divided by (1 + c)^e, c the damping in force, so
+ *     that a phase with less damping steps longer, below), checked after every
+ *     step against a proven bound on the fastest vibration of the contacts of that step,
+ *     shear and rotation included (below); dt is cut when it fails;
  *   - contact detection: a Verlet list of candidate pairs i < j (a half list: each pair once),
  *     those with a gap below skin + the free-flight gap, sorted by (i, j); rebuilt only when
  *     some sphere has moved (or grown) more than skin / 2 since the last rebuild, from
@@ -75,6 +77,12 @@
  * cannot blow up alone; params.dt_unguarded turns the cut off, for the tests). Every contact
  * is covered on the step it acts (the shares are summed over the pairs that touch), so the
  * check does not depend on the skin either.
+ * The fraction of the limit used, sqrt(lam) dt sqrt(1 + c) / 2, depends on c only through
+ * dt sqrt(1 + c). With params.dt_damping_exp e, dt (1 + c)^e is held fixed (dt_und; a cut sets
+ * it too) and dt = dt_und / (1 + c)^e at every change of c: e = 0.5 gives every damping the
+ * same fraction of its own limit for the same contacts (a phase at 0.2 steps sqrt(1.7 / 1.2)
+ * = 1.19 x longer than one at 0.7); e < 0.5 keeps the less damped phase below the more
+ * damped one's fraction, by the factor ((1 + c_lo) / (1 + c_hi))^(0.5 - e).
  *
  * Ownership: gp_dem3d_create copies the spheres; the gp_dem3d owns its state and its worker
  * threads until gp_dem3d_destroy. Lists handed out (gp_dem3d_contacts, gp_dem3d_find_pairs)
@@ -103,6 +111,10 @@ typedef struct gp_dem3d_params {
     double scaled_radius;/* density scaling radius (m); 0 = none */
     double skin;         /* Verlet skin (m); 0 = 0.2 * smallest radius */
     int dt_unguarded;    /* nonzero: never cut dt (tests of the stability bound) */
+    double dt_damping_exp; /* e > 0: the step follows the damping c in force (this one, then
+                            each gp_dem3d_set_damping): dt = dt_safety min_i sqrt(m_i / (2 E
+                            R_i)) / (1 + c)^e (see "Stability" above; 0.5: the same fraction
+                            of the damped limit for any c); 0: dt does not depend on c */
     int threads;         /* 0 = 1 */
 } gp_dem3d_params;
 
@@ -116,14 +128,20 @@ void gp_dem3d_destroy(gp_dem3d *d);
 
 double gp_dem3d_dt(const gp_dem3d *d);
 void gp_dem3d_set_friction(gp_dem3d *d, double friction_deg);
+/* With params.dt_damping_exp e this also sets dt = dt_und / (1 + damping)^e, dt_und =
+ * dt (1 + c)^e before the change (a cut's share is kept); otherwise dt stays. */
 void gp_dem3d_set_damping(gp_dem3d *d, double damping);
 /* Current radii are the full radii times s (in (0, 1]); masses stay those of the full radii. */
 void gp_dem3d_set_radius_scale(gp_dem3d *d, double s);
 double gp_dem3d_wall(const gp_dem3d *d, int w);
-/* Servo wall (Eq. 10): each step the wall moves inward by gain * (F - F_c) / k_wall, F_c and
- * k_wall the sum of the forces and normal stiffnesses of its contacts, at most vmax * dt (and
- * by vmax * dt when it has no contact). force <= 0 turns the servo off (the wall stays). */
+/* Servo wall (Eq. 10): each step the wall moves inward by gain * (F - F_c) / k_wall (gain: see
+ * gp_dem3d_set_servo_dt), F_c and k_wall the sum of the forces and normal stiffnesses of its
+ * contacts, at most vmax * dt (and by vmax * dt when it has no contact). force <= 0 turns the servo off (the wall stays). */
 void gp_dem3d_set_servo(gp_dem3d *d, int w, double force, double vmax);
+/* The servo as a rate in time: a step of dt moves a wall by gain = SERVO_GAIN dt / dt_ref of
+ * Eq. 10's displacement (SERVO_GAIN = 0.25), the same wall motion per unit time whatever the
+ * step; dt_ref <= 0 (the default): SERVO_GAIN per step. */
+void gp_dem3d_set_servo_dt(gp_dem3d *d, double dt_ref);
 /* The servo never moves wall w inward past position (NAN = no limit). */
 void gp_dem3d_set_servo_limit(gp_dem3d *d, int w, double position);
 
@@ -152,6 +170,9 @@ typedef struct gp_dem3d_state {
 } gp_dem3d_state;
 
 void gp_dem3d_get_state(const gp_dem3d *d, gp_dem3d_state *s);
+/* Starts state.dt_ratio afresh (0): the largest fraction of the limit from the next step on,
+ * e.g. one phase's own. */
+void gp_dem3d_reset_dt_ratio(gp_dem3d *d);
 /* Current x, y, z, r (current radii) into xyzr[4n]. */
 void gp_dem3d_spheres(const gp_dem3d *d, double *xyzr);
 

@@ -21,7 +21,10 @@
  *  box ("target_too_dense"), unless it stalled within POROSITY_SLACK of it; if after relaxation the top wall carries no force, the deposit
  *  itself is denser than the target ("target_too_loose").
  *  Durations are in units of sqrt(d50 / g), not in steps, so that a wide sieve (whose time
- *  step follows its small grains) gets the same physical time as the paper's.
+ *  step follows its small grains) gets the same physical time as the paper's. For the same
+ *  reason the servo is a rate in time (gp_dem3d_set_servo_dt): deposition and compaction, at
+ *  the material's damping, step longer than relaxation (DT_DAMPING_EXP), and the wall moves
+ *  as it would at relaxation's step.
  *  phase 2, tiling: gp_flip.
  * Code: gp_specimen3d_build() runs one function per phase over one build_run (read_spec,
  * draw_sample, place_sample, start_dem, deposit, compact, relax, collect_sample, tile_sample,
@@ -50,7 +53,8 @@
 #define STABILITY GP_SPEC3D_STABILITY /* Eq. 7: 0.01 % */
 #define GROW_FROM 0.6            /* initial radius scale of the placement */
 /* durations, in units of sqrt(d50 / g) (see where tu is computed; the paper's sieve has ~860
- * steps per unit, and these are its former step counts) */
+ * steps per unit at the relaxation's dt, ~735 at the deposition's and compaction's, and these
+ * are its former step counts at ~860) */
 #define GROW_T 1.75              /* growth of the radii */
 #define SETTLE_T 1.2             /* deposition ends after this ... */
 #define SETTLE_SC 5e-2           /* ... or when S_c is below this */
@@ -60,22 +64,47 @@
 #define LID_SPEED 1.4            /* top-wall speed limit, times sqrt(g d50) (1 m/s in the paper) */
 #define APPROACH_T 1.0           /* the wall closes the gap to b_z in no less than this */
 #define CHUNK 100
+#define RELAX_CHUNK 10           /* relaxation: S_c (measured on a run's last step) is looked at
+                                    every this many steps: it falls to 1e-4 through the noise of
+                                    rattlers settling, and a coarser look stops up to a chunk
+                                    later (over seeds 0-9 of the paper: -300 steps at 10, vs 100) */
 #define STALL_FRACTION 0.1
 #define LADDER_FRACTION 0.2      /* least progress per window, of the height still to go */
-#define LADDER_MIN_LEFT 0.002    /* ... counted as at least this fraction of b_z */
+#define LADDER_MIN_LEFT 0.004    /* ... counted as at least this fraction of b_z; also the
+                                    least gap of the approach's speed limit (APPROACH_T). The
+                                    last stretch of the paper's sample creeps at this floor
+                                    (0.002: ~1 unit for its last 1 mm); 0.004 saves ~300 steps
+                                    of compaction on seeds 0-9, and relaxation then takes no
+                                    longer; 0.006-0.008 save ~150 more in compaction but
+                                    relaxation takes 200-300 more (the packing arrives faster
+                                    than it settles) */
 #define LADDER_FACTOR 0.5        /* friction step of the ladder */
 #define LADDER_MIN_DEG 0.5       /* below this the ladder goes to zero friction */
 #define MAX_SCALED_RATIO 3.5     /* density scaling radius >= rmax / this */
 #define POROSITY_SLACK 0.003     /* the wall may end this far from the target porosity (the
                                     tolerance is 0.005): above, where the packing jams without
                                     friction; below, following a packing that settles away */
-#define DT_SAFETY 0.4            /* of sqrt(m / 2 E R), m density-scaled. The DEM checks every
-                                    step against a proven bound on omega_max (shear and rotation
-                                    included) and the limit omega dt < 2 / sqrt(1 + c) of
-                                    leapfrog with local damping c (gp_dem3d.h); on the paper's
-                                    sample (seeds 0, 1, 2, 7) the steps use at most 0.90-0.94
-                                    of that limit, in relaxation (c = 0.7); 0.43 already needs
-                                    a cut of dt on some seeds */
+#define DT_SAFETY 0.4            /* of sqrt(m / 2 E R), m density-scaled, at the relaxation's
+                                    damping c = 0.7. The DEM checks every step against a proven
+                                    bound on omega_max (shear and rotation included) and the
+                                    limit omega dt < 2 / sqrt(1 + c) of leapfrog with local
+                                    damping c (gp_dem3d.h); at 0.43 relaxation already needs a
+                                    cut on some seeds */
+#define DT_DAMPING_EXP 0.45      /* the other phases (c = the material's 0.2) step
+                                    ((1 + 0.7) / (1 + c))^0.45 = 1.17 x longer
+                                    (params.dt_damping_exp): for the same contacts they use
+                                    (1.2 / 1.7)^0.05 = 0.98 of the relaxation's fraction of its
+                                    own limit. On the paper's sample (seeds 0-9) the steps use
+                                    at most 0.80-0.89 of the limit in deposition, 0.88-0.94 in
+                                    compaction and 0.89-0.95 in relaxation, never cut (with one
+                                    step for all: 0.90-0.94, in relaxation); 0.96 in the
+                                    compaction of test_cancel_phases' 12 mm sample (0.96 in its
+                                    relaxation with one step). 0.5 (the same fraction, 1.19 x)
+                                    saves as many steps, but the small spec of the integration
+                                    tests (55 spheres at porosity 0.5, which jam without
+                                    friction at 0.50-0.54 by the seed: ~45 % reach 0.5, with
+                                    one step or with this one) then jammed at 0.5057 at its
+                                    default seed 0 */
 #define COMPACTION_STRESS 1.0    /* top-wall stress, times the geostatic stress at the bottom */
 /* local damping during relaxation (the static state does not depend on it; Sc <= 1e-4 comes
  * ~2x sooner than at 0.2) */
@@ -392,6 +421,7 @@ static gp_status relax_tiled(const gp_spec3d *spec, const gp_dem3d_params *dp, p
             break;
     }
     if (!st) {
+        S->dt_cuts += ds.dt_cuts; /* (flipped walls are image spheres: stiffer than walls) */
         S->tiled_stability = ds.stability;
         gp_dem3d_spheres(dem, tiled);
         st = gp_dem3d_contacts(dem, tcon, ntcon, err);
@@ -481,6 +511,7 @@ typedef struct build_run {
     double area, sigma0;     /* the top wall's area and servo stress (phase 1 on) */
     int pushed;              /* the top wall has pressed on grains */
     int reached;             /* the top wall reached b_z (or stalled within POROSITY_SLACK) */
+    long phase_start;        /* the DEM's steps when the current phase began */
     gp_status outcome;       /* GP_OK, GP_ERR_INFEASIBLE or GP_ERR_NOT_CONVERGED */
     const char *reason;      /* stats.stop_reason */
     /* phase 2 */
@@ -622,7 +653,10 @@ static gp_status start_dem(build_run *R)
     dp->scaled_radius = fmax(0.5 * diam[n / 2], 0.5 * diam[0] / MAX_SCALED_RATIO);
     dp->skin = 0.5 * diam[n - 1]; /* the smallest radius (rebuilds against candidates; results
                                      do not depend on it) */
-    dp->dt_safety = DT_SAFETY;
+    /* the step of damping c is DT_SAFETY ((1 + RELAX_DAMPING) / (1 + c))^DT_DAMPING_EXP of
+     * sqrt(m / 2 E R): the relaxation's is DT_SAFETY's */
+    dp->dt_safety = DT_SAFETY * pow(1 + RELAX_DAMPING, DT_DAMPING_EXP);
+    dp->dt_damping_exp = DT_DAMPING_EXP;
     R->res->stats.scaled_radius = dp->scaled_radius;
     dp->threads = spec->threads > 0 ? spec->threads : 1;
     for (size_t i = 0; i < n; i++)
@@ -632,12 +666,22 @@ static gp_status start_dem(build_run *R)
     gp_status st = gp_dem3d_create(dp, R->xyzr, n, lo, L, &R->dem, R->err);
     if (st)
         return st;
+    /* The servo is a rate in time, SERVO_GAIN per step of the relaxation's dt: the windows
+     * that judge the wall's progress are in time, and at a longer step a servo moving a
+     * fixed fraction per step would press faster, and the protocol would change with dt.
+     * (Setting the damping back gives the first step bit for bit: dt_und is unchanged.) */
+    double c_relax = fmax(spec->material.damping, RELAX_DAMPING);
+    gp_dem3d_set_damping(R->dem, c_relax);
+    double dt_relax = gp_dem3d_dt(R->dem);
+    gp_dem3d_set_servo_dt(R->dem, dt_relax);
+    gp_dem3d_set_damping(R->dem, spec->material.damping);
     gp_dem3d_set_cancel(R->dem, R->cancel); /* a chunk of 100 steps of a large sample takes seconds */
     /* Every duration of the protocol is a multiple of the skeleton's time sqrt(d50 / g) (d50 the
      * median diameter by weight: the grains that carry the load), the time a grain takes to
      * fall its own size. In steps this unit is ~860 for the paper's sieve and ~2300 for a size
-     * ratio of 20, where dt follows the small grains: counted in steps, the windows that judge
-     * progress were too short there, and the deposit never had the time to settle. */
+     * ratio of 20 (at the relaxation's dt; 1.17 x fewer at the deposition's, tu), where dt
+     * follows the small grains: counted in steps, the windows that judge progress were too
+     * short there, and the deposit never had the time to settle. */
     double d50 = diam[n - 1];
     double tot = 0, acc = 0;
     for (size_t i = 0; i < n; i++)
@@ -656,8 +700,25 @@ static gp_status start_dem(build_run *R)
     R->ladder_steps = CHUNK * (long)ceil(LADDER_T * tu / CHUNK);
     R->stall_steps = CHUNK * (long)ceil(STALL_T * tu / CHUNK);
     R->lid_speed = LID_SPEED * sqrt(GRAVITY * d50);
-    R->max_steps = spec->max_steps > 0 ? spec->max_steps : (long)fmax(400000, MAX_T * tu);
+    /* the cap counts steps of the relaxation's (shortest) dt, as when every phase had it */
+    double tu_relax = sqrt(d50 / GRAVITY) / dt_relax;
+    R->max_steps = spec->max_steps > 0 ? spec->max_steps : (long)fmax(400000, MAX_T * tu_relax);
     return GP_OK;
+}
+
+/* the end of DEM phase k (0 deposition, 1 compaction, 2 relaxation): its time step, steps and
+ * largest fraction of the stability limit into the stats; the next phase's fraction starts
+ * afresh */
+static void end_phase(build_run *R, int k)
+{
+    gp_stats3d *S = &R->res->stats;
+    gp_dem3d_get_state(R->dem, &R->ds);
+    S->phase_dt[k] = gp_dem3d_dt(R->dem);
+    S->phase_steps[k] = R->ds.steps - R->phase_start;
+    S->phase_dt_ratio[k] = R->ds.dt_ratio;
+    S->dt_cuts = R->ds.dt_cuts;
+    R->phase_start = R->ds.steps;
+    gp_dem3d_reset_dt_ratio(R->dem);
 }
 
 /* the radii grow to full size under gravity (GROW_T), then the deposit settles (SETTLE_T, or
@@ -690,6 +751,7 @@ static gp_status deposit(build_run *R)
         if (ds->stability < SETTLE_SC)
             break;
     }
+    end_phase(R, 0);
     R->res->t_deposition = gp_clock_seconds() - t_phase;
     return GP_OK;
 }
@@ -795,6 +857,7 @@ static gp_status compact(build_run *R)
     }
     S->deposition_porosity = 1 - vs / (area * (isnan(h_touch) ? gp_dem3d_wall(dem, 5) : h_touch));
     S->compaction_friction_deg = phi;
+    end_phase(R, 1);
     R->res->t_compaction = gp_clock_seconds() - t_phase;
     return GP_OK;
 }
@@ -827,7 +890,7 @@ static gp_status relax(build_run *R)
                 gp_dem3d_set_servo_limit(dem, 5, h_sink);
             }
             for (;;) {
-                gp_status st = gp_dem3d_run(dem, CHUNK, R->err);
+                gp_status st = gp_dem3d_run(dem, RELAX_CHUNK, R->err);
                 if (st)
                     return st;
                 gp_dem3d_get_state(dem, ds);
@@ -851,6 +914,7 @@ static gp_status relax(build_run *R)
                 }
             }
         }
+        end_phase(R, 2);
         if (R->outcome == GP_OK && !(ds->wall_force[5] > 0)) {
             /* the wall never touched a grain above b_z: the deposit is denser than the target;
              * or (pass 1) the packing settled further than POROSITY_SLACK */
@@ -877,6 +941,10 @@ static gp_status collect_sample(build_run *R)
     gp_dem3d_get_state(dem, &R->ds);
     S->stability = R->ds.stability;
     S->steps = R->ds.steps;
+    /* stats.dt is the relaxation's step (an export's relaxation runs at it), also where the
+     * protocol ended before relaxing */
+    if (!R->reached)
+        gp_dem3d_set_damping(dem, fmax(R->spec->material.damping, RELAX_DAMPING));
     S->dt = gp_dem3d_dt(dem);
     S->stop_reason = R->reason;
     gp_dem3d_spheres(dem, R->xyzr);

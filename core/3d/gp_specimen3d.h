@@ -117,7 +117,17 @@ typedef struct gp_stats3d {
     double tiled_stability;      /* S_c of the tiled packing (0 unless tile_relax_steps) */
     double compaction_friction_deg; /* friction angle in use when the target height was reached */
     long steps;                  /* DEM steps of the sample, all phases */
-    double dt;                   /* DEM time step, s */
+    double dt;                   /* DEM time step of the relaxation (its damping's), s */
+    /* per DEM phase (0 deposition, 1 compaction, 2 relaxation; zeros for a phase not run):
+     * its time step at its end (s; a phase with less damping steps longer, DT_DAMPING_EXP in
+     * gp_specimen3d.c and gp_dem3d.h), its steps, and the largest fraction of its own
+     * stability limit any of its steps used (the DEM's dt_ratio: < 1 unless the step had to
+     * be cut) */
+    double phase_dt[3];
+    long phase_steps[3];
+    double phase_dt_ratio[3];
+    long dt_cuts;                /* times the DEM cut its step, all phases and the tiled
+                                    relaxation (0 expected) */
     double scaled_radius;        /* the DEM's density scaling radius, m (gp_dem3d_params) */
 } gp_stats3d;
 

@@ -647,6 +647,123 @@ static void test_dt_threshold(void)
     free(s);
 }
 
+/* params.dt_damping_exp e: dt = dt_safety tmin / (1 + c)^e for the damping c in force, at
+ * the start and after gp_dem3d_set_damping, so that on the same contacts the fraction of the
+ * limit sqrt(lam (1 + c)) dt / 2 (the DEM's dt_ratio, compared over one step from the same
+ * settled packing at c = 0.2 and at 0.7) goes as (1 + c)^(0.5 - e): the same at e = 0.5, and
+ * (1.2 / 1.7)^0.05 times the relaxation's at the specimen's 0.45; without it the step
+ * ignores c. A guarded start at 1.2 x the bound's limit is cut to 0.9 of it, and a change of
+ * c after the cut keeps the cut's share: 0.9 ((1 + c) / 1.2)^(0.5 - e) of the new limit. */
+static void test_dt_per_damping(void)
+{
+    size_t n = 100;
+    double *s = malloc(4 * n * sizeof *s), top = 0;
+    settled_packing(n, 102, s, &top);
+    gp_dem3d_params p = base();
+    p.scaled_radius = 0.0045;
+    p.dt_safety = 0.5;
+    double hi[3] = {0.045, 0.045, top}, tmin = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        double r = s[4 * i + 3];
+        tmin = fmin(tmin, sqrt(inertial_mass(&p, r) / (2 * p.young * r)));
+    }
+    gp_error e;
+    const double exps[2] = {0.5, 0.45};
+    double ratio0 = 0;
+    for (int x = 0; x < 2; x++) {
+        double ex = exps[x];
+        p.dt_damping_exp = ex;
+        double ratio[2] = {0, 0};
+        for (int k = 0; k < 2; k++) { /* 0: c = 0.2 throughout; 1: set to 0.7 before the step */
+            gp_dem3d *d = in_box(&p, s, n, hi);
+            if (!d)
+                break;
+            CHECK_REL(gp_dem3d_dt(d), 0.5 * tmin / pow(1.2, ex), 1e-12);
+            if (k == 1) {
+                gp_dem3d_set_damping(d, 0.7);
+                CHECK_REL(gp_dem3d_dt(d), 0.5 * tmin / pow(1.7, ex), 1e-12);
+            }
+            CHECK(gp_dem3d_run(d, 1, &e) == GP_OK);
+            gp_dem3d_state st;
+            gp_dem3d_get_state(d, &st);
+            ratio[k] = st.dt_ratio;
+            CHECK_REL(st.dt_ratio, st.omega_bound * gp_dem3d_dt(d) * sqrt(k ? 1.7 : 1.2) / 2,
+                      1e-12);
+            CHECK(st.dt_cuts == 0);
+            gp_dem3d_reset_dt_ratio(d);
+            gp_dem3d_get_state(d, &st);
+            CHECK(st.dt_ratio == 0);
+            gp_dem3d_destroy(d);
+        }
+        printf("dt per damping, e = %.2f: fraction of the limit %.4f at c = 0.2, %.4f at c = "
+               "0.7\n", ex, ratio[0], ratio[1]);
+        CHECK(ratio[0] > 0.1 && ratio[0] < 1);
+        CHECK_REL(ratio[0] / ratio[1], pow(1.2 / 1.7, 0.5 - ex), 1e-9);
+        if (x == 0)
+            ratio0 = ratio[0];
+    }
+    /* without dt_damping_exp the step stays what dt_safety made it */
+    p.dt_damping_exp = 0;
+    gp_dem3d *d = in_box(&p, s, n, hi);
+    if (d) {
+        gp_dem3d_set_damping(d, 0.7);
+        CHECK_REL(gp_dem3d_dt(d), 0.5 * tmin, 1e-12);
+        gp_dem3d_destroy(d);
+    }
+    /* a cut, then a change of damping */
+    for (int x = 0; x < 2; x++) {
+        double ex = exps[x];
+        p.dt_damping_exp = ex;
+        /* 1.2 x the limit at c = 0.2 (ratio0: the fraction at dt_safety 0.5 and e = 0.5) */
+        p.dt_safety = 0.5 * 1.2 / ratio0 * pow(1.2, ex - 0.5);
+        d = in_box(&p, s, n, hi);
+        if (!d)
+            continue;
+        gp_dem3d_state st;
+        CHECK(gp_dem3d_run(d, 1, &e) == GP_OK);
+        gp_dem3d_get_state(d, &st);
+        CHECK(st.dt_cuts == 1);
+        CHECK_REL(st.dt_ratio, 1.2, 1e-9);
+        CHECK_REL(gp_dem3d_dt(d) * st.omega_bound * sqrt(1.2) / 2, 0.9, 1e-12);
+        gp_dem3d_set_damping(d, 0.7);
+        CHECK_REL(gp_dem3d_dt(d) * st.omega_bound * sqrt(1.7) / 2,
+                  0.9 * pow(1.7 / 1.2, 0.5 - ex), 1e-12);
+        gp_dem3d_destroy(d);
+    }
+    free(s);
+}
+
+/* gp_dem3d_set_servo_dt: the servo's first step, computed by hand. One sphere (no gravity)
+ * overlaps the top wall by delta: the wall carries F_c = 2 E R delta at stiffness k = 2 E R,
+ * and a servo pressing with 3 F_c moves it inward by gain (3 F_c - F_c) / k = 2 gain delta,
+ * gain = 0.25 dt / dt_ref (0.25 without dt_ref); a step twice as long moves it twice as far
+ * (a rate in time). The forces are those at the step's start, so the sphere's own move does
+ * not enter. */
+static void test_servo_rate(void)
+{
+    gp_dem3d_params p = base();
+    p.gravity[2] = 0;
+    double R = 0.01, delta = 1e-5;
+    double s[4] = {0.02, 0.02, 0.02, R};
+    double hi[3] = {0.04, 0.04, 0.02 + R - delta};
+    const double refs[3] = {0, 1, 0.5}; /* dt_ref: none, dt, dt / 2 */
+    const double gains[3] = {0.25, 0.25, 0.5};
+    for (int k = 0; k < 3; k++) {
+        gp_dem3d *d = in_box(&p, s, 1, hi);
+        if (!d)
+            return;
+        gp_dem3d_set_servo(d, 5, 3 * 2 * p.young * R * delta, 1e6);
+        gp_dem3d_set_servo_dt(d, refs[k] * gp_dem3d_dt(d));
+        gp_error e;
+        CHECK(gp_dem3d_run(d, 1, &e) == GP_OK);
+        gp_dem3d_state st;
+        gp_dem3d_get_state(d, &st);
+        CHECK_REL(st.wall_force[5], 2 * p.young * R * delta, 1e-9);
+        CHECK_REL(hi[2] - gp_dem3d_wall(d, 5), 2 * gains[k] * delta, 1e-9);
+        gp_dem3d_destroy(d);
+    }
+}
+
 static void test_solid_volume(void)
 {
     /* a sphere cut in half by a wall, and one whole */
@@ -668,5 +785,7 @@ int main(void)
     test_solid_volume();
     test_dt_bound();
     test_dt_threshold();
+    test_dt_per_damping();
+    test_servo_rate();
     return gp_test_summary();
 }

@@ -9,8 +9,13 @@
 #include "gp_test.h"
 #include "specimen3d_test.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 
 #if defined(__SANITIZE_ADDRESS__)
 #define GP_SANITIZED 1
@@ -65,6 +70,36 @@ static gp_specimen3d *build_and_check(const gp_spec3d *s)
     return r;
 }
 
+/* The time step of each DEM phase, recomputed from the spheres (untiled: their full radii)
+ * and the scaling radius: dt = 0.4 tmin (1.7 / (1 + c))^0.45, c the phase's damping (the
+ * material's 0.2 in deposition and compaction, 0.7 in relaxation), tmin = min sqrt(m_i /
+ * (2 E R_i)) with the density-scaled masses (gp_dem3d.h; DT_SAFETY and DT_DAMPING_EXP of
+ * gp_specimen3d.c), and the fraction of its own limit below 1 in each phase without a cut. */
+static void check_phase_steps(const gp_specimen3d *r, const gp_spec3d *s)
+{
+    const gp_stats3d *S = &r->stats;
+    double rs = S->scaled_radius, tmin = INFINITY, rho = s->material.density;
+    for (size_t i = 0; i < r->count; i++) {
+        double R = r->spheres[4 * i + 3];
+        double mi = R < rs ? 4.0 / 3.0 * M_PI * rs * rs * rs * rho * R / rs
+                           : 4.0 / 3.0 * M_PI * R * R * R * rho;
+        tmin = fmin(tmin, sqrt(mi / (2 * s->material.young * R)));
+    }
+    const double c[3] = {s->material.damping, s->material.damping, 0.7};
+    for (int k = 0; k < 3; k++) {
+        CHECK_REL(S->phase_dt[k], 0.4 * tmin * pow(1.7 / (1 + c[k]), 0.45), 1e-9);
+        CHECK(S->phase_steps[k] > 0);
+        CHECK(S->phase_dt_ratio[k] > 0.3 && S->phase_dt_ratio[k] < 1);
+    }
+    CHECK(S->phase_steps[0] + S->phase_steps[1] + S->phase_steps[2] == S->steps);
+    CHECK(S->dt == S->phase_dt[2]);
+    CHECK(S->dt_cuts == 0);
+    printf("phase steps: %ld / %ld / %ld, dt %.3g / %.3g / %.3g s, fraction of the limit "
+           "%.3f / %.3f / %.3f\n", S->phase_steps[0], S->phase_steps[1], S->phase_steps[2],
+           S->phase_dt[0], S->phase_dt[1], S->phase_dt[2], S->phase_dt_ratio[0],
+           S->phase_dt_ratio[1], S->phase_dt_ratio[2]);
+}
+
 static void test_small_and_tiled(void)
 {
     gp_spec3d s;
@@ -76,6 +111,7 @@ static void test_small_and_tiled(void)
         return;
     CHECK(r->count == r->stats.sample_particles);
     CHECK(r->ncontacts == r->stats.contacts + r->stats.wall_contacts);
+    check_phase_steps(r, &s);
     /* the same spec tiled 4 x 4 x 4: porosity within 0.002, fabric within 0.01, z kept */
     gp_spec3d t = s;
     t.tiling[0] = t.tiling[1] = t.tiling[2] = 4;
