@@ -314,6 +314,12 @@ static void cell_free(vcell *c)
     free(c);
 }
 
+/* c back to the pool, or freed when the pool cannot grow (out of memory) */
+static void pool_give(gp_voronoi *v, vcell *c)
+{
+    if (pool_put(v, c)) cell_free(c);
+}
+
 static int cell_reserve(vcell *c, int32_t nv, int32_t np, int32_t nnb)
 {
     if (nv > c->cap) {
@@ -2189,7 +2195,7 @@ static void undo(gp_voronoi *v)
 {
     for (uint32_t k = v->nchg; k-- > 0;) {
         uint32_t j = v->chg[k];
-        pool_put(v, v->cell[j]); /* cannot fail: the pool had room for it before */
+        pool_give(v, v->cell[j]);
         v->cell[j] = v->chg_old[k];
     }
     v->nchg = 0;
@@ -2215,7 +2221,7 @@ static gp_status recompute(gp_voronoi *v, uint32_t j, int how, const vcell *old_
                                    : compute_cell_cut(v, j, v->cell[j], i, c);
     if (st == GP_OK && chg_push(v, j, v->cell[j])) st = GP_ERR_NOMEM;
     if (st != GP_OK) {
-        pool_put(v, c);
+        pool_give(v, c);
         return st;
     }
     v->cell[j] = c;
@@ -2320,7 +2326,7 @@ void gp_voronoi_commit(gp_voronoi *v)
             v->cell[j] = own;
             spare = fresh;
         }
-        if (pool_put(v, spare)) cell_free(spare); /* the pool could not grow: drop the spare */
+        pool_give(v, spare);
     }
     v->nchg = 0;
     v->pending = 0;
