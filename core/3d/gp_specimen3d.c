@@ -68,10 +68,11 @@
  * at the first look <= 1e-4: the paper's condition, checked once (as YADE's scripts check
  * it). S_c is noisy there (rattlers settling). Measured on the paper's sample, seeds 0-9,
  * looking every 10 steps over the 1,000 steps after that stop: S_c is above 1e-4 at 46-82 %
- * of the looks, at most 3.3e-4 to 8.1e-4 (26-73 % and 2.6e-4 to 5.8e-4 with the one time
- * step of stop 25); holding it at every look for 100 steps would take 310-1,790 more steps.
- * A finer look stops earlier, on a dip of that noise: looking every 10 steps saved ~300
- * steps but left S_c above 1e-4 at 55-85 % of the later looks, so the look stays at CHUNK. */
+ * of the looks, at most 3.3e-4 to 8.1e-4 (26-73 % and 2.6e-4 to 5.8e-4 with one time step
+ * for all phases, before f116b41); holding it at every look for 100 steps would take 310 to
+ * 1,790 more steps. A finer look stops earlier, on a dip of that noise: looking every 10
+ * steps saved ~300 steps but left S_c above 1e-4 at 55-85 % of the later looks, so the look
+ * stays at CHUNK. */
 #define STALL_FRACTION 0.1
 #define LADDER_FRACTION 0.2      /* least progress per window, of the height still to go */
 #define LADDER_MIN_LEFT 0.004    /* ... counted as at least this fraction of b_z; also the
