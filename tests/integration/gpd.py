@@ -63,8 +63,8 @@ SMALL_3D = {
     "outputs": ["spheres", "contacts", "fabric", "stress"],
 }
 
-# Latency limits are multiplied by this (set GPD_TEST_TIME_SCALE=5 for a TSan build, which
-# runs the core several times slower).
+# Latency limits are multiplied by this (tests/run.sh sets GPD_TEST_TIME_SCALE=2 for its ASan
+# pass; set 5 for a TSan build, which runs the core several times slower).
 TIME_SCALE = float(os.environ.get("GPD_TEST_TIME_SCALE", "1"))
 
 DB_MODE = os.environ.get("GP_TEST_DB", "sqlite")
