@@ -129,10 +129,11 @@ static int mark(void *user, const gp_progress *pr)
     return 0;
 }
 
-static double speed(size_t n, long steps, double *cpu_rate)
+static double speed(size_t n, long steps, int threads, double *cpu_rate)
 {
     gp_imc_params p;
     gp_imc_params_defaults(&p);
+    p.threads = threads;
     p.cov = 0.8;
     p.threshold = 1e-12;
     p.max_steps = steps;
@@ -142,8 +143,8 @@ static double speed(size_t n, long steps, double *cpu_rate)
     gp_imc_run(SQ, 4, NULL, NULL, 0, n, &p, mark, &m, NULL, &v, &r, NULL);
     double t = m.t1 - m.t0, rate = t > 0 ? (double)(m.s1 - m.s0) / t : 0.0;
     double c = m.c1 - m.c0, crate = c > 0 ? (double)(m.s1 - m.s0) / c : 0.0;
-    printf("| speed, AD   | %6zu | %8ld | %8ld | %7.2f | %9.0f | %9.0f | %9.4g |\n", n, r.steps, r.accepted, t,
-           rate, crate, r.error);
+    printf("| speed, AD   | %7d | %6zu | %8ld | %8ld | %7.2f | %9.0f | %9.0f | %9.4g |\n", threads, n, r.steps,
+           r.accepted, t, rate, crate, r.error);
     fflush(stdout);
     gp_voronoi_destroy(v);
     gp_imc_report_free(&r);
@@ -156,12 +157,13 @@ int main(int argc, char **argv)
     long max_steps = argc > 1 ? atol(argv[1]) : 1000000;
     long speed_steps = argc > 2 ? atol(argv[2]) : 100000;
     size_t only_n = argc > 3 ? (size_t)atol(argv[3]) : 0;
+    int threads = argc > 4 ? atoi(argv[4]) : 2;
     shape square = {"square", SQ, 4, NULL, NULL, 0};
     const gp_vec2 *holes[1] = {HOLE};
     size_t nh[1] = {4};
     shape lshape = {"L with hole", LSH, 6, holes, nh, 1};
     if (only_n > 0) {
-        speed(only_n, speed_steps, NULL);
+        speed(only_n, speed_steps, threads, NULL);
         return 0;
     }
     if (max_steps == 0) goto rates;
@@ -183,12 +185,15 @@ int main(int argc, char **argv)
     row(&square, 500, 0.05, 1.0, GP_IMC_ERROR_AD, max_steps);
     row(&square, 500, 0.05, 1.0, 3, max_steps);
 rates:
-    printf("\n| rate        |      N |    steps | accepted | seconds |   steps/s | steps/CPU s |     error |\n"
-           "|---|---|---|---|---|---|---|---|\n");
+    printf("\n| rate        | threads |      N |    steps | accepted | seconds |   steps/s | steps/CPU s |     error |\n"
+           "|---|---|---|---|---|---|---|---|---|\n");
     const size_t sn[3] = {1000, 10000, 100000};
-    double rate[3][2];
-    for (int k = 0; k < 3; k++) rate[k][0] = speed(sn[k], speed_steps, &rate[k][1]);
-    printf("| ratio 100k/1k |      |          |          |         | %9.3f | %9.3f |           |\n",
-           rate[0][0] > 0 ? rate[2][0] / rate[0][0] : 0.0, rate[0][1] > 0 ? rate[2][1] / rate[0][1] : 0.0);
+    int tc[2] = {1, threads};
+    for (int c = 0; c < (threads > 1 ? 2 : 1); c++) {
+        double rate[3][2];
+        for (int k = 0; k < 3; k++) rate[k][0] = speed(sn[k], speed_steps, tc[c], &rate[k][1]);
+        printf("| ratio 100k/1k | %7d |      |          |          |         | %9.3f | %9.3f |           |\n", tc[c],
+               rate[0][0] > 0 ? rate[2][0] / rate[0][0] : 0.0, rate[0][1] > 0 ? rate[2][1] / rate[0][1] : 0.0);
+    }
     return 0;
 }

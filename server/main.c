@@ -48,7 +48,7 @@ static void usage(FILE *f)
             "                         (default 30)\n"
             "  --workers N            worker threads running jobs [GRAINPACK_WORKERS]\n"
             "                         (default: the number of CPU cores)\n"
-            "  --job-threads N        threads each job runs on (the filling, ODEC and\n"
+            "  --job-threads N        threads each job runs on (the IMC, filling, ODEC and\n"
             "                         descriptors of a 2D job, the DEM of a 3D one; results\n"
             "                         are the same whatever N) [GRAINPACK_JOB_THREADS]\n"
             "                         (default 0: the CPU cores over the workers, at least 1)\n"

@@ -872,6 +872,7 @@ static gp_status run_imc(build_ctx *b, gp_error *err)
     ip.init = spec->imc_init == GP_INIT_HALTON ? 1 : 0;
     ip.classes_size = spec->imc_classes;
     ip.classes_orient = spec->imc_classes;
+    ip.threads = spec->threads;
     imc_relay relay = {b->progress, b->user, b->cancel};
     gp_imc_report rep;
     memset(&rep, 0, sizeof rep);

@@ -130,7 +130,7 @@ typedef struct gp_spec2d {
     int imc_classes;            /* histogram classes; 0 = automatic (see gp_imc.h) */
     size_t contour_points;
     unsigned outputs;           /* GP_OUT2_* */
-    int threads;                /* worker threads for filling; 0 = 1 */
+    int threads;                /* threads for the IMC steps and the filling; 0 = 1 */
 } gp_spec2d;
 
 /* Fills a spec with the API defaults (unit square, 100 particles, lognormal cov 0.5 on cells,

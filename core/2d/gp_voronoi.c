@@ -2349,6 +2349,28 @@ size_t gp_voronoi_changed(const gp_voronoi *v, const uint32_t **cells)
     return v->nchg;
 }
 
+/* dst's cell j becomes src's (content), seed i and its bin follow src's pending move */
+gp_status gp_voronoi_apply(gp_voronoi *dst, const gp_voronoi *src, gp_error *err)
+{
+    if (!dst || !src || !src->pending || dst->pending || dst->n != src->n)
+        return gp_error_set(err, GP_ERR_INVALID, "voronoi apply: need a pending move in src, none in dst");
+    const uint32_t i = src->mv_i;
+    gp_vec2 o = dst->seed[i], p = src->seed[i];
+    int32_t bo = bin_y(dst, o.y) * dst->nbx + bin_x(dst, o.x), bn = bin_y(dst, p.y) * dst->nbx + bin_x(dst, p.x);
+    if (bo != bn) {
+        if (bin_insert(&dst->bins[bn], (int32_t)i)) return gp_error_set(err, GP_ERR_NOMEM, "voronoi apply: out of memory");
+        bin_remove(&dst->bins[bo], (int32_t)i);
+    }
+    dst->seed[i] = p;
+    dst->useed[i] = src->useed[i];
+    for (uint32_t k = 0; k < src->nchg; k++) {
+        uint32_t j = src->chg[k];
+        if (cell_copy(dst->cell[j], src->cell[j]))
+            return gp_error_set(err, GP_ERR_NOMEM, "voronoi apply: out of memory (dst is now unusable)");
+    }
+    return GP_OK;
+}
+
 gp_status gp_voronoi_move(gp_voronoi *v, size_t i, gp_vec2 p, gp_error *err)
 {
     gp_status st = gp_voronoi_try_move(v, i, p, err);

@@ -113,6 +113,15 @@ void gp_voronoi_commit(gp_voronoi *v);
 void gp_voronoi_rollback(gp_voronoi *v);
 size_t gp_voronoi_changed(const gp_voronoi *v, const uint32_t **cells);
 
+/* Replicas (gp_imc.c evaluates moves in parallel, one replica per thread). dst must hold the
+ * tessellation src held before its pending move (built from the same container and seeds, and
+ * given the same moves since) with no move pending; dst then takes src's pending move as it
+ * stands -- the moved seed and a copy of every changed cell, bit for bit, without recomputing
+ * anything -- and src may then commit. GP_ERR_INVALID without a pending move in src, or with
+ * one in dst; GP_ERR_NOMEM leaves dst unusable (destroy it). dst and src are both touched
+ * (src only read): neither may be used by another thread meanwhile. */
+gp_status gp_voronoi_apply(gp_voronoi *dst, const gp_voronoi *src, gp_error *err);
+
 /* A point uniformly distributed in cell i (all parts), drawn with u01() (uniform in [0, 1),
  * called a variable number of times). Returns 0 and the point in *p, or -1 if 1000 rejection
  * attempts in a very thin part all failed (then *p is the seed). */

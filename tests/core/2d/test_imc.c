@@ -225,10 +225,12 @@ static int progress_cb(void *user, const gp_progress *p)
  * lists (gp_voronoi.c, "Moves"), the fresh build from the grid: two independent routes to the
  * same cells. */
 static void rebuild_matches(const char *name, const gp_vec2 *outer, size_t no,
-                            const gp_vec2 *const *holes, const size_t *nh, size_t nholes, size_t n)
+                            const gp_vec2 *const *holes, const size_t *nh, size_t nholes, size_t n,
+                            int threads)
 {
     gp_imc_params p;
     gp_imc_params_defaults(&p);
+    p.threads = threads; /* > 1: the run's tessellation takes other lanes' moves by copy */
     p.cov = 0.8;
     p.threshold = 1e-12; /* never reached: exactly max_steps steps */
     p.max_steps = 10000;
@@ -254,12 +256,58 @@ static void rebuild_matches(const char *name, const gp_vec2 *outer, size_t no,
             fprintf(stderr, "%s: cell %zu area %.17g vs %.17g, orient %.17g vs %.17g, nb %zu vs %zu\n", name,
                     i, a, b, oa, ob, ka, kb);
     }
-    printf("%s: %ld steps (%ld accepted), rebuilt, %d cells differ\n", name, r.steps, r.accepted, bad);
+    printf("%s, %d thread(s): %ld steps (%ld accepted), rebuilt, %d cells differ\n", name, threads, r.steps,
+           r.accepted, bad);
     CHECK(bad == 0);
     gp_voronoi_destroy(f);
     gp_voronoi_destroy(v);
     gp_imc_report_free(&r);
     free(s);
+}
+
+/* The same run on 1, 2 and 3 threads: the same stop, steps, accepted moves and error, and the
+ * same seeds and cell areas bit for bit (gp_imc.h, "Threads"). Stopped by max_steps at a step
+ * no round boundary needs to fall on (30,001), by a progress callback cancelling at step
+ * 8192, or by the threshold. */
+static void threads_agree(const char *name, const gp_vec2 *outer, size_t no, const gp_vec2 *const *holes,
+                          const size_t *nh, size_t nholes, size_t n, double cov, long max_steps, int cancel)
+{
+    gp_imc_report r[3];
+    gp_voronoi *v[3] = {NULL, NULL, NULL};
+    for (int t = 0; t < 3; t++) {
+        gp_imc_params p;
+        gp_imc_params_defaults(&p);
+        p.cov = cov;
+        p.anisotropy = 0.5;
+        p.max_steps = max_steps;
+        p.seed = 21;
+        p.threads = t + 1;
+        if (cancel) p.threshold = 1e-9; /* the callback stops it */
+        int user = 1;
+        gp_imc_run(outer, no, holes, nh, nholes, n, &p, progress_cb, cancel ? &user : NULL, NULL, &v[t], &r[t],
+                   NULL);
+    }
+    int same = v[0] && v[1] && v[2];
+    for (int t = 1; same && t < 3; t++) {
+        same = r[t].steps == r[0].steps && r[t].accepted == r[0].accepted &&
+               r[t].stop_reason == r[0].stop_reason && !memcmp(&r[t].error, &r[0].error, sizeof(double));
+        for (size_t i = 0; same && i < n; i++) {
+            gp_vec2 a = gp_voronoi_seed(v[0], i), b = gp_voronoi_seed(v[t], i);
+            double x = gp_voronoi_cell_area(v[0], i), y = gp_voronoi_cell_area(v[t], i);
+            same = !memcmp(&a, &b, sizeof a) && !memcmp(&x, &y, sizeof x);
+        }
+    }
+    printf("%s: %s after %ld steps (%ld accepted), error %.6g; 2 and 3 threads %s\n", name,
+           gp_imc_stop_name(r[0].stop_reason), r[0].steps, r[0].accepted, r[0].error, same ? "the same" : "DIFFER");
+    CHECK(same);
+    CHECK(r[0].accepted > 50);
+    if (cancel) CHECK(r[0].stop_reason == GP_IMC_STOP_CANCELLED && r[0].steps == 8192);
+    else if (max_steps < 100000) CHECK(r[0].stop_reason == GP_IMC_STOP_MAX_STEPS && r[0].steps == max_steps);
+    else CHECK(r[0].stop_reason == GP_IMC_STOP_THRESHOLD);
+    for (int t = 0; t < 3; t++) {
+        gp_voronoi_destroy(v[t]);
+        gp_imc_report_free(&r[t]);
+    }
 }
 
 /* The Hilbert index of (x, y) on a 2^16 grid, by the state table of Hacker's Delight (Warren,
@@ -610,9 +658,14 @@ int main(void)
         gp_voronoi_circle_polygon((gp_vec2){0, 0}, 1.0, 1e-3, &c, &nc, NULL);
         gp_voronoi_circle_polygon((gp_vec2){0, 0}, 0.4, 1e-3, &h, &nh, NULL);
         const gp_vec2 *holes[1] = {h};
-        rebuild_matches("rebuild: square", SQ, 4, NULL, NULL, 0, 400);
-        rebuild_matches("rebuild: L-shape", L, 6, NULL, NULL, 0, 400);
-        rebuild_matches("rebuild: annulus", c, nc, holes, &nh, 1, 300);
+        for (int t = 1; t <= 3; t += 2) {
+            rebuild_matches("rebuild: square", SQ, 4, NULL, NULL, 0, 400, t);
+            rebuild_matches("rebuild: L-shape", L, 6, NULL, NULL, 0, 400, t);
+            rebuild_matches("rebuild: annulus", c, nc, holes, &nh, 1, 300, t);
+        }
+        threads_agree("threads: square, max_steps", SQ, 4, NULL, NULL, 0, 500, 0.1, 30001, 0);
+        threads_agree("threads: annulus, cancel at 8192", c, nc, holes, &nh, 1, 300, 0.8, 1000000, 1);
+        threads_agree("threads: L-shape, threshold", L, 6, NULL, NULL, 0, 400, 0.5, 1000000, 0);
         free(c);
         free(h);
     }

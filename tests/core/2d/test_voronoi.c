@@ -489,6 +489,28 @@ static void compare_full(const gp_voronoi *v, const gp_vec2 *outer, size_t no, c
     free(s);
 }
 
+/* Replica w against v: every cell's area, orientation, parts, neighbours and polygon bit for
+ * bit (gp_voronoi_apply copies what v computed; w must equal it exactly). */
+static void compare_replica(const gp_voronoi *v, const gp_voronoi *w, int *bad)
+{
+    static size_t a[1024], b[1024];
+    static gp_vec2 pa[4096], pb[4096];
+    for (size_t i = 0; i < gp_voronoi_count(v); i++) {
+        double x = gp_voronoi_cell_area(v, i), y = gp_voronoi_cell_area(w, i);
+        double oa = gp_voronoi_cell_orientation(v, i), ob = gp_voronoi_cell_orientation(w, i);
+        gp_vec2 sa = gp_voronoi_seed(v, i), sb = gp_voronoi_seed(w, i);
+        size_t ka = gp_voronoi_neighbours(v, i, a, 1024), kb = gp_voronoi_neighbours(w, i, b, 1024);
+        size_t np = gp_voronoi_cell_parts(v, i);
+        int ok = !memcmp(&x, &y, sizeof x) && !memcmp(&oa, &ob, sizeof oa) && !memcmp(&sa, &sb, sizeof sa) &&
+                 ka == kb && !memcmp(a, b, ka * sizeof *a) && np == gp_voronoi_cell_parts(w, i);
+        for (size_t k = 0; ok && k < np; k++) {
+            size_t ma = gp_voronoi_cell_polygon(v, i, k, pa, 4096), mb = gp_voronoi_cell_polygon(w, i, k, pb, 4096);
+            ok = ma == mb && ma <= 4096 && !memcmp(pa, pb, ma * sizeof *pa);
+        }
+        if (!ok && (*bad)++ < 3) fprintf(stderr, "replica: cell %zu differs\n", i);
+    }
+}
+
 static double u01cb(void *st)
 {
     (void)st;
@@ -511,7 +533,12 @@ static void property_moves(const char *name, const gp_vec2 *outer, size_t no, co
         free(s);
         return;
     }
-    int bad = 0, moved = 0, rolled = 0, errs = 0;
+    /* a replica given every kept move: by gp_voronoi_apply after try_move, or by a move of its
+     * own after gp_voronoi_move */
+    gp_voronoi *w = gp_voronoi_create(outer, no, holes, nh, nholes, s, (size_t)N, &e);
+    CHECK(w != NULL);
+    CHECK(gp_voronoi_apply(w, v, NULL) == GP_ERR_INVALID); /* nothing pending in v */
+    int bad = 0, moved = 0, rolled = 0, errs = 0, applied = 0;
     double area = gp_voronoi_container_area(v);
     for (int t = 0; t < moves; t++) {
         size_t i = (size_t)(urand() * N);
@@ -544,11 +571,16 @@ static void property_moves(const char *name, const gp_vec2 *outer, size_t no, co
                 if (urand() < 0.5) {
                     gp_voronoi_rollback(v);
                     rolled++;
-                } else
+                } else {
+                    if (gp_voronoi_apply(w, v, &e) != GP_OK) bad++;
+                    applied++;
                     gp_voronoi_commit(v);
+                }
             }
-        } else
+        } else {
             st = gp_voronoi_move(v, i, p, &e);
+            if (st == GP_OK && gp_voronoi_move(w, i, p, NULL) != GP_OK) bad++;
+        }
         if (st != GP_OK) {
             errs++;
             if (errs < 5) fprintf(stderr, "%s move: %s\n", name, e.message);
@@ -563,11 +595,23 @@ static void property_moves(const char *name, const gp_vec2 *outer, size_t no, co
         }
     }
     compare_full(v, outer, no, holes, nh, nholes, &bad);
-    printf("%s: %d moves (%d rolled back), %d refused\n", name, moved, rolled, errs);
+    if (w) compare_replica(v, w, &bad);
+    /* a move pending in dst is refused (seed 0 moved onto its own place: a valid move) */
+    gp_vec2 q0 = gp_voronoi_seed(v, 0);
+    int both = w && gp_voronoi_try_move(w, 0, q0, NULL) == GP_OK;
+    both = both && gp_voronoi_try_move(v, 0, q0, NULL) == GP_OK;
+    CHECK(both);
+    if (both) CHECK(gp_voronoi_apply(w, v, NULL) == GP_ERR_INVALID);
+    gp_voronoi_rollback(v);
+    gp_voronoi_rollback(w);
+    printf("%s: %d moves (%d rolled back, %d applied to a replica), %d refused\n", name, moved, rolled,
+           applied, errs);
+    CHECK(applied > moves / 10);
     CHECK(bad == 0);
     CHECK(errs == 0);
     CHECK(moved > moves / 2);
     gp_voronoi_destroy(v);
+    gp_voronoi_destroy(w);
     free(s);
 }
 
