@@ -232,7 +232,7 @@ typedef struct imc_state {
      * are one cache line, not six) */
     gp_adstat *ads, *adt;
     struct ad_val {
-        double sk, sg, sh, tk, tg, th;
+        double sk, sg, sh, tk, tg, th, ang;
     } *adv;
 } imc_state;
 
@@ -275,9 +275,14 @@ typedef struct cell_val {
     unsigned char cs, ct;      /* classes */
     double sk, sg, sh;         /* area: key, ln F, ln(1 - F) */
     double tk, tg, th;         /* orientation: key, ln u, ln(1 - u) */
+    double ang;                /* the orientation they come from, radians */
 } cell_val;
 
-static void cell_eval(const imc_state *S, const gp_voronoi *v, size_t i, cell_val *c)
+/* Cell i's contribution; with recorded (its values as S holds them), an orientation equal to
+ * the recorded one bit for bit keeps the recorded u and logs: a neighbour of a moved seed keeps
+ * its orientation whenever its thinnest side does not touch the edge that changed (canonical
+ * vertices: the same lines give the same bits), about half of them. */
+static void cell_eval(const imc_state *S, const gp_voronoi *v, size_t i, cell_val *c, int recorded)
 {
     double a = gp_voronoi_cell_area(v, i), th = gp_voronoi_cell_orientation(v, i);
     c->cs = (unsigned char)size_class(S, a);
@@ -285,6 +290,14 @@ static void cell_eval(const imc_state *S, const gp_voronoi *v, size_t i, cell_va
     if (S->kind != GP_IMC_ERROR_AD) return;
     c->sk = a;
     gp_law_log_cdf_sf(S->law, a, &c->sg, &c->sh);
+    c->ang = th;
+    const struct ad_val *o = &S->adv[i];
+    if (recorded && memcmp(&o->ang, &th, sizeof th) == 0) {
+        c->tk = o->tk;
+        c->tg = o->tg;
+        c->th = o->th;
+        return;
+    }
     /* the orientation window is circular: its cut is not a tail, so u is kept a quarter of a
      * rank step away from 0 and 1 (a cell exactly at the cut would otherwise cost ln 0) */
     double u = gp_orient_cdf(S->mean_deg, S->aniso, th * 180.0 / GP_IMC_PI);
@@ -306,7 +319,7 @@ static void cell_put(imc_state *S, size_t i, const cell_val *c)
     if (S->kind != GP_IMC_ERROR_AD) return;
     gp_adstat_set(S->ads, i, c->sk, c->sg, c->sh, c->sk * c->sk);
     gp_adstat_set(S->adt, i, c->tk, c->tg, c->th, 0.0);
-    S->adv[i] = (struct ad_val){c->sk, c->sg, c->sh, c->tk, c->tg, c->th};
+    S->adv[i] = (struct ad_val){c->sk, c->sg, c->sh, c->tk, c->tg, c->th, c->ang};
 }
 
 /* cell i's recorded contribution */
@@ -322,6 +335,7 @@ static void cell_get(const imc_state *S, size_t i, cell_val *c)
     c->tk = a->tk;
     c->tg = a->tg;
     c->th = a->th;
+    c->ang = a->ang;
 }
 
 static void hist_errors(const imc_state *s, int kind, double *es, double *et)
@@ -450,7 +464,7 @@ static gp_status state_init(imc_state *S, const gp_imc_params *p, const gp_law *
         if ((i + 1) % 4096 == 0 && cancel_raised(cancel))
             return gp_error_set(err, GP_ERR_CANCELLED, "imc: cancelled while evaluating the cells");
         cell_val c;
-        cell_eval(S, v, i, &c);
+        cell_eval(S, v, i, &c, 0);
         cell_put(S, i, &c);
     }
     return GP_OK;
@@ -610,7 +624,7 @@ typedef struct step_buf {
     size_t cap;                /* room of the arrays below, in changed cells */
     cell_val *undo;            /* the changed cells' contributions before the move */
     cell_val *nv;              /* ... and after it */
-    size_t *ids;               /* gp_adstat_a2_if arguments */
+    size_t *ids, *tids;        /* gp_adstat_a2_if arguments (areas, orientations) */
     double *sk, *sg, *sh, *sx, *tk, *tg, *th, *tx;
 } step_buf;
 
@@ -620,6 +634,7 @@ static void step_buf_free(step_buf *b)
     free(b->undo);
     free(b->nv);
     free(b->ids);
+    free(b->tids);
     double **d[8] = {&b->sk, &b->sg, &b->sh, &b->sx, &b->tk, &b->tg, &b->th, &b->tx};
     for (int k = 0; k < 8; k++) free(*d[k]);
 }
@@ -633,7 +648,9 @@ static int step_buf_grow(step_buf *b, size_t need)
     if (w) b->nv = w;
     size_t *id = realloc(b->ids, c * sizeof *id);
     if (id) b->ids = id;
-    int ok = u && w && id;
+    size_t *tid = realloc(b->tids, c * sizeof *tid);
+    if (tid) b->tids = tid;
+    int ok = u && w && id && tid;
     double **d[8] = {&b->sk, &b->sg, &b->sh, &b->sx, &b->tk, &b->tg, &b->th, &b->tx};
     for (int k = 0; k < 8; k++) {
         double *x = realloc(*d[k], c * sizeof *x);
@@ -705,24 +722,30 @@ static int propose_ad(const gp_voronoi *v, gsl_rng *rng, size_t n, step_buf *b, 
 }
 
 /* The objective the run would have with the changed cells' new contributions nv[], judged
- * without changing the AD statistics (gp_adstat_a2_if). */
+ * without changing the AD statistics (gp_adstat_a2_if). Cells whose orientation values did
+ * not change are left out of the orientations' what-if: its sums are exact integers, so an
+ * element set to its own value changes nothing, bit for bit, and costs two rank queries. */
 static objective evaluate_ad_if(const imc_state *S, const uint32_t *ch, size_t nch, const cell_val *nv,
                                 step_buf *b)
 {
+    size_t nt = 0;
     for (size_t k = 0; k < nch; k++) {
         b->ids[k] = ch[k];
         b->sk[k] = nv[k].sk;
         b->sg[k] = nv[k].sg;
         b->sh[k] = nv[k].sh;
         b->sx[k] = nv[k].sk * nv[k].sk;
-        b->tk[k] = nv[k].tk;
-        b->tg[k] = nv[k].tg;
-        b->th[k] = nv[k].th;
-        b->tx[k] = 0.0;
+        const struct ad_val *o = &S->adv[ch[k]];
+        if (nv[k].tk == o->tk && nv[k].tg == o->tg && nv[k].th == o->th) continue;
+        b->tids[nt] = ch[k];
+        b->tk[nt] = nv[k].tk;
+        b->tg[nt] = nv[k].tg;
+        b->th[nt] = nv[k].th;
+        b->tx[nt++] = 0.0;
     }
     double sx;
     double as = gp_adstat_a2_if(S->ads, nch, b->ids, b->sk, b->sg, b->sh, b->sx, &sx);
-    double at = gp_adstat_a2_if(S->adt, nch, b->ids, b->tk, b->tg, b->th, b->tx, NULL);
+    double at = gp_adstat_a2_if(S->adt, nt, b->tids, b->tk, b->tg, b->th, b->tx, NULL);
     double es = as - S->ad_floor + cov_term_of(S, sx), et = at - S->ad_floor;
     objective o = {es > et ? es : et, es + et, 0.0};
     return o;
@@ -784,7 +807,7 @@ static void lane_eval(lane *L, const imc_state *S, uint64_t seed, const objectiv
         L->out = LANE_SERIAL;
         return;
     }
-    for (size_t k = 0; k < nch; k++) cell_eval(S, L->v, ch[k], &L->b.nv[k]);
+    for (size_t k = 0; k < nch; k++) cell_eval(S, L->v, ch[k], &L->b.nv[k], 1);
     L->nw = evaluate_ad_if(S, ch, nch, L->b.nv, &L->b);
     L->out = not_worse(&L->nw, cur) ? LANE_ACCEPT : LANE_REJECT;
 }
@@ -797,7 +820,7 @@ static int judge_serial(imc_state *S, lane *L, const objective *cur)
     size_t nch = gp_voronoi_changed(L->v, &ch);
     for (size_t k = 0; k < nch; k++) {
         cell_get(S, ch[k], &L->b.undo[k]);
-        cell_eval(S, L->v, ch[k], &L->b.nv[k]);
+        cell_eval(S, L->v, ch[k], &L->b.nv[k], 1);
     }
     for (size_t k = 0; k < nch; k++) cell_put(S, ch[k], &L->b.nv[k]);
     L->nw = evaluate(S);
