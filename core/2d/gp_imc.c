@@ -24,6 +24,15 @@
  * What still grows with N is the commits, by the acceptance rate as much as by N, and the
  * cache misses: the treap's pointer walks (perf: 45 % of the time at N = 100,000 in its rank queries) are now binary
  * searches in contiguous blocks of 64.
+ * Threads (issue #16, gp_imc.h "Threads"): lanes evaluate the next steps at once on replicas
+ * of the tessellation. bench_imc, N = 1,000 (1 % of steps accepted): 91.5k steps/s on one
+ * thread, 129k-138k on two -- not 2x: a round lasts as long as its slowest lane (a jump
+ * recomputes ~18 cells, a short move ~9), and the settling (rollbacks, the accepted move's
+ * statistics and its copies into the replicas) is serial; perf showed 24 % of both threads'
+ * time waiting. While a third of the steps are accepted (N = 100,000, its first 10^5 steps)
+ * two threads gain 5 %: every step after an accepted one is evaluated again. What would help
+ * there: keep a speculated step whose cells (and those its proposal and recomputation read) are
+ * disjoint from the accepted step's, judging it again against the new statistics only.
  * Memory order (issue #16): generated seeds are numbered along a Hilbert curve (hilbert_sort),
  * and gp_voronoi keeps each cell's data in place across moves, so a step's ~9 cells lie
  * together. Cachegrind, N = 100,000, per step over steps 20,000-60,000, with a 512 KiB last
