@@ -96,6 +96,7 @@ typedef struct vcell {
     int32_t nce;          /* convex outer-ring edges of the convex polygon, in nb[nnb ..) */
     int32_t convex;       /* 1: one convex part (the clipped Voronoi polygon itself) */
     double area, orient;
+    gp_vec2 oe;           /* convex: the side orient is the direction of (NaN otherwise) */
     gp_vec2 *v;
     int32_t *tag;
     int32_t *poff;        /* nparts + 1 offsets into v */
@@ -412,12 +413,16 @@ clip_hp(const gp_vec2 *sv, const int32_t *st, int32_t m, gp_vec2 o, gp_vec2 nrm,
  * of the side across which the width is smallest, by gp_min_caliper's rotating calipers (same
  * start and tie rule) on squared widths; sides shorter than sqrt(eps2) are skipped, they are
  * collinear runs of the clipped polygon. */
-static double convex_orientation(const gp_vec2 *p, int32_t m, double eps2)
+static double convex_orientation(const gp_vec2 *p, int32_t m, double eps2, const vcell *prev, gp_vec2 *e)
 {
     size_t k = gp_min_caliper_edge(p, (size_t)m, eps2, 1);
-    if (k == (size_t)m) return gp_axis_angle(1.0, 0.0);
-    size_t k1 = k + 1 == (size_t)m ? 0 : k + 1;
-    return gp_axis_angle(p[k1].x - p[k].x, p[k1].y - p[k].y);
+    size_t k1 = k + 1 >= (size_t)m ? 0 : k + 1;
+    *e = k == (size_t)m ? (gp_vec2){1.0, 0.0} : (gp_vec2){p[k1].x - p[k].x, p[k1].y - p[k].y};
+    /* the cell before a move, thinnest across the same side bit for bit (about half of a
+     * move's cells: canonical vertices away from the changed edge keep their bits): the same
+     * angle, without the atan2 */
+    if (prev && memcmp(&prev->oe, e, sizeof *e) == 0) return prev->orient;
+    return gp_axis_angle(e->x, e->y);
 }
 
 static int vlt(const void *a, const void *b)
@@ -914,7 +919,8 @@ static gp_status seed_part_orientation(gp_voronoi *v, vcell *out, gp_vec2 s)
     memcpy(v->hv, out->v + b, (size_t)np * sizeof(gp_vec2));
     int32_t hn = hull(v->hv, np, v->hv + np);
     if (hn < 3) return GP_ERR_INTERNAL;
-    out->orient = convex_orientation(v->hv + np, hn, (1e-13 * v->L) * (1e-13 * v->L));
+    gp_vec2 he; /* a part's hull, not the cell: out->oe stays NaN, never reused */
+    out->orient = convex_orientation(v->hv + np, hn, (1e-13 * v->L) * (1e-13 * v->L), NULL, &he);
     return GP_OK;
 }
 
@@ -1038,6 +1044,7 @@ typedef struct cell_run {
     int ina;
     double rmax2;
     uint32_t es;         /* this cell's stamp in v->estamp */
+    const vcell *prev;   /* in a move, the cell before it (convex_orientation); else NULL */
     int32_t bx, by;      /* the seed's bin */
     double epsr;
 } cell_run;
@@ -1273,6 +1280,7 @@ static gp_status cell_finish(cell_run *R, vcell *out)
     const int32_t m = R->m;
     gp_vec2 *cv = R->ina ? v->sb : v->sa; /* canonical copy into the other buffer */
     int32_t *ct = R->ina ? v->tb : v->ta;
+    out->oe = (gp_vec2){NAN, NAN};
     canonicalise(v, R->s, R->ina ? v->sa : v->sb, R->ina ? v->ta : v->tb, m, cv, ct);
     gp_status st = cell_neighbours(v, out, ct, m);
     if (st != GP_OK) return st;
@@ -1292,7 +1300,7 @@ static gp_status cell_finish(cell_run *R, vcell *out)
     out->poff[1] = m;
     out->convex = 1;
     out->area = ring_area_about(cv, m, R->s);
-    out->orient = convex_orientation(cv, m, R->epsr * R->epsr);
+    out->orient = convex_orientation(cv, m, R->epsr * R->epsr, R->prev, &out->oe);
     if (!(out->area > 0.0)) return GP_ERR_INTERNAL;
     return GP_OK;
 }
@@ -1450,6 +1458,7 @@ static gp_status compute_cell_nb(gp_voronoi *v, uint32_t j, const vcell *old_j, 
     gp_status st = cell_init(&R, v, j);
     if (st == GP_OK && old_j->nv + 2 > v->scap && scratch_reserve(v, old_j->nv + 2)) st = GP_ERR_NOMEM;
     if (st != GP_OK) return st;
+    R.prev = old_j;
     /* from old C_j less i's edge (exactly: 2), j's old lines are in already; else they clip */
     const int start = unclip_start(&R, old_j, i), skip_j = start == 2;
     if (start == 0) cell_box(&R, 1);
@@ -1594,6 +1603,7 @@ static gp_status compute_cell_moved(gp_voronoi *v, uint32_t i, vcell *out)
     cell_run R;
     gp_status st = cell_start(&R, v, i, 1);
     if (st != GP_OK) return st;
+    R.prev = v->cell[i]; /* still the cell before the move (recompute swaps it after) */
     const gp_vec2 s = R.s;
     double d0;
     int32_t k0 = nearest_node(v, s, &d0), nh = 0;
@@ -1641,6 +1651,7 @@ static gp_status compute_cell_cut(gp_voronoi *v, uint32_t j, const vcell *old_j,
     if (st != GP_OK) return st;
     memcpy(v->sa, old_j->v, (size_t)old_j->nv * sizeof(gp_vec2));
     memcpy(v->ta, old_j->tag, (size_t)old_j->nv * sizeof(int32_t));
+    R.prev = old_j;
     R.m = old_j->nv;
     R.ina = 1;
     const gp_vec2 s = R.s;
@@ -2307,6 +2318,7 @@ static int cell_copy(vcell *dst, const vcell *src)
     dst->convex = src->convex;
     dst->area = src->area;
     dst->orient = src->orient;
+    dst->oe = src->oe;
     return 0;
 }
 
