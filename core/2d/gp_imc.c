@@ -29,10 +29,15 @@
  * thread, 129k-138k on two -- not 2x: a round lasts as long as its slowest lane (a jump
  * recomputes ~18 cells, a short move ~9), and the settling (rollbacks, the accepted move's
  * statistics and its copies into the replicas) is serial; perf showed 24 % of both threads'
- * time waiting. While a third of the steps are accepted (N = 100,000, its first 10^5 steps)
- * two threads gain 5 %: every step after an accepted one is evaluated again. What would help
- * there: keep a speculated step whose cells (and those its proposal and recomputation read) are
- * disjoint from the accepted step's, judging it again against the new statistics only.
+ * time waiting. A step evaluated after an accepted one in the same round is kept when its
+ * footprint is clear of the accepted move's cells (gp_voronoi_footprint), and only judged
+ * again; yet while a third of the steps are accepted (N = 100,000, its first 10^5 steps) two
+ * threads gain only 6 % (36.4k steps/s against 34.2k), 8 % at N = 10,000 (12 % accepted):
+ * the settling is serial, and an accepted step's part of it -- 2 x 9 cells into the AD
+ * statistics, its copy into 3 replicas, the next lane judged again (20 rank queries) -- is as
+ * long as a step at that N (perf: the helper waits 22 % of its time). Splitting that work
+ * between the threads (the two statistics are independent, each replica could take its copy
+ * on its own thread) is what is left.
  * Memory order (issue #16): generated seeds are numbered along a Hilbert curve (hilbert_sort),
  * and gp_voronoi keeps each cell's data in place across moves, so a step's ~9 cells lie
  * together. Cachegrind, N = 100,000, per step over steps 20,000-60,000, with a 512 KiB last
@@ -787,7 +792,10 @@ typedef struct lane {
     step_buf b;
     long step;
     int out, pending;
+    int redo;                  /* settle_round: evaluated on a tessellation that has changed */
     objective nw;
+    uint32_t *fp;              /* the pending move's footprint (gp_voronoi_footprint) */
+    size_t nfp, fpcap;
 } lane;
 
 /* d1-d5 for lane L's step, judged against cur without changing anything shared (S and the AD
@@ -836,23 +844,6 @@ static int judge_serial(imc_state *S, lane *L, const objective *cur)
     if (not_worse(&L->nw, cur)) return LANE_ACCEPT;
     for (size_t k = nch; k-- > 0;) cell_put(S, ch[k], &L->b.undo[k]);
     return LANE_REJECT;
-}
-
-/* Lane w's move becomes the run's: recorded in the statistics (unless judge_serial did), given
- * to every other replica (whose own moves were rolled back), committed. */
-static gp_status lane_commit(imc_state *S, lane *lanes, int nl, int w, int put, objective *cur,
-                             gp_error *err)
-{
-    lane *L = &lanes[w];
-    const uint32_t *ch;
-    size_t nch = gp_voronoi_changed(L->v, &ch);
-    for (size_t k = 0; put && k < nch; k++) cell_put(S, ch[k], &L->b.nv[k]);
-    for (int u = 0; u < nl; u++)
-        if (u != w && gp_voronoi_apply(lanes[u].v, L->v, err) != GP_OK) return GP_ERR_NOMEM;
-    gp_voronoi_commit(L->v);
-    L->pending = 0;
-    *cur = put ? evaluate(S) : L->nw; /* the what-if rounds the extras sum */
-    return GP_OK;
 }
 
 static int cancel_raised(const volatile int *cancel)
@@ -913,6 +904,7 @@ typedef struct run_ctx {
     int nl, nt, nr;            /* lanes, threads, lanes this round (thread t evaluates lanes t,
                                 * t + nt, ... < nr) */
     double acc_rate;           /* recent fraction of steps accepted (a moving average) */
+    uint32_t *wmark, mark;     /* per cell: the mark of the last accepted move that changed it */
     objective cur;
     run_out ro;
     double best;
@@ -945,44 +937,112 @@ static int stop_before_step(run_ctx *C)
     return 0;
 }
 
-/* A round's steps in order, as one thread would take them, up to the first accepted one (the
- * lanes after it evaluated a tessellation that no longer stands: their steps are taken again
- * next round, with the same streams); every other pending move is rolled back. Returns 1 when
- * the run stops. */
+/* Lane u's footprint into u->fp; -1 out of memory. */
+static int lane_footprint(lane *u)
+{
+    size_t need = gp_voronoi_footprint(u->v, u->fp, u->fpcap);
+    if (need > u->fpcap) {
+        uint32_t *f = realloc(u->fp, 2 * need * sizeof *f);
+        if (!f) return -1;
+        u->fp = f;
+        u->fpcap = 2 * need;
+        need = gp_voronoi_footprint(u->v, u->fp, u->fpcap);
+    }
+    u->nfp = need;
+    return 0;
+}
+
+/* Lane w's move becomes the run's: recorded in the statistics (unless judge_serial did), given
+ * to every other replica, committed. A later lane of the round whose pending move is clear of
+ * w's changed cells (gp_voronoi_footprint) keeps it and takes w's move underneath; one that is
+ * not is rolled back and marked redo, and so is a later lane without a pending move (its
+ * proposal may have read w's cells). */
+static gp_status lane_commit(run_ctx *C, int w, int put, gp_error *err)
+{
+    lane *L = &C->lanes[w];
+    const uint32_t *ch;
+    size_t nch = gp_voronoi_changed(L->v, &ch);
+    for (size_t k = 0; put && k < nch; k++) cell_put(C->S, ch[k], &L->b.nv[k]);
+    if (++C->mark == 0 && C->wmark) { /* wrapped (2^32 accepted moves): start the marks again */
+        memset(C->wmark, 0, C->S->n * sizeof *C->wmark);
+        C->mark = 1;
+    }
+    uint32_t mark = C->mark;
+    for (size_t k = 0; C->wmark && k < nch; k++) C->wmark[ch[k]] = mark; /* NULL: one lane */
+    for (int u = 0; u < C->nl; u++) {
+        lane *U = &C->lanes[u];
+        if (u == w) continue;
+        if (u > w && u < C->nr && !U->redo) {
+            int clear = U->pending;
+            if (clear && lane_footprint(U) != 0) return gp_error_set(err, GP_ERR_NOMEM, "imc: out of memory");
+            for (size_t k = 0; clear && k < U->nfp; k++) clear = C->wmark[U->fp[k]] != mark;
+            if (!clear) {
+                U->redo = 1;
+                if (U->pending) gp_voronoi_rollback(U->v);
+                U->pending = 0;
+            }
+        }
+        if (gp_voronoi_apply(U->v, L->v, err) != GP_OK) return GP_ERR_NOMEM;
+    }
+    gp_voronoi_commit(L->v);
+    L->pending = 0;
+    C->cur = put ? evaluate(C->S) : L->nw; /* the what-if rounds the extras sum */
+    return GP_OK;
+}
+
+/* The outcome of lane L's step taken now: as evaluated while no step of the round was accepted
+ * before it, else judged again against the statistics as they are (its cells are those it
+ * would have computed, lane_commit saw to that). */
+static int lane_outcome(run_ctx *C, lane *L, int after_win)
+{
+    if (L->out == LANE_SERIAL) return judge_serial(C->S, L, &C->cur);
+    if (after_win && (L->out == LANE_ACCEPT || L->out == LANE_REJECT)) {
+        const uint32_t *ch;
+        size_t nch = gp_voronoi_changed(L->v, &ch);
+        L->nw = evaluate_ad_if(C->S, ch, nch, L->b.nv, &L->b);
+        return not_worse(&L->nw, &C->cur) ? LANE_ACCEPT : LANE_REJECT;
+    }
+    return L->out;
+}
+
+/* A round's steps in order, as one thread would take them: each accepted step is committed
+ * (lane_commit), and the round goes on with the next lane unless that lane must be redone;
+ * the lanes from there on are taken again next round, with the same streams. Every pending
+ * move left is rolled back. Returns 1 when the run stops. */
 static int settle_round(run_ctx *C, gp_status *st, gp_error *err)
 {
-    int w = -1, put = 1, stop = 0;
-    for (int t = 0; t < C->nr && w < 0; t++) {
-        if (stop_before_step(C)) {
-            stop = 1;
+    int stop = 0, wins = 0;
+    for (int t = 0; t < C->nr && !stop; t++) {
+        lane *L = &C->lanes[t];
+        if (L->redo || stop_before_step(C)) {
+            stop = !L->redo;
             break;
         }
         C->ro.steps++;
-        lane *L = &C->lanes[t];
-        int out = L->out;
-        if (out == LANE_NOMEM) {
+        if (L->out == LANE_NOMEM) {
             *st = gp_error_set(err, GP_ERR_NOMEM, "imc: out of memory");
             stop = 1;
             break;
         }
-        if (out == LANE_SERIAL) out = judge_serial(C->S, L, &C->cur);
-        if (out == LANE_ACCEPT) {
-            w = t;
-            put = L->out != LANE_SERIAL;
-        }
+        int out = lane_outcome(C, L, wins > 0);
         C->acc_rate = 0.99 * C->acc_rate + (out == LANE_ACCEPT ? 0.01 : 0.0);
-    }
-    for (int t = 0; t < C->nr; t++)
-        if (t != w && C->lanes[t].pending) {
-            gp_voronoi_rollback(C->lanes[t].v);
-            C->lanes[t].pending = 0;
+        if (out != LANE_ACCEPT) {
+            if (L->pending) gp_voronoi_rollback(L->v); /* before a later win copies into it */
+            L->pending = 0;
+            continue;
         }
-    if (w >= 0) {
         C->ro.accepted++;
-        if (lane_commit(C->S, C->lanes, C->nl, w, put, &C->cur, err) != GP_OK) {
+        wins++;
+        if (lane_commit(C, t, L->out != LANE_SERIAL, err) != GP_OK) {
             *st = GP_ERR_NOMEM;
             stop = 1;
         }
+    }
+    for (int t = 0; t < C->nl; t++) {
+        lane *L = &C->lanes[t];
+        if (L->pending) gp_voronoi_rollback(L->v);
+        L->pending = 0;
+        L->redo = 0;
     }
     return stop;
 }
@@ -992,7 +1052,8 @@ static int settle_round(run_ctx *C, gp_status *st, gp_error *err)
  * (below 5 %), GP_IMC_LANES_PER_THREAD per thread, which evens out the threads' loads (a
  * round lasts as long as its slowest thread). N = 1,000, 2 threads, 1 % accepted: 127k steps/s
  * with 1 lane per thread, 139k with 2, 138k with 3; N = 100,000, 33 % accepted: 37.8k, 29.5k,
- * 23.3k (one thread: 31.6k). Which lanes run changes nothing but the speed. */
+ * 23.3k (one thread: 31.6k) before lanes after an accepted step were kept, 36.4k with 1 lane a
+ * thread and 33.2k with 2 since. Which lanes run changes nothing but the speed. */
 static void number_lanes(run_ctx *C)
 {
     C->nr = C->acc_rate < 0.05 ? C->nl : C->nt;
@@ -1062,8 +1123,11 @@ static void lanes_free(run_ctx *C)
         if (t > 0) gp_voronoi_destroy(C->lanes[t].v);
         if (C->lanes[t].rng) gsl_rng_free(C->lanes[t].rng);
         step_buf_free(&C->lanes[t].b);
+        free(C->lanes[t].fp);
     }
     free(C->lanes);
+    free(C->wmark);
+    C->wmark = NULL;
     gp_team_destroy(C->team);
     C->lanes = NULL;
     C->team = NULL;
@@ -1089,6 +1153,8 @@ static gp_status lanes_init(run_ctx *C, gp_voronoi *v, replica_job *J, gp_error 
     }
     C->lanes[0].v = v;
     if (C->nl == 1) return GP_OK;
+    C->wmark = calloc(C->S->n, sizeof *C->wmark);
+    if (!C->wmark) return gp_error_set(err, GP_ERR_NOMEM, "imc: out of memory");
     J->lanes = C->lanes;
     J->nl = C->nl;
     J->nt = C->nt;

@@ -2361,11 +2361,22 @@ size_t gp_voronoi_changed(const gp_voronoi *v, const uint32_t **cells)
     return v->nchg;
 }
 
+/* 1 when dst's pending move (if any) and src's share a changed cell (the moved seeds are
+ * changed cells of their own moves) */
+static int moves_overlap(const gp_voronoi *dst, const gp_voronoi *src)
+{
+    for (uint32_t a = 0; dst->pending && a < dst->nchg; a++)
+        for (uint32_t b = 0; b < src->nchg; b++)
+            if (dst->chg[a] == src->chg[b]) return 1;
+    return 0;
+}
+
 /* dst's cell j becomes src's (content), seed i and its bin follow src's pending move */
 gp_status gp_voronoi_apply(gp_voronoi *dst, const gp_voronoi *src, gp_error *err)
 {
-    if (!dst || !src || !src->pending || dst->pending || dst->n != src->n)
-        return gp_error_set(err, GP_ERR_INVALID, "voronoi apply: need a pending move in src, none in dst");
+    if (!dst || !src || !src->pending || dst->n != src->n || moves_overlap(dst, src))
+        return gp_error_set(err, GP_ERR_INVALID,
+                            "voronoi apply: need a pending move in src, none in dst that changes the same cells");
     const uint32_t i = src->mv_i;
     gp_vec2 o = dst->seed[i], p = src->seed[i];
     int32_t bo = bin_y(dst, o.y) * dst->nbx + bin_x(dst, o.x), bn = bin_y(dst, p.y) * dst->nbx + bin_x(dst, p.x);
@@ -2381,6 +2392,23 @@ gp_status gp_voronoi_apply(gp_voronoi *dst, const gp_voronoi *src, gp_error *err
             return gp_error_set(err, GP_ERR_NOMEM, "voronoi apply: out of memory (dst is now unusable)");
     }
     return GP_OK;
+}
+
+size_t gp_voronoi_footprint(const gp_voronoi *v, uint32_t *out, size_t cap)
+{
+    if (!v || !v->pending) return 0;
+    size_t cnt = 0;
+    for (uint32_t k = 0; k < v->nchg; k++) {
+        const vcell *now = v->cell[v->chg[k]], *was = v->chg_old[k];
+        if (cnt < cap) out[cnt] = v->chg[k];
+        cnt++;
+        for (int pass = 0; pass < 2; pass++) {
+            const vcell *c = pass ? was : now;
+            for (int32_t q = 0; q < c->nnb; q++, cnt++)
+                if (cnt < cap) out[cnt] = (uint32_t)c->nb[q];
+        }
+    }
+    return cnt;
 }
 
 gp_status gp_voronoi_move(gp_voronoi *v, size_t i, gp_vec2 p, gp_error *err)

@@ -115,12 +115,24 @@ size_t gp_voronoi_changed(const gp_voronoi *v, const uint32_t **cells);
 
 /* Replicas (gp_imc.c evaluates moves in parallel, one replica per thread). dst must hold the
  * tessellation src held before its pending move (built from the same container and seeds, and
- * given the same moves since) with no move pending; dst then takes src's pending move as it
- * stands -- the moved seed and a copy of every changed cell, bit for bit, without recomputing
- * anything -- and src may then commit. GP_ERR_INVALID without a pending move in src, or with
- * one in dst; GP_ERR_NOMEM leaves dst unusable (destroy it). dst and src are both touched
- * (src only read): neither may be used by another thread meanwhile. */
+ * given the same moves since); dst then takes src's pending move as it stands -- the moved
+ * seed and a copy of every changed cell, bit for bit, without recomputing anything -- and src
+ * may then commit. dst may hold a pending move of its own that changes none of src's changed
+ * cells: src's move then goes in underneath it, and dst's commit or rollback still works.
+ * GP_ERR_INVALID without a pending move in src, or with a pending move in dst that changes one
+ * of the same cells; GP_ERR_NOMEM leaves dst unusable (destroy it). dst and src are both
+ * touched (src only read): neither may be used by another thread meanwhile. */
 gp_status gp_voronoi_apply(gp_voronoi *dst, const gp_voronoi *src, gp_error *err);
+
+/* The footprint of the pending move: its changed cells and their neighbours before and after
+ * it, written into out (at most cap; repeats possible); returns the count (0 with no move
+ * pending). A move B evaluated beside a move A on the same tessellation is the move B would
+ * be after A (the same changed cells, bit for bit) when A's changed cells are outside B's
+ * footprint: every cell B recomputes is bounded by seeds of its footprint both before and
+ * after B, and the region B takes or frees goes to its neighbours' cells, none of which A
+ * touched; the seed A moves is a changed cell of A, so it is neither a neighbour of B's cells
+ * at its old place nor at its new one. */
+size_t gp_voronoi_footprint(const gp_voronoi *v, uint32_t *out, size_t cap);
 
 /* A point uniformly distributed in cell i (all parts), drawn with u01() (uniform in [0, 1),
  * called a variable number of times). Returns 0 and the point in *p, or -1 if 1000 rejection
