@@ -131,7 +131,8 @@ gp_status gp_voronoi_apply(gp_voronoi *dst, const gp_voronoi *src, gp_error *err
  * footprint: every cell B recomputes is bounded by seeds of its footprint both before and
  * after B, and the region B takes or frees goes to its neighbours' cells, none of which A
  * touched; the seed A moves is a changed cell of A, so it is neither a neighbour of B's cells
- * at its old place nor at its new one. */
+ * at its old place nor at its new one. (Disjoint changed cells alone may well be enough --
+ * test_voronoi's side-by-side moves pass with that too -- but that is not argued here.) */
 size_t gp_voronoi_footprint(const gp_voronoi *v, uint32_t *out, size_t cap);
 
 /* A point uniformly distributed in cell i (all parts), drawn with u01() (uniform in [0, 1),

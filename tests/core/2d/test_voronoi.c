@@ -615,6 +615,68 @@ static void property_moves(const char *name, const gp_vec2 *outer, size_t no, co
     free(s);
 }
 
+/* Two moves evaluated side by side on two replicas (gp_imc.c's lanes): when A's changed cells
+ * are outside B's footprint, B goes on top of A as it was computed -- A applied underneath B's
+ * pending move, then B committed and copied back -- and the result is the tessellation a
+ * fresh build of the final seeds gives, bit for bit; B rolled back instead leaves A alone. */
+static void moves_side_by_side(const char *name, const gp_vec2 *outer, size_t no, const gp_vec2 *const *holes,
+                               const size_t *nh, size_t nholes, int N, int trials)
+{
+    gp_vec2 *s = malloc((size_t)N * sizeof *s);
+    gp_vec2 lo, hi;
+    gp_poly_bbox(outer, no, &lo, &hi, NULL);
+    for (int i = 0; i < N; i++)
+        s[i] = rand_in(outer, no, nholes ? holes[0] : NULL, nholes ? nh[0] : 0, lo.x, lo.y, hi.x, hi.y);
+    gp_voronoi *v = gp_voronoi_create(outer, no, holes, nh, nholes, s, (size_t)N, NULL);
+    gp_voronoi *w = gp_voronoi_create(outer, no, holes, nh, nholes, s, (size_t)N, NULL);
+    CHECK(v && w);
+    static uint32_t fp[4096];
+    int bad = 0, kept = 0, dropped = 0, clashes = 0;
+    for (int t = 0; v && w && t < trials; t++) {
+        size_t i = (size_t)(urand() * N), j = (size_t)(urand() * N);
+        gp_vec2 p = {lo.x + (hi.x - lo.x) * urand(), lo.y + (hi.y - lo.y) * urand()};
+        gp_vec2 q = {lo.x + (hi.x - lo.x) * urand(), lo.y + (hi.y - lo.y) * urand()};
+        if (!gp_voronoi_contains(v, p) || !gp_voronoi_contains(v, q)) continue;
+        int a = gp_voronoi_try_move(v, i, p, NULL) == GP_OK, b = a && gp_voronoi_try_move(w, j, q, NULL) == GP_OK;
+        if (!b) {
+            gp_voronoi_rollback(v);
+            continue;
+        }
+        const uint32_t *ch;
+        size_t nch = gp_voronoi_changed(v, &ch), nfp = gp_voronoi_footprint(w, fp, 4096);
+        int clear = nfp <= 4096;
+        for (size_t k = 0; clear && k < nfp; k++)
+            for (size_t m = 0; clear && m < nch; m++) clear = fp[k] != ch[m];
+        if (!clear) {
+            clashes++;
+            gp_voronoi_rollback(v);
+            gp_voronoi_rollback(w);
+            continue;
+        }
+        if (gp_voronoi_apply(w, v, NULL) != GP_OK) bad++;
+        gp_voronoi_commit(v);
+        if (urand() < 0.5) {
+            if (gp_voronoi_apply(v, w, NULL) != GP_OK) bad++;
+            gp_voronoi_commit(w);
+            kept++;
+        } else {
+            gp_voronoi_rollback(w);
+            dropped++;
+        }
+        if (t % 50 == 0) compare_full(v, outer, no, holes, nh, nholes, &bad);
+    }
+    if (v && w) {
+        compare_full(v, outer, no, holes, nh, nholes, &bad);
+        compare_replica(v, w, &bad);
+    }
+    printf("%s: %d second moves kept on top of the first, %d dropped, %d clashed\n", name, kept, dropped, clashes);
+    CHECK(bad == 0);
+    CHECK(kept > trials / 20 && clashes > 0);
+    gp_voronoi_destroy(v);
+    gp_voronoi_destroy(w);
+    free(s);
+}
+
 /* gp_voronoi_create_ex: a raised cancel flag stops a large tessellation (GP_ERR_CANCELLED, NULL),
  * a lowered one changes nothing (the same cells, bit for bit, as gp_voronoi_create); a small
  * one (under the polling interval) is never cut short. */
@@ -694,6 +756,9 @@ int main(void)
     property_moves("annulus N=150", c, nc, holes, &nh, 1, 150, 10000, 25);
     /* more cells: the moved seed's search walks far on the neighbour graph (jumps anywhere) */
     property_moves("square N=3000", sq, 4, NULL, NULL, 0, 3000, 10000, 2500);
+    moves_side_by_side("side by side, square N=400", sq, 4, NULL, NULL, 0, 400, 2000);
+    moves_side_by_side("side by side, L-shape N=300", L, 6, NULL, NULL, 0, 300, 2000);
+    moves_side_by_side("side by side, annulus N=300", c, nc, holes, &nh, 1, 300, 2000);
     free(c);
     free(h);
     test_cancel(); /* last: it draws from urand() */
