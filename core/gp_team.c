@@ -5,6 +5,7 @@
 #include <sched.h>
 #include <stdlib.h>
 #include <time.h>
+#include <unistd.h>
 
 /* how long a helper spins after a round before it sleeps, and the caller before it yields */
 #define SPIN_NS 100000L
@@ -99,6 +100,8 @@ gp_team *gp_team_create(int size, gp_error *err)
         return NULL;
     }
     t->size = 1;
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    if (cpus >= 1 && size > cpus) size = (int)cpus; /* a spinning team beyond the CPUs only waits */
     if (size <= 1) return t;
     t->th = calloc((size_t)size, sizeof *t->th);
     t->args = calloc((size_t)size, sizeof *t->args);

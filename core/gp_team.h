@@ -13,9 +13,11 @@
  * caller's: for results that do not depend on the thread count, tid must pick a piece of
  * work, never decide how the work is done.
  *
- * Ownership: gp_team_create starts size - 1 threads (fewer when the system refuses some: the
- * team then has the threads it got, gp_team_size says how many, at least 1); gp_team_destroy
- * joins them. One caller at a time (gp_team_run is not reentrant, nor thread-safe). No global
+ * Ownership: gp_team_create starts size - 1 threads, fewer when the machine has fewer CPUs
+ * online than size (a thread that spins while another waits for its CPU only slows the round:
+ * the IMC at N = 1,000 ran 25.6k steps/s on 3 threads on 2 CPUs, 137k on 2, 92k on 1) or when
+ * the system refuses some; gp_team_size says how many the team has, at least 1.
+ * gp_team_destroy joins them. One caller at a time (gp_team_run is not reentrant, nor thread-safe). No global
  * state.
  */
 #ifndef GP_TEAM_H
