@@ -65,17 +65,20 @@
  * tessellation it starts from. Near the end most steps are refused (99 % at N = 1,000), and a
  * refused step leaves the tessellation as it was: so T threads evaluate steps s + 1 .. s + k
  * at once, each on its own replica of the tessellation (read-only on the statistics), and the
- * round's steps are then taken in order up to the first accepted one, whose move the other
- * replicas copy (gp_voronoi_apply); the steps after it are evaluated again next round, with the
- * same streams. Every step is judged exactly as one thread judges it, against the same error,
- * so the run is the one-thread run bit for bit. Only AD runs use more than one thread, and
- * the replicas hold at most 500,000 cells together (a replica is a whole tessellation, ~660
- * bytes a cell): one thread from N = 500,000 on. N = 1,000, 2 threads: 1.57x the steps/s of
- * one; N = 100,000 while a third of the steps are accepted: 1.2x.
+ * round's steps are then taken in order. An accepted step's move is copied into the other
+ * replicas (gp_voronoi_apply); a later step of the round stands if its footprint is clear of
+ * that move's cells (gp_voronoi_footprint) and is judged again, else it is evaluated again next
+ * round, with the same stream. Every step is judged exactly as one thread judges it, against
+ * the same error, so the run is the one-thread run bit for bit. Only AD runs use more than one
+ * thread; the replicas hold at most 500,000 cells together (a replica is a whole tessellation,
+ * ~660 bytes a cell): one thread from N = 500,000 on; no more threads than CPUs online; and the
+ * run times stretches alone and on its threads and keeps the faster (a busy machine). N =
+ * 1,000, 2 threads: ~1.45x the steps/s of one; while a tenth to a third of the steps are
+ * accepted (N = 10,000 to 100,000, early), 1.02-1.1x: the settling of a round is serial.
  *
  * Determinism: the same container, N and params (seed included) give the same tessellation bit
  * for bit, whatever params.threads. Thread-safety: one run per call, no shared state; a run
- * with threads > 1 starts threads - 1 threads of its own and joins them before it returns.
+ * on more than one thread starts its own threads and joins them before it returns.
  */
 #ifndef GP_IMC_H
 #define GP_IMC_H
