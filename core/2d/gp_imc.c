@@ -13,8 +13,14 @@
  *     grid candidates                      139k (voronoi 109k)  169k (voronoi 103k)
  *     neighbour lists, AD on a treap        72k (voronoi  42k)  107k (voronoi  42k)
  *     AD on sorted blocks                   68k (voronoi  42k)   82k (voronoi  41k)
- *     leaner clipping and search (now)      65k (voronoi ~38k)   79k (voronoi ~38k)
- * Now, N = 1,000 / 100,000: the tessellation ~38k (clipping ~8k, canonical lines 5.7k,
+ *     leaner clipping and search            65k (voronoi ~38k)   79k (voronoi ~38k)
+ *     unchanged orientations kept (now)     61.2k                75.6k
+ * The last row (one thread; the per-step streams draw other moves, so its steps are not the
+ * rows' above): recompute 19.0k / 18.2k, cell_finish 9.8k / 9.9k, the min caliper 5.9k / 5.9k,
+ * gp_adstat_a2_if 10.4k / 14.1k, gp_adstat_set 1.0k / 5.2k. The instructions grow 1.24x from
+ * N = 1,000 to 100,000, the time 2.7-2.9x: the rest is memory (blocks in key order, cells in
+ * a 66 MB tessellation) and accepted steps.
+ * Before, N = 1,000 / 100,000: the tessellation ~38k (clipping ~8k, canonical lines 5.7k,
  * min caliper 5.9k and atan2 1.3k, the moved seed's search ~4k, the rest cell bookkeeping),
  * the what-if of the two statistics (gp_adstat_a2_if) 15k / 18k (treap: 17k / 27k), the
  * cells' CDF values and logs 7.4k, committing accepted moves (gp_adstat_set) 1.9k / 12.6k
