@@ -74,6 +74,10 @@ def test_two_daemons_one_killed(env):
         time.sleep(0.02)
     a.kill9()
     t_kill = time.time()
+    # what a was running when it died, read again now: a job of the snapshot above may have
+    # finished (and a taken another) between that query and the kill
+    on_a = owned_by(env, a)
+    assert on_a, "daemon a died with no job running"
     # a's jobs still show running (their leases hold them) until b takes them over
     ids_sql = ", ".join("'%s'" % j for j in sorted(on_a))  # ids made by the daemon: hex only
     while True:
