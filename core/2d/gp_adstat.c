@@ -617,12 +617,32 @@ static void element_ranks(const gp_adstat *s, uint32_t id, double kn, int64_t wn
     side_add(sn, kn, id, wn, below, above);
 }
 
+/* The cache lines the rank queries of elements ids[] will read, asked for all at once: the
+ * queries themselves are chains of dependent loads (a directory search, then a search in a
+ * block of 1.4 KB), and at N = 100,000 the blocks are far from every cache level but the last
+ * (they are in key order: the ~9 cells of a step have unrelated keys), so one after the other
+ * each waits its full latency. */
+static void prefetch_ranks(const gp_adstat *s, size_t k, const size_t *ids)
+{
+    for (size_t i = 0; i < k; i++)
+        if (ids[i] < s->cap) __builtin_prefetch(&s->el[ids[i]]);
+    for (size_t i = 0; i < k; i++) {
+        if (ids[i] >= s->cap || !s->el[ids[i]].on) continue;
+        const block *b = &s->pool[s->dir[find_block(s, s->el[ids[i]].key, (uint32_t)ids[i])]];
+        for (size_t j = 0; j < BMAX; j += 64 / sizeof(double)) __builtin_prefetch(&b->key[j]);
+        __builtin_prefetch(&b->cpre[0]);
+        __builtin_prefetch(&b->cpre[NCH / 2]);
+        __builtin_prefetch(&b->w[b->n / 2]);
+    }
+}
+
 double gp_adstat_a2_if(const gp_adstat *s, size_t k, const size_t *ids, const double *key,
                        const double *g, const double *h, const double *extra, double *sum_extra)
 {
     size_t n = gp_adstat_count(s);
     if (n == 0) return 0.0;
     if (k > GP_ADSTAT_IF_MAX) return NAN;
+    if (s->nb > 64) prefetch_ranks(s, k, ids); /* below, the blocks stay in the nearest caches */
     side so, sn;
     so.k = sn.k = 0;
     i128 dg = 0, dh = 0;
