@@ -7,13 +7,16 @@
  * the tessellation (not the run's own numbers): the cell-area KS distance to the target law
  * as a fraction of its 5 % critical value 1.36/sqrt(N), the COV error, and the orientation KS
  * fraction. Then the raw step rate at N = 1k, 10k, 100k (COV 0.8, threshold 1e-12: the run never
- * stops) and the ratio of the 100k rate to the 1k rate: the rate is timed between the first
- * progress report (step 4096) and the end, so that neither the initial tessellation nor the
- * O(N) set-up of the objective counts, in wall time and in the process's CPU time (steadier on
- * a shared machine); the error reached is printed beside it.
- * Usage: bench_imc [max_steps] [speed_steps] [N]   (max_steps 0 skips the fidelity table; N: only
- * that rate row -- for callgrind: the instructions per step are the difference of two runs of
- * different speed_steps over their difference, the set-up cancelling out) */
+ * stops) and the ratio of the 100k rate to the 1k rate, on one thread and then on `threads`
+ * (gp_imc.h "Threads": the same steps, accepted moves and error whatever the count): the rate
+ * is timed between the first progress report (step 4096) and the end, so that neither the
+ * initial tessellation (nor the replicas' builds) nor the O(N) set-up of the objective counts,
+ * in wall time and in the process's CPU time (all threads'); the error reached is printed
+ * beside it.
+ * Usage: bench_imc [max_steps] [speed_steps] [N] [threads]   (max_steps 0 skips the fidelity
+ * table; N > 0: only that rate row, on `threads` -- for callgrind, with threads 1: the
+ * instructions per step are the difference of two runs of different speed_steps over their
+ * difference, the set-up cancelling out; threads defaults to 2) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -99,8 +102,8 @@ static void row(const shape *sh, size_t n, double cov, double aniso, int kind, l
     gp_imc_report_free(&r);
 }
 
-/* the process's CPU time: the run is single-threaded, and on a shared machine its CPU time is
- * steadier than wall time (the speed rows print both) */
+/* the process's CPU time, all threads' (the speed rows print it beside wall time: with one
+ * thread it is steadier on a shared machine; with more it shows what the steps cost in all) */
 static double cpu_now(void)
 {
     struct timespec t;
