@@ -4,11 +4,12 @@
 #include <pthread.h>
 #include <sched.h>
 #include <stdlib.h>
-#include <time.h>
 #include <unistd.h>
 
+#include "gp_clock.h"
+
 /* how long a helper spins after a round before it sleeps, and the caller before it yields */
-#define SPIN_NS 100000L
+#define SPIN_S 100e-6
 
 typedef struct helper {
     struct gp_team *t;
@@ -29,13 +30,6 @@ struct gp_team {
     helper *args;
 };
 
-static long now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1000000000L + ts.tv_nsec;
-}
-
 static inline void cpu_relax(void)
 {
 #if defined(__x86_64__) || defined(__i386__)
@@ -45,17 +39,17 @@ static inline void cpu_relax(void)
 #endif
 }
 
-/* The round after `seen`: spins for SPIN_NS (the clock read every 64 pauses), then sleeps. */
+/* The round after `seen`: spins for SPIN_S (the clock read every 64 pauses), then sleeps. */
 static unsigned wait_round(gp_team *t, unsigned seen)
 {
     unsigned g;
-    long t0 = 0;
+    double t0 = -1.0;
     for (int k = 0; (g = __atomic_load_n(&t->gen, __ATOMIC_ACQUIRE)) == seen; k++) {
         cpu_relax();
         if ((k & 63) != 63) continue;
-        long now = now_ns();
-        if (t0 == 0) t0 = now;
-        if (now - t0 < SPIN_NS) continue;
+        double now = gp_clock_seconds();
+        if (t0 < 0) t0 = now;
+        if (now - t0 < SPIN_S) continue;
         pthread_mutex_lock(&t->mu);
         __atomic_add_fetch(&t->sleepers, 1, __ATOMIC_SEQ_CST);
         while (__atomic_load_n(&t->gen, __ATOMIC_SEQ_CST) == seen) pthread_cond_wait(&t->cv, &t->mu);
@@ -150,12 +144,12 @@ void gp_team_run(gp_team *t, gp_team_fn fn, void *ctx)
     __atomic_store_n(&t->done, 0, __ATOMIC_RELAXED);
     start_round(t);
     fn(ctx, 0);
-    long t0 = 0;
+    double t0 = -1.0;
     for (int k = 0; __atomic_load_n(&t->done, __ATOMIC_ACQUIRE) < t->size - 1; k++) {
         cpu_relax();
         if ((k & 63) != 63) continue;
-        long now = now_ns();
-        if (t0 == 0) t0 = now;
-        if (now - t0 >= SPIN_NS) sched_yield(); /* a helper was preempted: let it run */
+        double now = gp_clock_seconds();
+        if (t0 < 0) t0 = now;
+        if (now - t0 >= SPIN_S) sched_yield(); /* a helper was preempted: let it run */
     }
 }

@@ -429,6 +429,18 @@ static double inertial_mass(const gp_dem3d_params *p, double r)
     return rs > r ? 4.0 / 3.0 * M_PI * rs * rs * rs * p->density * r / rs : m;
 }
 
+/* the least sqrt(m / 2 k_n) over the n spheres of s (x, y, z, r each): the time scale the
+ * DEM's step is a fraction of */
+static double packing_tmin(const gp_dem3d_params *p, const double *s, size_t n)
+{
+    double tmin = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        double r = s[4 * i + 3];
+        tmin = fmin(tmin, sqrt(inertial_mass(p, r) / (2 * p->young * r)));
+    }
+    return tmin;
+}
+
 /* adds k v v^T to K (6n x 6n), v given on the degrees of freedom a[0..na-1] */
 static void add_outer(gsl_matrix *K, double k, const size_t *a, const double *v, int na)
 {
@@ -578,11 +590,7 @@ static void test_dt_threshold(void)
     settled_packing(n, 101, s, &top);
     gp_dem3d_params p = base();
     p.scaled_radius = 0.0045;
-    double hi[3] = {0.045, 0.045, top}, tmin = INFINITY;
-    for (size_t i = 0; i < n; i++) {
-        double r = s[4 * i + 3];
-        tmin = fmin(tmin, sqrt(inertial_mass(&p, r) / (2 * p.young * r)));
-    }
+    double hi[3] = {0.045, 0.045, top}, tmin = packing_tmin(&p, s, n);
     gp_dem3d *d = in_box(&p, s, n, hi);
     gp_error e;
     CHECK(d && gp_dem3d_run(d, 1, &e) == GP_OK);
@@ -662,11 +670,7 @@ static void test_dt_per_damping(void)
     gp_dem3d_params p = base();
     p.scaled_radius = 0.0045;
     p.dt_safety = 0.5;
-    double hi[3] = {0.045, 0.045, top}, tmin = INFINITY;
-    for (size_t i = 0; i < n; i++) {
-        double r = s[4 * i + 3];
-        tmin = fmin(tmin, sqrt(inertial_mass(&p, r) / (2 * p.young * r)));
-    }
+    double hi[3] = {0.045, 0.045, top}, tmin = packing_tmin(&p, s, n);
     gp_error e;
     const double exps[2] = {0.5, 0.45};
     double ratio0 = 0;
