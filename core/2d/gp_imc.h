@@ -48,10 +48,12 @@
  * Histograms for the report are always computed (gp_imc_report), on the law's quantile classes,
  * whatever the objective.
  *
- * Step (d1-d5): pick a seed uniformly; move it to a point uniform in the union of its cell and
- * its neighbours' cells (a cell chosen by area, then a point uniform in it); update the cells
- * locally (gp_voronoi_try_move); update the objective for the changed cells; accept if the
- * error does not increase (plateaus are crossed), otherwise roll the tessellation back.
+ * Step (d1-d5): take the next seed of a sweep along the seeds' order (the paper picks one at
+ * random: gp_imc.c sweep_seed says why not, and what it changed); move it to a point uniform
+ * in the union of its cell and its neighbours' cells (a cell chosen by area, then a point
+ * uniform in it); update the cells locally (gp_voronoi_try_move); update the objective for the
+ * changed cells; accept if the error does not increase (plateaus are crossed), otherwise roll
+ * the tessellation back.
  *
  * Seed numbering: generated seeds (init uniform or Halton) are renumbered along a Hilbert curve
  * over the container's bounding box before the tessellation is built, so that neighbouring
