@@ -21,12 +21,12 @@
  * counts as at the limit. Ties of key are broken by the element's id, which is harmless only
  * where tied keys have equal g and h.
  *
- * Structure (gp_adstat.c): the elements in (key, id) order in blocks of at most 64 (keys, ids,
+ * Structure (gp_adstat.c): the elements in (key, id) order in blocks of at most 32 (keys, ids,
  * fixed w's, and chunk prefix sums of the w's), a directory of the blocks' first keys, and a
  * Fenwick tree of the blocks' counts and w-sums: a query is two short binary searches in
  * contiguous arrays and a Fenwick prefix -- a few cache lines, where a pointer tree walks
  * ~log2 N nodes spread over the heap. Blocks split when full and merge with a neighbour when
- * the two hold <= 40, so there are at most 2N / 41 + 1 of them; the pool for that is
+ * the two hold <= 20, so there are at most 2N / 21 + 1 of them; the pool for that is
  * allocated at create (calloc: untouched pages cost nothing) and nothing is allocated after.
  * The sum of extras is kept in a segment tree of fixed shape over ids (a function of the set
  * as well, in floating point).
