@@ -319,12 +319,12 @@ static void phases_table(size_t n, int threads)
            "(seconds; f+o+d = fill + odec + desc), what they made (SF, cells meeting F_S, mean "
            "discs and descriptors) and hashes of the grains' contours, discs and descriptors\n\n",
            n, threads);
-    printf("| grains | th | IMC s | fill s | odec s | desc s | f+o+d s | SF | met | discs | "
+    printf("| grains | th | IMC steps | IMC err | IMC s | fill s | odec s | desc s | f+o+d s | SF | met | discs | "
            "round | circ | regul | elong | contours | discs | desc |\n");
-    printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    printf("| %zu | %d | %.2f | %.2f | %.2f | %.2f | %.2f | %.5f | %zu | %.3f | %.5f | %.5f | "
+    printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    printf("| %zu | %d | %ld | %.4f | %.2f | %.2f | %.2f | %.2f | %.2f | %.5f | %zu | %.3f | %.5f | %.5f | "
            "%.5f | %.5f | %08x | %08x | %08x |\n",
-           sp->ngrains, threads, sp->t_imc, sp->t_fill, sp->t_odec, sp->t_descriptors,
+           sp->ngrains, threads, (long)sp->imc_steps, sp->imc_error, sp->t_imc, sp->t_fill, sp->t_odec, sp->t_descriptors,
            sp->t_fill + sp->t_odec + sp->t_descriptors, sp->solid_fraction, sp->cells_target_met,
            m[0] * k, m[1] * k, m[2] * k, m[3] * k, m[4] * k, fold(hc), fold(hd), fold(hq));
     gp_specimen2d_destroy(sp);
