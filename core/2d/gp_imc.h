@@ -74,9 +74,10 @@
  * the same error, so the run is the one-thread run bit for bit. Only AD runs use more than one
  * thread; the replicas hold at most 500,000 cells together (a replica is a whole tessellation,
  * ~660 bytes a cell): one thread from N = 500,000 on; no more threads than CPUs online; and the
- * run times stretches alone and on its threads and keeps the faster (a busy machine). N =
- * 1,000, 2 threads: ~1.45x the steps/s of one; while a tenth to a third of the steps are
- * accepted (N = 10,000 to 100,000, early), 1.02-1.1x: the settling of a round is serial.
+ * run times stretches alone and on its threads and keeps the faster (a busy machine). 2
+ * threads against one (bench_imc): N = 1,000 ~1.5x, N = 10,000 1.3-1.4x; N = 100,000 in its
+ * first 10^5 steps, a third of them accepted, 0.91-0.94x: the settling of a round is serial,
+ * so the run goes alone, and the other replicas still take each accepted move.
  *
  * Determinism: the same container, N and params (seed included) give the same tessellation bit
  * for bit, whatever params.threads. Thread-safety: one run per call, no shared state; a run
