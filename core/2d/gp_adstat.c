@@ -603,29 +603,23 @@ static i128 side_pairs(const side *sd, const side *old)
     return p;
 }
 
-/* Both values of element id into the sides: the old one is in the set (one directory search);
- * the new one, usually near it, reuses that search when it falls in the same block. */
-static void element_ranks(const gp_adstat *s, uint32_t id, double kn, int64_t wn, side *so, side *sn)
+/* Both values of element id into the sides: the old one at directory position d (it is in
+ * the set), the new one at dn (d itself when it falls in the same block: one Fenwick prefix
+ * for both). */
+static void element_ranks(const gp_adstat *s, uint32_t id, double kn, int64_t wn, size_t d, size_t dn,
+                          side *so, side *sn)
 {
     double ko = s->el[id].key;
-    size_t d = find_block(s, ko, id), c, below;
+    size_t c, below;
     i128 wd, above;
     fen_prefix(s, d, &c, &wd);
     rank_in(s, d, c, wd, ko, id, &below, &above);
     side_add(so, ko, id, s->el[id].g - s->el[id].h, below, above);
-    if (!in_block(s, d, kn, id)) {
-        d = find_block(s, kn, id);
-        fen_prefix(s, d, &c, &wd);
-    }
-    rank_in(s, d, c, wd, kn, id, &below, &above);
+    if (dn != d) fen_prefix(s, dn, &c, &wd);
+    rank_in(s, dn, c, wd, kn, id, &below, &above);
     side_add(sn, kn, id, wn, below, above);
 }
 
-/* The cache lines the rank queries of elements ids[] will read, asked for all at once: the
- * queries themselves are chains of dependent loads (a directory search, then a search in a
- * block of 0.7 KB), and at N = 100,000 the blocks are far from every cache level but the last
- * (they are in key order: the ~9 cells of a step have unrelated keys), so one after the other
- * each waits its full latency. */
 static void prefetch_block(const block *b)
 {
     for (size_t j = 0; j < BMAX; j += 64 / sizeof(double)) __builtin_prefetch(&b->key[j]);
@@ -634,16 +628,24 @@ static void prefetch_block(const block *b)
     __builtin_prefetch(&b->w[b->n / 2]);
 }
 
-static void prefetch_ranks(const gp_adstat *s, size_t k, const size_t *ids, const double *key)
+/* The blocks of the old and the new value of each present element ids[i] (d[i], dn[i]), found
+ * once for the queries that follow. Above 64 blocks their cache lines are asked for at once:
+ * the queries themselves are chains of dependent loads (a directory search, then a search in
+ * a block of 0.7 KB), and at N = 100,000 the blocks are far from every cache level but the
+ * last (they are in key order: the ~9 cells of a step have unrelated keys), so one after the
+ * other each would wait its full latency. */
+static void find_blocks(const gp_adstat *s, size_t k, const size_t *ids, const double *key, size_t *d,
+                        size_t *dn)
 {
-    for (size_t i = 0; i < k; i++)
+    int far = s->nb > 64; /* below, the blocks stay in the nearest caches */
+    for (size_t i = 0; far && i < k; i++)
         if (ids[i] < s->cap) __builtin_prefetch(&s->el[ids[i]]);
     for (size_t i = 0; i < k; i++) {
         if (ids[i] >= s->cap || !s->el[ids[i]].on) continue;
-        size_t d = find_block(s, s->el[ids[i]].key, (uint32_t)ids[i]);
-        prefetch_block(&s->pool[s->dir[d]]);
-        if (!in_block(s, d, key[i], (uint32_t)ids[i]))
-            prefetch_block(&s->pool[s->dir[find_block(s, key[i], (uint32_t)ids[i])]]);
+        d[i] = find_block(s, s->el[ids[i]].key, (uint32_t)ids[i]);
+        dn[i] = in_block(s, d[i], key[i], (uint32_t)ids[i]) ? d[i] : find_block(s, key[i], (uint32_t)ids[i]);
+        if (far) prefetch_block(&s->pool[s->dir[d[i]]]);
+        if (far && dn[i] != d[i]) prefetch_block(&s->pool[s->dir[dn[i]]]);
     }
 }
 
@@ -653,7 +655,8 @@ double gp_adstat_a2_if(const gp_adstat *s, size_t k, const size_t *ids, const do
     size_t n = gp_adstat_count(s);
     if (n == 0) return 0.0;
     if (k > GP_ADSTAT_IF_MAX) return NAN;
-    if (s->nb > 64) prefetch_ranks(s, k, ids, key); /* below, the blocks stay in the nearest caches */
+    size_t d[GP_ADSTAT_IF_MAX], dn[GP_ADSTAT_IF_MAX];
+    find_blocks(s, k, ids, key, d, dn);
     side so, sn;
     so.k = sn.k = 0;
     i128 dg = 0, dh = 0;
@@ -665,7 +668,7 @@ double gp_adstat_a2_if(const gp_adstat *s, size_t k, const size_t *ids, const do
         dg += (i128)gf - s->el[id].g;
         dh += (i128)hf - s->el[id].h;
         dx += extra[i] - s->xt[s->P + id];
-        element_ranks(s, (uint32_t)id, key[i], gf - hf, &so, &sn);
+        element_ranks(s, (uint32_t)id, key[i], gf - hf, d[i], dn[i], &so, &sn);
     }
     side_sums(&so);
     side_sums(&sn);
