@@ -75,8 +75,8 @@
  * thread; the replicas hold at most 500,000 cells together (a replica is a whole tessellation,
  * ~660 bytes a cell): one thread from N = 500,000 on; no more threads than CPUs online; and the
  * run times stretches alone and on its threads and keeps the faster (a busy machine). 2
- * threads against one (bench_imc): N = 1,000 ~1.5x, N = 10,000 1.3-1.4x; N = 100,000 in its
- * first 10^5 steps, a third of them accepted, 0.91-0.94x: the settling of a round is serial,
+ * threads against one (bench_imc): N = 1,000 ~1.5x, N = 10,000 1.25-1.4x; N = 100,000 in its
+ * first 10^5 steps, a third of them accepted, 0.87-0.94x: the settling of a round is serial,
  * so the run goes alone, and the other replicas still take each accepted move.
  *
  * Determinism: the same container, N and params (seed included) give the same tessellation bit
