@@ -29,7 +29,7 @@
  * kind of update (a Delaunay structure kept by edge flips instead of re-clipping the cells).
  * What still grows with N is the commits, by the acceptance rate as much as by N, and the
  * cache misses: the treap's pointer walks (perf: 45 % of the time at N = 100,000 in its rank queries) are now binary
- * searches in contiguous blocks of 64.
+ * searches in contiguous blocks (of 32 since the sweep: gp_adstat.c, BMAX).
  * Threads (issue #16, gp_imc.h "Threads"): lanes evaluate the next steps at once on replicas
  * of the tessellation. bench_imc, N = 1,000 (1 % of steps accepted): 91.5k steps/s on one
  * thread, 129k-138k on two -- not 2x: a round lasts as long as its slowest lane (a jump

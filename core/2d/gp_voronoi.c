@@ -267,6 +267,9 @@ static inline int32_t bin_y(const gp_voronoi *v, double y)
     return b;
 }
 
+/* the bin of local point p */
+static inline int32_t bin_of(const gp_voronoi *v, gp_vec2 p) { return bin_y(v, p.y) * v->nbx + bin_x(v, p.x); }
+
 /* The bins a polygon's bounding box reaches, padded by 1e-9 L (an edge on a bin's border is
  * in both): r = {ix0, ix1, iy0, iy1}, inclusive. */
 static void poly_bins(const gp_voronoi *v, const gp_vec2 *p, size_t m, int32_t r[4])
@@ -2063,7 +2066,7 @@ static gp_status insert_seeds(gp_voronoi *v, const gp_vec2 *seeds, size_t n,
         if (dup_check(v, p, (uint32_t)i, &other))
             return gp_error_set(err, GP_ERR_INVALID, "voronoi: seeds %u and %zu coincide (duplicate seeds)",
                                 other, i);
-        if (bin_insert(&v->bins[bin_y(v, p.y) * v->nbx + bin_x(v, p.x)], (int32_t)i))
+        if (bin_insert(&v->bins[bin_of(v, p)], (int32_t)i))
             return gp_error_set(err, GP_ERR_NOMEM, "voronoi: out of memory");
     }
     return GP_OK;
@@ -2212,10 +2215,10 @@ static void undo(gp_voronoi *v)
     v->nchg = 0;
     uint32_t i = v->mv_i;
     gp_vec2 p = v->seed[i];
-    bin_remove(&v->bins[bin_y(v, p.y) * v->nbx + bin_x(v, p.x)], (int32_t)i);
+    bin_remove(&v->bins[bin_of(v, p)], (int32_t)i);
     v->seed[i] = v->mv_seed;
     v->useed[i] = v->mv_useed;
-    bin_insert(&v->bins[bin_y(v, v->mv_seed.y) * v->nbx + bin_x(v, v->mv_seed.x)], (int32_t)i);
+    bin_insert(&v->bins[bin_of(v, v->mv_seed)], (int32_t)i);
 }
 
 /* How a move recomputes a cell: the moved seed's (best-first search), a former neighbour of it
@@ -2262,15 +2265,15 @@ gp_status gp_voronoi_try_move(gp_voronoi *v, size_t i, gp_vec2 pu, gp_error *err
         return gp_error_set(err, GP_ERR_NOMEM, "voronoi move: out of memory");
     int32_t na = oc->nnb;
     memcpy(v->aff, oc->nb, (size_t)na * sizeof(int32_t));
-    bin_remove(&v->bins[bin_y(v, v->mv_seed.y) * v->nbx + bin_x(v, v->mv_seed.x)], (int32_t)i);
+    bin_remove(&v->bins[bin_of(v, v->mv_seed)], (int32_t)i);
     v->seed[i] = p;
     v->useed[i] = pu;
     gp_status st = GP_OK;
-    if (bin_insert(&v->bins[bin_y(v, p.y) * v->nbx + bin_x(v, p.x)], (int32_t)i)) {
+    if (bin_insert(&v->bins[bin_of(v, p)], (int32_t)i)) {
         st = GP_ERR_NOMEM;
         v->seed[i] = v->mv_seed;
         v->useed[i] = v->mv_useed;
-        bin_insert(&v->bins[bin_y(v, v->mv_seed.y) * v->nbx + bin_x(v, v->mv_seed.x)], (int32_t)i);
+        bin_insert(&v->bins[bin_of(v, v->mv_seed)], (int32_t)i);
         return gp_error_set(err, st, "voronoi move: out of memory");
     }
     st = recompute(v, (uint32_t)i, RC_MOVED, NULL);
@@ -2379,7 +2382,7 @@ gp_status gp_voronoi_apply(gp_voronoi *dst, const gp_voronoi *src, gp_error *err
                             "voronoi apply: need a pending move in src, none in dst that changes the same cells");
     const uint32_t i = src->mv_i;
     gp_vec2 o = dst->seed[i], p = src->seed[i];
-    int32_t bo = bin_y(dst, o.y) * dst->nbx + bin_x(dst, o.x), bn = bin_y(dst, p.y) * dst->nbx + bin_x(dst, p.x);
+    int32_t bo = bin_of(dst, o), bn = bin_of(dst, p);
     if (bo != bn) {
         if (bin_insert(&dst->bins[bn], (int32_t)i)) return gp_error_set(err, GP_ERR_NOMEM, "voronoi apply: out of memory");
         bin_remove(&dst->bins[bo], (int32_t)i);

@@ -420,12 +420,6 @@ static double unevenness(const gp_voronoi *v)
     return chi;
 }
 
-static int cmp_dbl(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* The two-sample KS distance between the areas of the cells on either side of the line
  * x = 0.5 (axis 0) or y = 0.5 (axis 1): whether both halves follow the same law, which a
  * mean cannot tell (the cells tile each half, whatever their law). */
@@ -438,8 +432,8 @@ static double halves_ks(const gp_voronoi *v, int axis)
         if ((axis ? q.y : q.x) < 0.5) a[na++] = gp_voronoi_cell_area(v, i);
         else b[nb++] = gp_voronoi_cell_area(v, i);
     }
-    qsort(a, na, sizeof *a, cmp_dbl);
-    qsort(b, nb, sizeof *b, cmp_dbl);
+    qsort(a, na, sizeof *a, cmp_double);
+    qsort(b, nb, sizeof *b, cmp_double);
     for (size_t i = 0, j = 0; i < na && j < nb;) {
         double x = a[i] <= b[j] ? a[i] : b[j];
         while (i < na && a[i] <= x) i++;
