@@ -6,6 +6,8 @@
 #include "gp_law.h"
 
 #include <gsl/gsl_cdf.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_integration.h>
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_sf_erf.h>
 #include <math.h>
@@ -36,6 +38,9 @@ struct gp_law {
     double ztot;
     /* tail law for bounded kinds: lognormal (tm, ts) */
     double tm, ts;
+    /* a powered law (gp_law_powered): A = lam B^kappa, B the law above (the "base"; every
+     * field above describes B); kappa = lam = 1 otherwise */
+    double kappa, lam;
 };
 
 const char *gp_law_name(gp_law_kind kind)
@@ -114,6 +119,7 @@ static gp_law *law_alloc(gp_law_kind kind)
     if (l) {
         l->kind = kind;
         l->scale = 1.0;
+        l->kappa = l->lam = 1.0;
     }
     return l;
 }
@@ -233,14 +239,76 @@ gp_law *gp_law_scaled(const gp_law *src, double factor, gp_error *err)
         l->cum = c->cum;
         free(c);
     }
-    l->scale = src->scale * factor;
     l->mean = src->mean * factor;
+    if (src->kappa != 1.0) { /* lam B^kappa -> (factor lam) B^kappa: the base stays */
+        l->lam = src->lam * factor;
+        return l;
+    }
+    l->scale = src->scale * factor;
     l->m += log(factor);
     l->tm += log(factor);
     l->mu *= factor;
     l->sigma *= factor;
     l->lo *= factor;
     l->hi *= factor;
+    return l;
+}
+
+static double base_quantile(const gp_law *l, double p);
+
+typedef struct moment_ctx {
+    const gp_law *base;
+    double power;
+} moment_ctx;
+
+static double quantile_power(double p, void *v)
+{
+    const moment_ctx *c = v;
+    return pow(base_quantile(c->base, p), c->power);
+}
+
+/* E[B^power] = integral over p in (0, 1) of Q_B(p)^power (GSL's QAGS: the ends may be
+ * singular, as Q -> inf at p -> 1 for an unbounded law); NaN when it does not converge */
+static double base_moment(const gp_law *base, double power)
+{
+    gsl_integration_workspace *w = gsl_integration_workspace_alloc(256);
+    if (!w) return NAN;
+    moment_ctx c = {base, power};
+    gsl_function f = {quantile_power, &c};
+    double r = NAN, e = 0;
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    int st = gsl_integration_qags(&f, 0.0, 1.0, 0.0, 1e-10, 256, w, &r, &e);
+    gsl_set_error_handler(old);
+    gsl_integration_workspace_free(w);
+    return st == GSL_SUCCESS || st == GSL_EROUND ? r : NAN;
+}
+
+gp_law *gp_law_powered(const gp_law *src, double kappa, double mean, gp_error *err)
+{
+    if (!src || !(kappa > 0 && kappa <= 4) || !(mean > 0) || !isfinite(mean)) {
+        gp_error_set(err, GP_ERR_INVALID, "law: power must be in (0, 4] and mean > 0 "
+                                          "(got %g, %g)", kappa, mean);
+        return NULL;
+    }
+    if (kappa == 1.0)
+        return gp_law_scaled(src, mean / src->mean, err);
+    if (src->kind == GP_LAW_LOGNORMAL) { /* lognormal again: ln A ~ N(., (kappa s)^2) */
+        double cov = sqrt(expm1(kappa * kappa * src->s * src->s));
+        return gp_law_create(GP_LAW_LOGNORMAL, mean, fmax(cov, GP_LAW_COV_MIN), err);
+    }
+    gp_law *l = gp_law_scaled(src, 1.0, err);
+    if (!l) return NULL;
+    l->kappa = src->kappa * kappa; /* the same base: lam' B^(kappa_src kappa) */
+    double m1 = base_moment(l, l->kappa), m2 = base_moment(l, 2 * l->kappa);
+    if (!(m1 > 0) || !(m2 > 0) || !isfinite(m1) || !isfinite(m2)) {
+        gp_law_destroy(l);
+        gp_error_set(err, GP_ERR_INVALID, "law: the moments of the powered law do not converge");
+        return NULL;
+    }
+    l->lam = mean / m1;
+    l->mean = mean;
+    double var = m2 / (m1 * m1) - 1.0;
+    l->cov = sqrt(var > 0 ? var : 0);
     return l;
 }
 
@@ -256,6 +324,17 @@ void gp_law_destroy(gp_law *l)
 
 /* ---------------------------------------------------------------- queries */
 
+/* an area of the law -> the base law's, and back (identities unless powered) */
+static double to_base(const gp_law *l, double a)
+{
+    return l->kappa == 1.0 ? a : pow(a / l->lam, 1.0 / l->kappa);
+}
+
+static double from_base(const gp_law *l, double b)
+{
+    return l->kappa == 1.0 ? b : l->lam * pow(b, l->kappa);
+}
+
 gp_law_kind gp_law_kind_of(const gp_law *l) { return l->kind; }
 double gp_law_mean(const gp_law *l) { return l->mean; }
 double gp_law_cov(const gp_law *l) { return l->cov; }
@@ -263,13 +342,13 @@ double gp_law_cov(const gp_law *l) { return l->cov; }
 void gp_law_support(const gp_law *l, double *lo, double *hi)
 {
     int bounded = l->kind == GP_LAW_UNIFORM || l->kind == GP_LAW_SIEVE;
-    if (lo) *lo = bounded ? l->lo : 0.0;
-    if (hi) *hi = bounded ? l->hi : INFINITY;
+    if (lo) *lo = bounded ? from_base(l, l->lo) : 0.0;
+    if (hi) *hi = bounded ? from_base(l, l->hi) : INFINITY;
 }
 
 size_t gp_law_sieve_rows(const gp_law *l, const double **d, const double **pw)
 {
-    if (l->kind != GP_LAW_SIEVE) return 0;
+    if (l->kind != GP_LAW_SIEVE || l->kappa != 1.0) return 0;
     if (d) *d = l->d;
     if (pw) *pw = l->pw;
     return l->nrows;
@@ -303,7 +382,7 @@ static double sieve_quantile_d(const gp_law *l, double p)
     return fmin(fmax(x, l->d[k]), l->d[k + 1]);
 }
 
-double gp_law_cdf(const gp_law *l, double a)
+static double base_cdf(const gp_law *l, double a)
 {
     if (!(a > 0)) return 0.0;
     switch (l->kind) {
@@ -321,7 +400,7 @@ double gp_law_cdf(const gp_law *l, double a)
     return NAN;
 }
 
-double gp_law_quantile(const gp_law *l, double p)
+static double base_quantile(const gp_law *l, double p)
 {
     if (!(p >= 0 && p <= 1)) return NAN;
     switch (l->kind) {
@@ -360,7 +439,7 @@ static void log_cdf_sf_exact(const gp_law *l, double a, double *lf, double *ls)
         *ls = fmin(0.0, log_phic(z) - lq0);
         /* F = (Phi(z) - Phi(z0)) / q0. Near a = 0 that difference cancels (z rounds to z0
          * below a ~ 1e-16 sigma): there F = phi(z0) dz (1 - z0 dz / 2 + O(dz^2)) / q0. */
-        double f = gp_law_cdf(l, a);
+        double f = base_cdf(l, a);
         if (f > 1e-3)
             *lf = log(f);
         else if (dz > 1e-5)
@@ -370,7 +449,7 @@ static void log_cdf_sf_exact(const gp_law *l, double a, double *lf, double *ls)
         return;
     }
     default: {
-        double f = gp_law_cdf(l, a);
+        double f = base_cdf(l, a);
         *lf = f > 0 ? log(f) : -INFINITY;
         *ls = f < 1 ? log1p(-f) : -INFINITY;
         return;
@@ -378,8 +457,20 @@ static void log_cdf_sf_exact(const gp_law *l, double a, double *lf, double *ls)
     }
 }
 
+double gp_law_cdf(const gp_law *l, double a)
+{
+    return a > 0 ? base_cdf(l, to_base(l, a)) : 0.0;
+}
+
+double gp_law_quantile(const gp_law *l, double p)
+{
+    return from_base(l, base_quantile(l, p));
+}
+
 void gp_law_log_cdf_sf(const gp_law *l, double a, double *lf, double *ls)
 {
+    if (!(a > 0)) a = 1e-300;
+    a = to_base(l, a);
     if (!(a > 0)) a = 1e-300;
     log_cdf_sf_exact(l, a, lf, ls);
     if (l->kind == GP_LAW_LOGNORMAL || l->kind == GP_LAW_NORMAL) return;
