@@ -2,8 +2,9 @@
  *
  * Rows: the paper's Example 1 and 2 (500 grains, filled to F_S = 0.65, ODEC and descriptors)
  * with the default AD objective and with the paper's E3, the filling rate with 1 and 2 threads,
- * a law on the grains ("of": "grains", COV 0.5), a sieve curve by mass (0.5-4 mm in a 0.1 m
- * square), and a 10,000-grain specimen.
+ * a law on the grains ("of": "grains", COV 0.5; 500 and 10,000 grains: the larger one sizes
+ * its cells for their grains, a second IMC run, whose steps the IMC column adds), a sieve
+ * curve by mass (0.5-4 mm in a 0.1 m square), and a 10,000-grain specimen.
  * Columns: seconds per phase, grains filled per second, the IMC error and steps, and what the
  * specimen achieved (from its fit report, measured on the cells and grains): cell- and
  * grain-area KS over its 5 % critical value, the grains' COV error, the sieve's largest
@@ -352,6 +353,7 @@ int main(int argc, char **argv)
         {"Example 1, 2 threads", 500, 0.8, 1.0, 0.1, 0.06, 0.03, 2, all, GP_IMC_AD, 0},
         {"of grains, COV 0.5", 500, 0.5, 1.0, 0.1, 0.05, 0.02, 2, GP_OUT2_GRAINS, GP_IMC_AD, 1},
         {"sieve 0.5-4 mm, 0.1 m", 0, 0.0, 1.0, 0.1, 0.05, 0.02, 2, GP_OUT2_GRAINS, GP_IMC_AD, 2},
+        {"of grains, 10,000", 10000, 0.5, 1.0, 0.1, 0.05, 0.02, 2, GP_OUT2_GRAINS, GP_IMC_AD, 1},
         {"10,000 grains, 2 thr.", 10000, 0.5, 1.0, 0.1, 0.05, 0.02, 2, all, GP_IMC_AD, 0},
     };
     printf("2D Fourier-Voronoi specimen, end to end (F_S = 0.65, Np = 128; AD threshold 0.1, E3 0.002)\n");
