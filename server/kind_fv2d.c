@@ -547,6 +547,12 @@ static json_t *brief(const json_t *spec, const json_t *stats)
 /* - shape.outlines, phase "shape": gp_outline_set_analyze, ~0.37 ms an outline at Np 128
  *   and ~1.7 ms at 512 (100-1,000 outlines of 64-1,000 vertices: the vertices barely count) */
 #define COST_OUTLINE_S 0.33e-3 /* an outline at 128 points, times Np / 128 */
+/* - a law of grains (size.of "grains", a sieve) from about this many cells on usually sizes its
+ *   cells again (the core's resize_cells: at 500 grains the first cells do, at 2,000-100,000
+ *   the second IMC ran in every case measured), and that IMC took about as many steps again
+ *   (10,000 grains: 30,503 + 30,167; the sieve's 3,931 grains: 28,015 + 13,037) */
+#define RESIZE_CELLS_MIN 2000
+#define RESIZE_IMC_SHARE 1.0
 #define DISCS_GUESS 20      /* ODEC discs of a grain, for the plan */
 #define CORNERS_GUESS 7     /* corners of a cell, for the plan */
 /* bytes of the result's text (at 17 digits): a grain's own members, a contour point, a disc,
@@ -573,7 +579,7 @@ static int plan(const void *spec_, const json_t *spec_json, gpd_phase *out, int 
                  spec->size_of_grains || spec->size_law == GP_LAW_SIEVE;
     /* the core's shape_step: only these forms compute their shape (spectrum wins) */
     gp_shape_form form = spec->has_spectrum ? GP_SHAPE_FORM_SPECTRUM : spec->shape_form;
-    gpd_phase ph[12];
+    gpd_phase ph[GPD_PLAN_MAX];
     int k = 0;
     if (form == GP_SHAPE_FORM_DESCRIPTORS)
         ph[k++] = (gpd_phase){"shape", FIT_EVALS_GUESS * COST_FIT_EVAL_S *
@@ -581,6 +587,7 @@ static int plan(const void *spec_, const json_t *spec_json, gpd_phase *out, int 
     if (form == GP_SHAPE_FORM_OUTLINES)
         ph[k++] = (gpd_phase){"shape", COST_OUTLINE_S * (double)spec->noutlines * scale, 1};
     ph[k++] = (gpd_phase){"tessellation", COST_TESS_S * n, 1};
+    int imc = k;
     ph[k++] = (gpd_phase){"imc", moves * COST_IMC_S *
                                      (1 + COST_IMC_DECADE * log10(fmax(n, 1000) / 1000)), 0};
     if (grains && form == GP_SHAPE_FORM_DESCRIPTORS) {
@@ -593,6 +600,11 @@ static int plan(const void *spec_, const json_t *spec_json, gpd_phase *out, int 
     if (grains) ph[k++] = (gpd_phase){"fill", COST_FILL_S * n * scale, 1};
     if (grains && !spec->size_of_grains && spec->size_law != GP_LAW_SIEVE)
         ph[k++] = (gpd_phase){"fill", REFILL_SHARE * COST_FILL_S * n * scale, 0};
+    if (grains && (spec->size_of_grains || spec->size_law == GP_LAW_SIEVE) &&
+        n >= RESIZE_CELLS_MIN) { /* the core's resize_cells: the IMC again, a second pass A */
+        ph[k++] = (gpd_phase){"imc", RESIZE_IMC_SHARE * ph[imc].cost_s, 0};
+        ph[k++] = (gpd_phase){"fill", COST_FILL_S * n * scale, 1};
+    }
     if (grains && finish)
         ph[k++] = (gpd_phase){"odec", n * scale * (((o & GP_OUT2_ODEC) ? COST_ODEC_S : 0) +
                                                    ((o & GP_OUT2_DESCRIPTORS) ? COST_DESC_S : 0)),

@@ -34,7 +34,7 @@ typedef struct gpd_phase {
  * contacts, costs about twice as much a byte). */
 #define GPD_RESULT_S_PER_BYTE 0.05e-6
 
-#define GPD_PLAN_MAX 10
+#define GPD_PLAN_MAX 12
 #define GPD_RATE_WINDOW 16 /* reports kept for the current phase's rate */
 
 typedef struct gpd_progress_model {
