@@ -872,7 +872,7 @@ static gp_status run_imc(build_ctx *b, const gp_vec2 *seeds, gp_error *err)
     ip.anisotropy = spec->anisotropy;
     ip.error_kind = (int)spec->imc_error;
     ip.threshold = spec->imc_threshold;
-    ip.max_steps = spec->imc_max_steps;
+    ip.max_steps = spec->imc_max_steps - (seeds ? out->imc_steps : 0); /* one budget for both */
     ip.init = spec->imc_init == GP_INIT_HALTON ? 1 : 0;
     ip.classes_size = spec->imc_classes;
     ip.classes_orient = spec->imc_classes;
@@ -1409,8 +1409,9 @@ static void grains_reset(gp_specimen2d *out)
  * So after pass A, when the matched grains miss GRAIN_LAW_KS_GOAL of the critical value, the
  * cell law is drawn together (gp_law_powered: kappa < 1 keeps the mean and narrows the
  * spread, giving the small cells room) by the kappa that pass A's own cells predict best,
- * the IMC runs again from the seeds it ended on, and pass A fills the new cells. The new
- * cells are the specimen whatever they give (the fit report measures it); no third round. */
+ * the IMC runs again from the seeds it ended on (with what is left of the spec's max_steps),
+ * and pass A fills the new cells. The new cells are the specimen whatever they give (the fit
+ * report measures it); no third round. */
 static gp_status resize_cells(build_ctx *b, fill_job *job, gp_error *err)
 {
     if (b->n < 2)
@@ -1427,7 +1428,9 @@ static gp_status resize_cells(build_ctx *b, fill_job *job, gp_error *err)
             st = best_power(b, &z, &kappa, &pred, err);
     }
     sizing_free(&z);
-    if (st != GP_OK || kappa == 1.0 || !(pred < RESIZE_GAIN * now))
+    /* the spec's max_steps bounds both IMC runs together: none left, nothing to gain */
+    if (st != GP_OK || kappa == 1.0 || !(pred < RESIZE_GAIN * now) ||
+        b->out->imc_steps >= b->spec->imc_max_steps)
         return st;
     gp_law *cells = gp_law_powered(b->cell_law, kappa, gp_law_mean(b->cell_law), err);
     size_t n = b->n;

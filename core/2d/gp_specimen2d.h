@@ -22,7 +22,8 @@
  *      critical value (by number, or by mass), the cell law is drawn together
  *      (gp_law_powered: lam A^kappa, the same mean) by the kappa that pass A's own cells
  *      predict best (each keeps its rank and the fraction of itself it held), the IMC runs
- *      again from the seeds it ended on, and pass A fills the new cells (cell_law_power; once);
+ *      again from the seeds it ended on (both runs within max_steps), and pass A fills the
+ *      new cells (cell_law_power; once);
  *   4. rank matching: the k-th smallest of those grains is given the k-th smallest of the
  *      grain law's N quantiles at (2k - 1) / 2N, and shrunk about its centre to that area
  *      (every contour point moves along its own ray, so it stays in its cell, and shape and

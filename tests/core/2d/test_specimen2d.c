@@ -313,6 +313,26 @@ static void law_on_grains_large(void)
     }
     for (int t = 0; t < 3; t++)
         gp_specimen2d_destroy(r[t]);
+    /* imc.max_steps bounds both IMC runs together: a budget the first run uses up leaves the
+     * cells as they are; one it leaves room in caps the second */
+    const long budgets[2] = {5000, 12000};
+    for (int t = 0; t < 2; t++) {
+        gp_spec2d s;
+        gp_spec2d_defaults(&s);
+        s.particles = 3000;
+        s.cov = 0.5;
+        s.size_of_grains = 1;
+        s.threads = 2;
+        s.imc_max_steps = budgets[t];
+        gp_specimen2d *q = build(&s);
+        CHECK(q != NULL);
+        if (!q) continue;
+        printf("of grains, N 3000, max_steps %ld: %ld IMC steps, power %.4f, grain KS %.4f\n",
+               budgets[t], q->imc_steps, q->cell_law_power, q->fit.grain_area.ks);
+        CHECK(q->imc_steps <= budgets[t]);
+        CHECK(t == 0 ? q->cell_law_power == 1.0 : q->cell_law_power < 1.0);
+        gp_specimen2d_destroy(q);
+    }
 }
 
 /* A sieve curve by mass: 0.5-4 mm, 10 / 50 / 90 % passing at 1 / 2 / 3 mm in a 0.1 m square.
