@@ -1295,6 +1295,8 @@ static double matched_miss(double *cap, const double *q, size_t n, const gp_law 
         sa += cap[k];
         sq += q[k];
     }
+    if (!(sa > 0.0))
+        return 1.0; /* no grain at all: as far as can be */
     double ca = 0.0, cq = 0.0;
     for (size_t i = 0, j = 0; i < n || j < n;) {
         double t = j >= n || (i < n && cap[i] < q[j]) ? cap[i] : q[j];
@@ -1437,7 +1439,7 @@ static gp_status resize_cells(build_ctx *b, fill_job *job, gp_error *err)
     gp_vec2 *seeds = cells ? malloc(n * sizeof *seeds) : NULL;
     if (!seeds) {
         gp_law_destroy(cells);
-        return cells ? gp_error_set(err, GP_ERR_NOMEM, "out of memory") : err->code;
+        return cells || !err ? gp_error_set(err, GP_ERR_NOMEM, "out of memory") : err->code;
     }
     for (size_t i = 0; i < n; i++)
         seeds[i] = gp_voronoi_seed(b->vor, i);

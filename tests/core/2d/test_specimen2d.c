@@ -252,6 +252,18 @@ static void law_on_grains(void)
     gp_specimen2d_destroy(r);
 }
 
+/* a law of grains: lognormal, COV 0.5, in the unit square */
+static gp_spec2d grains_spec(size_t n, int threads)
+{
+    gp_spec2d s;
+    gp_spec2d_defaults(&s);
+    s.particles = n;
+    s.cov = 0.5;
+    s.size_of_grains = 1;
+    s.threads = threads;
+    return s;
+}
+
 /* "of": "grains" at N = 3,000 and 10,000, where the grains of cells drawn to the grain law
  * over F_S came out 1.5 times the critical KS distance away at 10,000 (the smallest cells hold
  * less of themselves): the grains' KS distance, computed here from their contours, within half
@@ -264,12 +276,7 @@ static void law_on_grains_large(void)
     const size_t ns[3] = {3000, 3000, 10000};
     const int threads[3] = {1, 3, 2};
     for (int t = 0; t < 3; t++) {
-        gp_spec2d s;
-        gp_spec2d_defaults(&s);
-        s.particles = ns[t];
-        s.cov = 0.5;
-        s.size_of_grains = 1;
-        s.threads = threads[t];
+        gp_spec2d s = grains_spec(ns[t], threads[t]);
         s.outputs = GP_OUT2_GRAINS | GP_OUT2_CELLS;
         r[t] = build(&s);
         CHECK(r[t] != NULL);
@@ -317,12 +324,7 @@ static void law_on_grains_large(void)
      * cells as they are; one it leaves room in caps the second */
     const long budgets[2] = {5000, 12000};
     for (int t = 0; t < 2; t++) {
-        gp_spec2d s;
-        gp_spec2d_defaults(&s);
-        s.particles = 3000;
-        s.cov = 0.5;
-        s.size_of_grains = 1;
-        s.threads = 2;
+        gp_spec2d s = grains_spec(3000, 2);
         s.imc_max_steps = budgets[t];
         gp_specimen2d *q = build(&s);
         CHECK(q != NULL);
