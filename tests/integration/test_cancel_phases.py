@@ -32,10 +32,11 @@ PHASES = [
                        imc={"max_steps": 0}, outputs=["odec", "descriptors"])),
     ("result", 1.5, dict(D2, particles=3000, contour_points=1024, solid_fraction=0.3,
                          imc={"max_steps": 0}, outputs=["grains"])),
-    # (the paper's sample on one thread, Release: deposition ~0.5 s, compaction ~1.5 s)
+    # (the paper's sample on one thread, Release: deposition ~0.5 s, compaction ~1.4-1.7 s,
+    # relaxation 0.46-0.68 s: a DELETE 0.5 s into it missed it in a CI run, the job done)
     ("deposition", 0.2, PAPER_3D),
     ("compaction", 0.6, PAPER_3D),
-    ("relaxation", 0.5, PAPER_3D),
+    ("relaxation", 0.1, PAPER_3D),
     ("tiling", 0.0, dict(gpd.SMALL_3D, box=[0.012, 0.012, 0.012], porosity=0.45,
                          tiling=[16, 16, 16], outputs=["fabric", "stress"])),
     ("result", 2.5, dict(gpd.SMALL_3D, tiling=[16, 16, 16], outputs=["spheres", "contacts"])),
