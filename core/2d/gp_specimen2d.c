@@ -1430,10 +1430,13 @@ static gp_status resize_cells(build_ctx *b, fill_job *job, gp_error *err)
             st = best_power(b, &z, &kappa, &pred, err);
     }
     sizing_free(&z);
-    /* the spec's max_steps bounds both IMC runs together: none left, nothing to gain */
-    if (st != GP_OK || kappa == 1.0 || !(pred < RESIZE_GAIN * now) ||
-        b->out->imc_steps >= b->spec->imc_max_steps)
+    if (st != GP_OK || kappa == 1.0 || !(pred < RESIZE_GAIN * now))
         return st;
+    /* the spec's max_steps bounds both IMC runs together: none left, nothing to gain */
+    if (b->out->imc_steps >= b->spec->imc_max_steps) {
+        b->out->cells_resize_blocked = 1;
+        return GP_OK;
+    }
     gp_law *cells = gp_law_powered(b->cell_law, kappa, gp_law_mean(b->cell_law), err);
     size_t n = b->n;
     gp_vec2 *seeds = cells ? malloc(n * sizeof *seeds) : NULL;
@@ -1619,6 +1622,10 @@ static void collect_warnings(build_ctx *b)
              out->imc_stop_reason, out->imc_steps);
     warn_fit_area(out, "cell", &out->fit.cell_area);
     warn_fit_area(out, "grain", &out->fit.grain_area);
+    if (out->cells_resize_blocked)
+        warn(out, "grain areas: the cells were not resized for their grains: the first IMC run "
+                  "used all of imc.max_steps (%ld); a larger max_steps lets them be",
+             spec->imc_max_steps);
     warn_fit_orient(out, "cell", &out->fit.cell_orientation);
     warn_fit_orient(out, "grain", &out->fit.grain_orientation);
     if (out->fit.passing.n > 0 && out->fit.passing.max_error_pp > 3.0)

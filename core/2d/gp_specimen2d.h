@@ -254,6 +254,8 @@ typedef struct gp_specimen2d {
                                  * by before the IMC ran again (1: it was not; resize_cells in
                                  * gp_specimen2d.c); imc_steps and the IMC's times then count
                                  * both runs */
+    int cells_resize_blocked;   /* a grain law would have resized its cells, but the first IMC
+                                 * run used all of imc_max_steps (warned) */
     const char *imc_error_kind; /* "AD", "E1", "E2", "E3" */
     gp_fit2d fit;               /* measured on the cells and grains themselves */
     char **warnings;            /* nwarnings one-line messages: a target not reached, and how

@@ -333,6 +333,11 @@ static void law_on_grains_large(void)
                budgets[t], q->imc_steps, q->cell_law_power, q->fit.grain_area.ks);
         CHECK(q->imc_steps <= budgets[t]);
         CHECK(t == 0 ? q->cell_law_power == 1.0 : q->cell_law_power < 1.0);
+        CHECK(q->cells_resize_blocked == (t == 0)); /* and says why, in a warning */
+        int said = 0;
+        for (size_t w = 0; w < q->nwarnings; w++)
+            said |= strstr(q->warnings[w], "not resized") != NULL;
+        CHECK(said == (t == 0));
         gp_specimen2d_destroy(q);
     }
 }
