@@ -69,7 +69,8 @@ gp_law *gp_law_scaled(const gp_law *law, double factor, gp_error *err);
  * in (0, 4]: kappa < 1 draws the law together in log scale (ln A's spread times kappa), which
  * keeps its order and shape class. A lognormal stays a lognormal (COV sqrt(exp(kappa^2 s^2) - 1)
  * for ln A's sd s); any other law keeps its kind with the transform on top: its mean and COV
- * integrated from the quantile (GSL QAGS, relative 1e-10), and gp_law_sieve_rows gives none
+ * integrated from the quantile (GSL fixed Gauss-Legendre, graded pieces), and
+ * gp_law_sieve_rows gives none
  * (the rows are the base law's). kappa = 1 is gp_law_scaled. Used by the 2D specimen to size
  * cells for the grains they can hold (gp_specimen2d.h). */
 gp_law *gp_law_powered(const gp_law *law, double kappa, double mean, gp_error *err);
