@@ -552,7 +552,6 @@ static json_t *brief(const json_t *spec, const json_t *stats)
  *   the second IMC ran in every case measured), and that IMC took about as many steps again
  *   (10,000 grains: 30,503 + 30,167; the sieve's 3,931 grains: 28,015 + 13,037) */
 #define RESIZE_CELLS_MIN 2000
-#define RESIZE_IMC_SHARE 1.0
 #define DISCS_GUESS 20      /* ODEC discs of a grain, for the plan */
 #define CORNERS_GUESS 7     /* corners of a cell, for the plan */
 /* bytes of the result's text (at 17 digits): a grain's own members, a contour point, a disc,
@@ -602,7 +601,7 @@ static int plan(const void *spec_, const json_t *spec_json, gpd_phase *out, int 
         ph[k++] = (gpd_phase){"fill", REFILL_SHARE * COST_FILL_S * n * scale, 0};
     if (grains && (spec->size_of_grains || spec->size_law == GP_LAW_SIEVE) &&
         n >= RESIZE_CELLS_MIN) { /* the core's resize_cells: the IMC again, a second pass A */
-        ph[k++] = (gpd_phase){"imc", RESIZE_IMC_SHARE * ph[imc].cost_s, 0};
+        ph[k++] = (gpd_phase){"imc", ph[imc].cost_s, 0};
         ph[k++] = (gpd_phase){"fill", COST_FILL_S * n * scale, 1};
     }
     if (grains && finish)

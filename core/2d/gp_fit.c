@@ -46,15 +46,28 @@ double gp_fit_ks_critical(size_t n)
 /* Two-sided KS distance of u_i = F(x_(i)) given in the order of the sorted x: the empirical CDF
  * jumps from (i-1)/n to i/n at x_(i), so the sup of |F_n - F| is reached at one of those ends
  * (with ties, the extreme ends of a run are among them). */
+static double ks_at(double d, double u, size_t i, size_t n)
+{
+    double above = (double)(i + 1) / (double)n - u;
+    double below = u - (double)i / (double)n;
+    if (above > d) d = above;
+    if (below > d) d = below;
+    return d;
+}
+
 static double ks_of_sorted_u(const double *u, size_t n)
 {
     double d = 0;
-    for (size_t i = 0; i < n; i++) {
-        double above = (double)(i + 1) / (double)n - u[i];
-        double below = u[i] - (double)i / (double)n;
-        if (above > d) d = above;
-        if (below > d) d = below;
-    }
+    for (size_t i = 0; i < n; i++)
+        d = ks_at(d, u[i], i, n);
+    return d;
+}
+
+double gp_fit_ks_sorted(const double *x, size_t n, const gp_law *law)
+{
+    double d = 0;
+    for (size_t i = 0; i < n; i++)
+        d = ks_at(d, gp_law_cdf(law, x[i]), i, n);
     return d;
 }
 

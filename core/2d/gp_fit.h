@@ -76,6 +76,10 @@ typedef struct gp_fit_passing {
 /* 5 % critical value of D: 1.36 / sqrt(n) (asymptotic; 0 for n = 0). */
 double gp_fit_ks_critical(size_t n);
 
+/* The two-sided KS distance of the ascending values x[0..n) to law's CDF (the ks that
+ * gp_fit_area_measure reports, alone and without a copy). */
+double gp_fit_ks_sorted(const double *x, size_t n, const gp_law *law);
+
 /* Fit of n values (areas) to law. n = 0: present = 0 with the target fields filled, GP_OK
  * (values may then be NULL). A non-finite value: GP_ERR_INVALID naming its index. ncurve: the
  * number of curve points (0: no curve). COV is 0 for n = 1. */

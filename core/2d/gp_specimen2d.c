@@ -872,7 +872,7 @@ static gp_status run_imc(build_ctx *b, const gp_vec2 *seeds, gp_error *err)
     ip.anisotropy = spec->anisotropy;
     ip.error_kind = (int)spec->imc_error;
     ip.threshold = spec->imc_threshold;
-    ip.max_steps = spec->imc_max_steps - (seeds ? out->imc_steps : 0); /* one budget for both */
+    ip.max_steps = spec->imc_max_steps - out->imc_steps; /* one budget for both runs */
     ip.init = spec->imc_init == GP_INIT_HALTON ? 1 : 0;
     ip.classes_size = spec->imc_classes;
     ip.classes_orient = spec->imc_classes;
@@ -885,9 +885,8 @@ static gp_status run_imc(build_ctx *b, const gp_vec2 *seeds, gp_error *err)
     gp_status st = gp_imc_run(b->cont.outer, b->cont.nouter, b->cont.holes, b->cont.nhole,
                               b->cont.nholes, b->n, &ip, imc_progress, &relay, b->cancel, &b->vor,
                               &rep, err);
-    double again = seeds ? 1.0 : 0.0;
-    out->t_tessellation = again * out->t_tessellation + rep.t_init;
-    out->t_imc = again * out->t_imc + gp_clock_seconds() - t0 - rep.t_init;
+    out->t_tessellation += rep.t_init; /* out starts zeroed: a second run adds to the first */
+    out->t_imc += gp_clock_seconds() - t0 - rep.t_init;
     /* Reaching max_steps is not a failure: the specimen is built and its warnings say how far
      * the IMC got. A threshold below the integer-count floor (refused at submit by the
      * service), a cancel or bad input end the job with the IMC's message. */
@@ -898,7 +897,7 @@ static gp_status run_imc(build_ctx *b, const gp_vec2 *seeds, gp_error *err)
     if (st == GP_OK) {
         out->container_area = gp_voronoi_container_area(b->vor);
         out->imc_error = rep.error;
-        out->imc_steps = (seeds ? out->imc_steps : 0) + rep.steps;
+        out->imc_steps += rep.steps;
         out->imc_stop_reason = gp_imc_stop_name(rep.stop_reason);
         out->imc_error_floor = rep.floor;
         out->imc_threshold = spec->imc_threshold;
@@ -1072,6 +1071,9 @@ static void job_free(fill_job *job, size_t n)
     free(job->cell_poly);
     free(job->cell_n);
     free(job->curve);
+    job->cell_poly = NULL; /* set up again by job_setup (resize_cells) */
+    job->cell_n = NULL;
+    job->curve = NULL;
 }
 
 /* solid_fraction is the specimen's (api.md: stats.solid_fraction is the whole container's),
@@ -1287,14 +1289,13 @@ static int cmp_double_asc(const void *a, const void *b)
 static double matched_miss(double *cap, const double *q, size_t n, const gp_law *law)
 {
     qsort(cap, n, sizeof *cap, cmp_double_asc);
-    double d = 0.0, sa = 0.0, sq = 0.0;
+    double sa = 0.0, sq = 0.0;
     for (size_t k = 0; k < n; k++) {
         cap[k] = fmin(cap[k], q[k]);
-        double f = gp_law_cdf(law, cap[k]);
-        d = fmax(d, fmax((double)(k + 1) / (double)n - f, f - (double)k / (double)n));
         sa += cap[k];
         sq += q[k];
     }
+    double d = gp_fit_ks_sorted(cap, n, law);
     if (!(sa > 0.0))
         return 1.0; /* no grain at all: as far as can be */
     double ca = 0.0, cq = 0.0;
@@ -1450,9 +1451,6 @@ static gp_status resize_cells(build_ctx *b, fill_job *job, gp_error *err)
     b->cell_law = cells;
     b->out->cell_law_power = kappa;
     job_free(job, n);
-    job->cell_poly = NULL;
-    job->cell_n = NULL;
-    job->curve = NULL;
     grains_reset(b->out);
     gp_voronoi_destroy(b->vor);
     b->vor = NULL;
