@@ -200,7 +200,7 @@ static void row(const char *name, char *text, size_t edges)
         if (t > 1) break;
     }
     char verdict[300];
-    /* the status as the server chooses it from the code (server/http.c) */
+    /* the status as the server chooses it from the code (server/http/http.c) */
     int status = strcmp(p.code, "internal") ? 422 : 500;
     if (rc) snprintf(verdict, sizeof verdict, "%d %s %s", status, p.code, p.pointer);
     else snprintf(verdict, sizeof verdict, "ok");

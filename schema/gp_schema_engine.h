@@ -1,6 +1,5 @@
 /* gp_schema_engine.h -- internal to schema/: a JSON Schema (2020-12) interpreter for the
- * embedded spec schemas, knowing nothing of the kinds, and the problem helper shared by the
- * spec files.
+ * embedded spec schemas, knowing nothing of the kinds; it reports through gp_problem.h.
  *
  * Keywords: type, properties, required, additionalProperties, minimum / maximum /
  * exclusiveMinimum / exclusiveMaximum, minItems / maxItems, items, prefixItems, enum, const,
@@ -28,14 +27,7 @@
 
 #include <jansson.h>
 
-#include "gp_spec.h"
-
-/* Fills *p (when p is not NULL): code, pointer, and the message "<pointer>: <printf text>"
- * ("spec: ..." for the empty pointer). Returns -1, for `return gp_problem(...)`. */
-int gp_problem(gp_spec_problem *p, const char *code, const char *pointer, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-int gp_problemv(gp_spec_problem *p, const char *code, const char *pointer, const char *fmt,
-                va_list ap) __attribute__((format(printf, 4, 0)));
+#include "gp_problem.h"
 
 /* Parses schema text and compiles every object of it; a new reference, or NULL (with a line on
  * stderr naming `name`) when the text is not JSON. Not thread-safe: see above. */

@@ -28,7 +28,7 @@
  * (each kind's schema is a complete embedded schema resource with its own $id).
  *
  * Problems. The FIRST problem found (instance keys in document order, then missing required
- * fields) is reported, with a code; the HTTP layer chooses the status (server/http.c: 500 for
+ * fields) is reported, with a code; the HTTP layer chooses the status (server/http/http.c: 500 for
  * "internal", 422 for the others):
  *   "invalid_spec" -- the spec breaks its schema (wrong type, range, unknown field, missing
  *                     field, bad enum, unknown kind, ...), or fits it but is not meaningful
@@ -70,14 +70,9 @@
 
 #include <jansson.h>
 
+#include "gp_problem.h"
 #include "gp_specimen2d.h"
 #include "gp_specimen3d.h"
-
-typedef struct gp_spec_problem {
-    char code[32];              /* "invalid_spec", "too_large" or "internal" ("" when none) */
-    char pointer[256];          /* RFC 6901 pointer of the first bad field */
-    char message[512];          /* "<pointer>: expected ..., got ..." */
-} gp_spec_problem;
 
 /* The kinds' names, NULL-terminated: {<2D kind>, <3D kind>, NULL} (the "kind" of a spec;
  * schema/<kind>.schema.json). */
@@ -133,7 +128,7 @@ void gp_spec3d_free(gp_spec3d *s);
  *     (imc.max_steps moves, each costing a little more on more cells), the filling, ODEC and
  *     descriptors per grain in proportion to contour_points, the shape's own work (target
  *     descriptors: the fit and the calibration's fills; outlines: one description each); the
- *     result as server/http.c has always estimated it (bytes per grain by outputs and
+ *     result as server/http/http.c has always estimated it (bytes per grain by outputs and
  *     contour_points);
  *   3D: the sample's spheres (gp_sieve_expected_count, the count the DEM draws), its
  *     time step (gp_dem3d.h: 0.3 sqrt(m / 2 E R) at the density-scaling radius of

@@ -12,6 +12,7 @@
 #include <float.h>
 
 #include "gp_schema_engine.h"
+#include "gp_spec.h"
 
 /* Advice by the field that drives a bound: rows {pointer, text}, the last one {NULL, the
  * text for any other field}. */

@@ -17,12 +17,12 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "http.h"
-#include "kind.h"
-#include "maint.h"
-#include "store.h"
-#include "util.h"
-#include "workers.h"
+#include "http/http.h"
+#include "kinds/kind.h"
+#include "jobs/maint.h"
+#include "store/store.h"
+#include "util/util.h"
+#include "jobs/workers.h"
 
 /* GPD_VERSION: the project's version, defined by server/CMakeLists.txt */
 

@@ -1,4 +1,4 @@
-// dashboard_check.js -- runs the dashboard page's script (server/dashboard.html as served, the
+// dashboard_check.js -- runs the dashboard page's script (server/http/dashboard.html as served, the
 // kinds filled in) in node against a small stand-in DOM and a stand-in service (fetch answered
 // from fixtures), and checks how the page behaves:
 //  - the example spec of every kind is compact (short arrays on one line, < 20 lines) and parses

@@ -1,4 +1,4 @@
-/* test_progress.c -- the progress model (server/progress.h) on runs played with a made-up clock:
+/* test_progress.c -- the progress model (server/jobs/progress.h) on runs played with a made-up clock:
  * phases that take what their plan says, or twice as long (a loaded machine), a phase run again
  * (the 2D refill), a phase whose own rate slows (a converging error), a name the plan does not
  * have (the core's "done"), and the result phase: the fraction never goes down, stays below 1
@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "gp_test.h"
-#include "progress.h"
+#include "jobs/progress.h"
 
 #define DT 0.05 /* seconds between the core's reports */
 

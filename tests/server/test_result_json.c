@@ -1,4 +1,4 @@
-/* test_result_json.c -- the streaming result writer (server/result_json.h) against jansson.
+/* test_result_json.c -- the streaming result writer (server/jobs/result_json.h) against jansson.
  *
  * The truth is jansson itself: every value the writer writes is also built as a jansson tree
  * and dumped with json_dumps(JSON_COMPACT | JSON_REAL_PRECISION(17)), the way results were
@@ -15,8 +15,8 @@
 #include <string.h>
 
 #include "gp_test.h"
-#include "kind_fv2d.h"
-#include "result_json.h"
+#include "kinds/fourier-voronoi-2d/kind_fv2d.h"
+#include "jobs/result_json.h"
 
 #define FLAGS (JSON_COMPACT | JSON_REAL_PRECISION(17) | JSON_ENCODE_ANY)
 

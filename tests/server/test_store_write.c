@@ -25,10 +25,10 @@
 #include <sqlite3.h>
 
 #include "gp_test.h"
-#include "json_scan.h"
-#include "maint.h"
-#include "result_json.h"
-#include "store.h"
+#include "util/json_scan.h"
+#include "jobs/maint.h"
+#include "jobs/result_json.h"
+#include "store/store.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define UNDER_ASAN 1

@@ -10,8 +10,8 @@
  * packing, where the grains are on a half-empty one) and the grains drawn in it; the
  * descriptor histograms' Freedman-Diaconis bins, bar heights, mean and target.
  * The size view from stats.fit (CDF curves, KS lines, warnings), and stats.fit / warnings as
- * server/result_json.c writes them from a specimen, drawn by the size view.
- * Compact reading (what GET /svg does): server/json_scan.c (member spans, array walks, the
+ * server/jobs/result_json.c writes them from a specimen, drawn by the size view.
+ * Compact reading (what GET /svg does): server/util/json_scan.c (member spans, array walks, the
  * summary of a result, cut texts refused), the element parser against jansson, the fast
  * "%.1f", and every view drawn as a pull stream from a summary plus an export pack or the
  * scanned result text, in pieces of 7 bytes to 1 MiB, byte for byte as gp_svg_render draws
@@ -24,10 +24,10 @@
 #include <unistd.h>
 
 #include "gp_test.h"
-#include "json_scan.h"
-#include "kind_fv2d.h"
-#include "svg.h"
-#include "svg_internal.h" /* the element parsers, the fast "%.1f" */
+#include "util/json_scan.h"
+#include "kinds/fourier-voronoi-2d/kind_fv2d.h"
+#include "svg/svg.h"
+#include "svg/svg_internal.h" /* the element parsers, the fast "%.1f" */
 
 #define KIND_2D "fourier-voronoi-2d"
 #define KIND_3D "spheres-3d"
@@ -362,7 +362,7 @@ static void test_2d(void)
     CHECK(status == 409);
     json_decref(r);
 
-    /* the shapes server/result_json.c writes: stats as {"target", "achieved"}, null targets and
+    /* the shapes server/jobs/result_json.c writes: stats as {"target", "achieved"}, null targets and
      * histograms, descriptor stats with only a mean */
     r = load(RESULT_2D);
     json_t *st = json_object_get(r, "stats");

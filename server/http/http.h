@@ -1,0 +1,74 @@
+/* http.h -- the HTTP front of grainpackd (libmicrohttpd): routing, bodies, errors.
+ *
+ * Routes (shared/spec/api.md; extensions marked +):
+ *   GET  /                         dashboard (text/html)
+ *   GET  /v1/health                liveness, queue depth, workers
+ *   GET  /v1/schema[?kind=K]       the JSON Schema (+ ?kind= one kind's schema)
+ *   POST /v1/jobs                  201 job object (+ full job object, not only id/status), Location
+ *                                  (503 queue_full with Retry-After past --max-queued)
+ *   GET  /v1/jobs?status=&limit=&after=   newest first, keyset cursor "next"
+ *   GET  /v1/jobs/{id}             job object
+ *   DELETE /v1/jobs/{id}           cancel (200 job object; 409 already_finished)
+ *   DELETE /v1/jobs/{id}?purge=1   remove a finished job, result, pack and summary (204;
+ *                                  409 not_finished while queued or running)
+ *   GET  /metrics                  Prometheus text format 0.0.4 (metrics.h)
+ *   GET  /v1/jobs/{id}/result      result JSON (409 not_ready)
+ *   GET  /v1/jobs/{id}/svg?view=V  image/svg+xml (409 not_ready)
+ *   GET  /v1/jobs/{id}/export?format=F   an export file of the job (api.md formats)
+ *   GET  /v1/jobs/{id}/spec        + the effective spec (defaults filled in)
+ * HEAD is accepted wherever GET is. Every 4xx/5xx body is
+ *   {"error": {"code": "...", "message": "...", "pointer": "/json/pointer"}}
+ * (pointer only where a field of the spec or a query parameter is at fault).
+ *
+ * Before routing (api.md, "Limits and origin"):
+ *   414 uri_too_long      the request target (path and query) is over GPD_MAX_URL bytes
+ *   403 forbidden_host    the Host header names a host this daemon does not answer to
+ *                         (DNS rebinding): accepted are localhost, 127.0.0.1, [::1], the
+ *                         --listen host (as given and as bound), the host of each allowed
+ *                         origin, and for a daemon on 0.0.0.0 / [::] also any IP address and
+ *                         the machine's host name. The Host port is not compared.
+ *   403 forbidden_origin  an Origin header other than the daemon's own address (the page's
+ *                         origin equals the Host it sent, or is http://NAME:PORT with NAME one
+ *                         of the daemon's own names above and PORT its port) or an origin given
+ *                         with --allow-origin. No Origin (curl, scripts): no check.
+ * An allowed Origin gets Access-Control-Allow-Origin, and its preflight (OPTIONS with
+ * Access-Control-Request-Method) 204. GET / carries a Content-Security-Policy with the
+ * SHA-256 of its inline script and style; every response has X-Content-Type-Options: nosniff
+ * and X-Frame-Options: DENY.
+ */
+#ifndef GPD_HTTP_H
+#define GPD_HTTP_H
+
+#include <stddef.h>
+
+#include "http/origin.h" /* gpd_allow_origins */
+
+typedef struct gpd_http_config {
+    int listen_fd;               /* bound and listening (gpd_listen_socket) */
+    unsigned threads;            /* MHD thread pool size */
+    unsigned max_connections;    /* connection limit */
+    unsigned timeout_s;          /* idle timeout per connection */
+    size_t max_body;             /* request body limit in bytes (413 above) */
+    double max_result_mb;        /* specs whose estimated result is larger get 422 too_large */
+    long max_queued;             /* a submit while this many jobs are queued gets 503 queue_full
+                                    (with Retry-After); 0 = no cap */
+    const char *listen;          /* the --listen value as given (its host is an accepted Host) */
+    const char *host;            /* the bound host as gpd_listen_socket wrote it */
+    int port;                    /* the bound port */
+} gpd_http_config;
+
+/* request targets longer than this get 414 uri_too_long (JSON); libmicrohttpd itself answers
+ * (with its own HTML body) only past its per-connection buffer of GPD_CONN_MEMORY bytes */
+#define GPD_MAX_URL 8192
+#define GPD_CONN_MEMORY (256u * 1024u)
+
+/* Parses "HOST:PORT" ("[v6]:PORT", ":PORT" = 127.0.0.1), binds and listens. Returns the fd
+ * and the bound port in *port (the actual one when PORT was 0), -1 with a message on stderr
+ * on failure. host_out receives the host as it should appear in a URL. */
+int gpd_listen_socket(const char *listen, char *host_out, size_t host_len, int *port);
+
+int gpd_http_start(const gpd_http_config *cfg);
+/* Stops accepting, closes connections, joins the pool. */
+void gpd_http_stop(void);
+
+#endif /* GPD_HTTP_H */
