@@ -326,7 +326,7 @@ static int file_read(void *user, uint64_t off, void *dst, size_t n)
 
 js_source store_text_source(const store_text *t)
 {
-    if (t->mem) return js_memory_source(t->mem, (size_t)t->len);
+    if (t->mem) return json_scan_memory_source(t->mem, (size_t)t->len);
     return (js_source){file_read, (void *)t, t->len};
 }
 
@@ -348,7 +348,7 @@ store_rc store_succeed(const char *id, const store_text *result, const char *pro
     js_source rsrc = store_text_source(result);
     size_t slen = 0;
     uint64_t spans[STORE_SUMMARY_NSKIP][2];
-    char *summary = js_object_without(&rsrc, skip, &slen, spans);
+    char *summary = json_scan_object_without(&rsrc, skip, &slen, spans);
     char *arrays = summary ? store_spans_text(spans) : NULL;
     if (!summary || !arrays) {
         gpd_log(GPD_LOG_WARN, "job %s: no result summary (the views will scan the result)", id);
@@ -371,7 +371,7 @@ static int stream_read(void *user, uint64_t off, void *dst, size_t n)
 
 js_source store_value_source(const char *text, size_t len, store_stream *s)
 {
-    if (text) return js_memory_source(text, len);
+    if (text) return json_scan_memory_source(text, len);
     return (js_source){stream_read, s, store_stream_size(s)};
 }
 
@@ -390,7 +390,7 @@ static store_rc summary_by_scan(const char *id, char **text, size_t *len,
     js_source src = store_value_source(small, small_len, ss);
     static const char *const skip[] = STORE_SUMMARY_SKIP;
     uint64_t sp[STORE_SUMMARY_NSKIP][2];
-    *text = js_object_without(&src, skip, len, sp);
+    *text = json_scan_object_without(&src, skip, len, sp);
     if (*text && spans) memcpy(spans, sp, sizeof sp);
     free(small);
     store_stream_close(ss);

@@ -14,7 +14,7 @@
 
 int svg_part_error(gpd_err *err, gp_svg_part part)
 {
-    gpd_err_set(err, 500, "cannot read the %s of the result", SVG_PART_NAME[part]);
+    gpd_err_set(err, 500, "cannot read the %s of the result", svg_items_part_name[part]);
     return -1;
 }
 
@@ -22,17 +22,17 @@ int svg_open_part(gp_svg *g, const gp_svg_input *in, gp_svg_part part, const cha
                   gpd_err *err)
 {
     int failed;
-    g->items = svg_open_items(in, part, &failed);
+    g->items = svg_items_open(in, part, &failed);
     if (g->items) return 0;
     if (failed) return svg_part_error(err, part);
     gpd_err_set(err, 409, "view \"%s\" needs the %s: the spec did not ask for output \"%s\"", view,
-                SVG_PART_NAME[part], SVG_PART_NAME[part]);
+                svg_items_part_name[part], svg_items_part_name[part]);
     return -1;
 }
 
 int svg_pass_failed(gp_svg *g)
 {
-    snprintf(g->err, sizeof g->err, "reading the %s failed", SVG_PART_NAME[g->items->part]);
+    snprintf(g->err, sizeof g->err, "reading the %s failed", svg_items_part_name[g->items->part]);
     return -1;
 }
 

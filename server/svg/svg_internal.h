@@ -11,9 +11,9 @@
 #include "svg/svg_plot.h"
 
 /* a part's name in a result ("grains", "cells", "spheres": the member and the output) */
-extern const char *const SVG_PART_NAME[3];
+extern const char *const svg_items_part_name[3];
 /* the four shape descriptors, in the order of svg_item.desc */
-extern const char *const SVG_DESC_NAME[4];
+extern const char *const svg_items_desc_name[4];
 
 /* ---- item sources ---- */
 
@@ -46,14 +46,14 @@ struct gp_svg_items {
 /* One element of a result array (as api.md writes it) into the item: from its JSON tree, or
  * straight from its text (the same values, without building a tree). -1 on out of memory or,
  * for the text, text that is not JSON. */
-int svg_item_from_json(gp_svg_part part, svg_item *c, const json_t *e);
-int svg_item_parse(gp_svg_part part, svg_item *c, const char *text, size_t len);
+int svg_items_from_json(gp_svg_part part, svg_item *c, const json_t *e);
+int svg_items_parse(gp_svg_part part, svg_item *c, const char *text, size_t len);
 /* the same without the points (contour, polygons skipped): a light source's parse */
-int svg_item_parse_light(gp_svg_part part, svg_item *c, const char *text, size_t len);
+int svg_items_parse_light(gp_svg_part part, svg_item *c, const char *text, size_t len);
 /* Appends the points of a JSON ring [[x,y],...] to the item's; -1 on out of memory. */
-int svg_item_ring(svg_item *c, const json_t *ring);
+int svg_items_ring(svg_item *c, const json_t *ring);
 /* Frees what the item holds (not the item). */
-void svg_item_free(svg_item *c);
+void svg_items_free(svg_item *c);
 
 /* ---- the rendering stream ---- */
 
@@ -111,7 +111,7 @@ struct gp_svg {
 
 /* The items of part: from in->open, else the summary's arrays. NULL when the result has none,
  * with *failed = 1 when they could not be read. */
-gp_svg_items *svg_open_items(const gp_svg_input *in, gp_svg_part part, int *failed);
+gp_svg_items *svg_items_open(const gp_svg_input *in, gp_svg_part part, int *failed);
 /* g->items = the items of part that view draws; -1 with err when there are none: 409 naming
  * the output to ask for, or 500 when they cannot be read. */
 int svg_open_part(gp_svg *g, const gp_svg_input *in, gp_svg_part part, const char *view,
@@ -124,14 +124,14 @@ int svg_pass_begin(gp_svg *g);
 int svg_pass_failed(gp_svg *g);
 /* the drawing pass over g->items begins: the reads call step (500 when it cannot begin) */
 int svg_start_steps(gp_svg *g, int (*step)(gp_svg *g), gpd_err *err);
-/* svg_open_items, the source made light (numbers only: the statistics views) */
-gp_svg_items *svg_open_light(const gp_svg_input *in, gp_svg_part part, int *failed);
+/* svg_items_open, the source made light (numbers only: the statistics views) */
+gp_svg_items *svg_items_open_light(const gp_svg_input *in, gp_svg_part part, int *failed);
 /* One pass over it, fn(user, item) on each item: 0, or -1 when the source failed. Memory O(1):
  * what the statistics views need of the items they accumulate in passes. */
 int svg_items_fold(gp_svg_items *it, void (*fn)(void *user, const svg_item *c), void *user);
 /* Values of one field of a part's items (NaN ones left out); NULL when none. field: 0 area,
  * 1 orientation, 2..5 the descriptors. *failed when the items could not be read. */
-double *svg_collect_items(const gp_svg_input *in, gp_svg_part part, int field, size_t *n,
+double *svg_items_collect(const gp_svg_input *in, gp_svg_part part, int field, size_t *n,
                           int *failed);
 
 #endif /* GPD_SVG_INTERNAL_H */

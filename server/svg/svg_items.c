@@ -8,8 +8,8 @@
 #include "gp_export_internal.h" /* the pack's record readers (gp_xr_grain, gp_xr_point, ...) */
 #include "svg/svg_internal.h"
 
-const char *const SVG_PART_NAME[3] = {"grains", "cells", "spheres"};
-const char *const SVG_DESC_NAME[4] = {"elongation", "roundness", "circularity", "regularity"};
+const char *const svg_items_part_name[3] = {"grains", "cells", "spheres"};
+const char *const svg_items_desc_name[4] = {"elongation", "roundness", "circularity", "regularity"};
 
 /* p resized for n elements of size bytes, its capacity *cap doubled from first until they fit;
  * NULL (p untouched) on out of memory */
@@ -53,42 +53,42 @@ static void item_clear(svg_item *c)
 }
 
 /* appends the points of a JSON ring; -1 on out of memory */
-int svg_item_ring(svg_item *c, const json_t *ring)
+int svg_items_ring(svg_item *c, const json_t *ring)
 {
     size_t n = json_array_size(ring);
     if (pts_room(c, c->npts + n)) return -1;
     for (size_t i = 0; i < n; i++) {
         const json_t *p = json_array_get(ring, i);
-        c->xy[2 * (c->npts + i)] = jnum(json_array_get(p, 0), NAN);
-        c->xy[2 * (c->npts + i) + 1] = jnum(json_array_get(p, 1), NAN);
+        c->xy[2 * (c->npts + i)] = svg_plot_jnum(json_array_get(p, 0), NAN);
+        c->xy[2 * (c->npts + i) + 1] = svg_plot_jnum(json_array_get(p, 1), NAN);
     }
     c->npts += n;
     return 0;
 }
 
-int svg_item_from_json(gp_svg_part part, svg_item *c, const json_t *e)
+int svg_items_from_json(gp_svg_part part, svg_item *c, const json_t *e)
 {
     item_clear(c);
     if (part == GP_SVG_SPHERES) {
-        for (int a = 0; a < 4; a++) c->q[a] = jnum(json_array_get(e, (size_t)a), NAN);
+        for (int a = 0; a < 4; a++) c->q[a] = svg_plot_jnum(json_array_get(e, (size_t)a), NAN);
         return 0;
     }
-    c->area = jnum(json_object_get(e, "area"), NAN);
-    c->orientation_deg = jnum(json_object_get(e, "orientation_deg"), NAN);
+    c->area = svg_plot_jnum(json_object_get(e, "area"), NAN);
+    c->orientation_deg = svg_plot_jnum(json_object_get(e, "orientation_deg"), NAN);
     if (part == GP_SVG_GRAINS) {
         const json_t *d = json_object_get(e, "descriptors");
-        for (int k = 0; k < 4; k++) c->desc[k] = jnum(json_object_get(d, SVG_DESC_NAME[k]), NAN);
-        return svg_item_ring(c, json_object_get(e, "contour"));
+        for (int k = 0; k < 4; k++) c->desc[k] = svg_plot_jnum(json_object_get(d, svg_items_desc_name[k]), NAN);
+        return svg_items_ring(c, json_object_get(e, "contour"));
     }
     const json_t *sd = json_object_get(e, "seed");
-    c->seed[0] = jnum(json_array_get(sd, 0), NAN);
-    c->seed[1] = jnum(json_array_get(sd, 1), NAN);
+    c->seed[0] = svg_plot_jnum(json_array_get(sd, 0), NAN);
+    c->seed[1] = svg_plot_jnum(json_array_get(sd, 1), NAN);
     const json_t *polys = json_object_get(e, "polygons");
     size_t np = json_array_size(polys);
     if (rings_room(c, np)) return -1;
     for (size_t j = 0; j < np; j++) {
         size_t before = c->npts;
-        if (svg_item_ring(c, json_array_get(polys, j))) return -1;
+        if (svg_items_ring(c, json_array_get(polys, j))) return -1;
         c->rings[c->nrings++] = c->npts - before;
     }
     return 0;
@@ -102,7 +102,7 @@ static gp_svg_items *items_new(gp_svg_part part)
     return it;
 }
 
-void svg_item_free(svg_item *c)
+void svg_items_free(svg_item *c)
 {
     free(c->xy);
     free(c->rings);
@@ -111,10 +111,10 @@ void svg_item_free(svg_item *c)
 void gp_svg_items_close(gp_svg_items *it)
 {
     if (it) {
-        js_close(it->js);
+        json_scan_close(it->js);
         gp_export_destroy(it->e);
         gp_export_destroy(it->ep);
-        svg_item_free(&it->cur);
+        svg_items_free(&it->cur);
     }
     free(it);
 }
@@ -131,7 +131,7 @@ static int json_rewind(gp_svg_items *it)
 static int json_next(gp_svg_items *it)
 {
     if (it->idx >= json_array_size(it->arr)) return 0;
-    if (svg_item_from_json(it->part, &it->cur, json_array_get(it->arr, it->idx++))) return -1;
+    if (svg_items_from_json(it->part, &it->cur, json_array_get(it->arr, it->idx++))) return -1;
     if (it->light) it->cur.npts = it->cur.nrings = 0; /* as the other sources give it */
     return 1;
 }
@@ -150,7 +150,7 @@ gp_svg_items *gp_svg_items_json(const json_t *array, gp_svg_part part)
 /* ------------------------------------------------------------------ the element parser */
 
 /* An element's text read straight into the item (the scan source): the same values as
- * svg_item_from_json() gives for the parsed element, without building a JSON tree (three times
+ * svg_items_from_json() gives for the parsed element, without building a JSON tree (three times
  * faster on cells, which are read in three passes). A number is read with strtod (the C
  * locale: the daemon never sets another), null and any other value where a number belongs
  * give NaN, unknown members are skipped. -1 on text that is not JSON. */
@@ -309,7 +309,7 @@ static int pp_descriptors(pp *q, svg_item *c)
     size_t kl;
     while ((r = pp_member(q, &first, &k, &kl)) > 0) {
         int j = 0;
-        while (j < 4 && !key_is(k, kl, SVG_DESC_NAME[j])) j++;
+        while (j < 4 && !key_is(k, kl, svg_items_desc_name[j])) j++;
         if (j < 4 ? pp_num(q, &c->desc[j]) : pp_skip(q)) return -1;
     }
     return r;
@@ -360,12 +360,12 @@ static int item_parse(gp_svg_part part, svg_item *c, const char *text, size_t le
     return r;
 }
 
-int svg_item_parse(gp_svg_part part, svg_item *c, const char *text, size_t len)
+int svg_items_parse(gp_svg_part part, svg_item *c, const char *text, size_t len)
 {
     return item_parse(part, c, text, len, 0);
 }
 
-int svg_item_parse_light(gp_svg_part part, svg_item *c, const char *text, size_t len)
+int svg_items_parse_light(gp_svg_part part, svg_item *c, const char *text, size_t len)
 {
     return item_parse(part, c, text, len, 1);
 }
@@ -375,15 +375,15 @@ int svg_item_parse_light(gp_svg_part part, svg_item *c, const char *text, size_t
 /* -- an array of a JSON text, element by element */
 static int scan_rewind(gp_svg_items *it)
 {
-    return js_array_begin(it->js, it->off);
+    return json_scan_array_begin(it->js, it->off);
 }
 
 static int scan_next(gp_svg_items *it)
 {
     uint64_t a, b;
-    int r = js_array_next(it->js, &a, &b);
+    int r = json_scan_array_next(it->js, &a, &b);
     if (r <= 0) return r;
-    const char *t = js_span(it->js, a, b);
+    const char *t = json_scan_span(it->js, a, b);
     if (!t) return -1;
     return item_parse(it->part, &it->cur, t, (size_t)(b - a), it->light) ? -1 : 1;
 }
@@ -392,7 +392,7 @@ gp_svg_items *gp_svg_items_scan(const js_source *text, uint64_t off, gp_svg_part
 {
     gp_svg_items *it = items_new(part);
     if (!it) return NULL;
-    it->js = js_open(text);
+    it->js = json_scan_open(text);
     if (!it->js) {
         gp_svg_items_close(it);
         return NULL;
@@ -467,19 +467,19 @@ gp_svg_items *gp_svg_items_pack(const gp_export_source *pack, gp_svg_part part)
 
 /* ------------------------------------------------------------------ what the views read */
 
-gp_svg_items *svg_open_items(const gp_svg_input *in, gp_svg_part part, int *failed)
+gp_svg_items *svg_items_open(const gp_svg_input *in, gp_svg_part part, int *failed)
 {
     *failed = 0;
     if (in->open) return in->open(in->user, part, failed);
-    const json_t *a = json_object_get(in->summary, SVG_PART_NAME[part]);
+    const json_t *a = json_object_get(in->summary, svg_items_part_name[part]);
     gp_svg_items *it = gp_svg_items_json(a, part);
     if (!it && json_is_array(a)) *failed = 1;
     return it;
 }
 
-gp_svg_items *svg_open_light(const gp_svg_input *in, gp_svg_part part, int *failed)
+gp_svg_items *svg_items_open_light(const gp_svg_input *in, gp_svg_part part, int *failed)
 {
-    gp_svg_items *it = svg_open_items(in, part, failed);
+    gp_svg_items *it = svg_items_open(in, part, failed);
     if (it) it->light = 1;
     return it;
 }
@@ -491,11 +491,11 @@ int svg_items_fold(gp_svg_items *it, void (*fn)(void *user, const svg_item *c), 
     return r < 0 ? -1 : 0;
 }
 
-double *svg_collect_items(const gp_svg_input *in, gp_svg_part part, int field, size_t *n,
+double *svg_items_collect(const gp_svg_input *in, gp_svg_part part, int field, size_t *n,
                           int *failed)
 {
     *n = 0;
-    gp_svg_items *it = svg_open_light(in, part, failed);
+    gp_svg_items *it = svg_items_open_light(in, part, failed);
     if (!it) return NULL;
     size_t cap = 0;
     double *v = NULL;

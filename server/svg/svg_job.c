@@ -52,7 +52,7 @@ static int skip_index(gp_svg_part part)
 {
     static const char *const skip[] = STORE_SUMMARY_SKIP;
     for (int k = 0; k < STORE_SUMMARY_NSKIP; k++)
-        if (!strcmp(skip[k], SVG_PART_NAME[part])) return k;
+        if (!strcmp(skip[k], svg_items_part_name[part])) return k;
     return -1;
 }
 
@@ -71,7 +71,7 @@ static gp_svg_items *pack_items(svg_job *j, gp_svg_part part, int *failed)
     gp_svg_items *it = gp_svg_items_pack(&src, part);
     if (!it)
         gpd_log(GPD_LOG_WARN, "job %s: its export pack has no %s; reading the result", j->id,
-                SVG_PART_NAME[part]);
+                svg_items_part_name[part]);
     return it;
 }
 
@@ -95,7 +95,7 @@ static gp_svg_items *job_items(void *user, gp_svg_part part, int *failed)
     js_source src = value_source(&j->result);
     if (j->spans[k][1] > src.size) {
         gpd_log(GPD_LOG_ERROR, "job %s: the %s are not where the summary says", j->id,
-                SVG_PART_NAME[part]);
+                svg_items_part_name[part]);
         *failed = 1;
         return NULL;
     }

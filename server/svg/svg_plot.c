@@ -9,7 +9,7 @@
 
 /* ------------------------------------------------------------------ the XML writer */
 
-void sb_printf(sb *s, const char *fmt, ...)
+void svg_plot_sb_printf(sb *s, const char *fmt, ...)
 {
     if (s->oom) return;
     va_list ap;
@@ -29,11 +29,11 @@ void sb_printf(sb *s, const char *fmt, ...)
     s->len += (size_t)n;
 }
 
-void sb_puts(sb *s, const char *str) { gpd_buf_add(s, str, strlen(str)); }
+void svg_plot_sb_puts(sb *s, const char *str) { gpd_buf_add(s, str, strlen(str)); }
 
 /* The rounding is done on v * 10 unless that lies within 1e-6 of a half, where snprintf
  * decides (its exact decimal rounding), so the text is always printf's. */
-int fmt_f1(char *buf, double v)
+int svg_plot_fmt_f1(char *buf, double v)
 {
     double t = v * 10.0;
     if (!(fabs(t) < 1e15)) return snprintf(buf, F1_MAX, "%.1f", v);
@@ -59,55 +59,55 @@ int fmt_f1(char *buf, double v)
 }
 
 /* text content with XML escaping */
-void sb_text(sb *s, const char *str)
+void svg_plot_sb_text(sb *s, const char *str)
 {
     for (; *str; str++) {
         switch (*str) {
-        case '<': sb_puts(s, "&lt;"); break;
-        case '>': sb_puts(s, "&gt;"); break;
-        case '&': sb_puts(s, "&amp;"); break;
-        case '"': sb_puts(s, "&quot;"); break;
+        case '<': svg_plot_sb_puts(s, "&lt;"); break;
+        case '>': svg_plot_sb_puts(s, "&gt;"); break;
+        case '&': svg_plot_sb_puts(s, "&amp;"); break;
+        case '"': svg_plot_sb_puts(s, "&quot;"); break;
         default: gpd_buf_add(s, str, 1);
         }
     }
 }
 
-void text_at(sb *s, double x, double y, const char *anchor, const char *extra,
+void svg_plot_text_at(sb *s, double x, double y, const char *anchor, const char *extra,
                     const char *str)
 {
-    sb_printf(s, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"%s\"%s%s>", x, y, anchor,
+    svg_plot_sb_printf(s, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"%s\"%s%s>", x, y, anchor,
               extra && *extra ? " " : "", extra ? extra : "");
-    sb_text(s, str);
-    sb_puts(s, "</text>\n");
+    svg_plot_sb_text(s, str);
+    svg_plot_sb_puts(s, "</text>\n");
 }
 
-void text_up(sb *s, double x, double y, const char *str)
+void svg_plot_text_up(sb *s, double x, double y, const char *str)
 {
-    sb_printf(s, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" transform=\"rotate(-90 %.1f %.1f)\">",
+    svg_plot_sb_printf(s, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" transform=\"rotate(-90 %.1f %.1f)\">",
               x, y, x, y);
-    sb_text(s, str);
-    sb_puts(s, "</text>\n");
+    svg_plot_sb_text(s, str);
+    svg_plot_sb_puts(s, "</text>\n");
 }
 
-void doc_begin(sb *s, int w, int h, const char *title)
+void svg_plot_doc_begin(sb *s, int w, int h, const char *title)
 {
-    sb_puts(s, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    sb_printf(s,
+    svg_plot_sb_puts(s, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    svg_plot_sb_printf(s,
               "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"%d\" height=\"%d\" "
               "viewBox=\"0 0 %d %d\" font-family=\"Helvetica, Arial, sans-serif\" font-size=\"12\">\n",
               w, h, w, h);
-    sb_puts(s, "<title>");
-    sb_text(s, title);
-    sb_puts(s, "</title>\n");
-    sb_printf(s, "<rect x=\"0\" y=\"0\" width=\"%d\" height=\"%d\" fill=\"#ffffff\"/>\n", w, h);
-    text_at(s, w / 2.0, 22, "middle", "font-size=\"15\" font-weight=\"bold\"", title);
+    svg_plot_sb_puts(s, "<title>");
+    svg_plot_sb_text(s, title);
+    svg_plot_sb_puts(s, "</title>\n");
+    svg_plot_sb_printf(s, "<rect x=\"0\" y=\"0\" width=\"%d\" height=\"%d\" fill=\"#ffffff\"/>\n", w, h);
+    svg_plot_text_at(s, w / 2.0, 22, "middle", "font-size=\"15\" font-weight=\"bold\"", title);
 }
 
-void doc_end(sb *s) { sb_puts(s, "</svg>\n"); }
+void svg_plot_doc_end(sb *s) { svg_plot_sb_puts(s, "</svg>\n"); }
 
 /* ------------------------------------------------------------------ labels and colours */
 
-void fmt_label(char *buf, size_t n, double v)
+void svg_plot_fmt_label(char *buf, size_t n, double v)
 {
     if (fabs(v) < 1e-12) v = 0;
     snprintf(buf, n, "%.4g", v);
@@ -131,7 +131,7 @@ static void fmt_pow10(char *buf, size_t n, double v)
     snprintf(buf, n, "%s", out);
 }
 
-void fmt_tick(char *buf, size_t n, double v, double step)
+void svg_plot_fmt_tick(char *buf, size_t n, double v, double step)
 {
     step = fabs(step) > 0 ? fabs(step) : fabs(v);
     if (fabs(v) < step * 1e-9 || v == 0) {
@@ -149,7 +149,7 @@ void fmt_tick(char *buf, size_t n, double v, double step)
     snprintf(buf, n, "%.*f", dec, v);
 }
 
-double text_w(const char *str)
+double svg_plot_text_w(const char *str)
 {
     double w = 0;
     for (const unsigned char *p = (const unsigned char *)str; *p; p++)
@@ -165,8 +165,8 @@ static int ticks_fit(const ticks *t, const double *pos, int horiz)
     double wprev = 0;
     for (int i = 0; i < t->n; i++) {
         char lab[64];
-        fmt_tick(lab, sizeof lab, t->v[i], t->step);
-        double w = text_w(lab);
+        svg_plot_fmt_tick(lab, sizeof lab, t->v[i], t->step);
+        double w = svg_plot_text_w(lab);
         if (i > 0) {
             double need = horiz ? (w + wprev) / 2 + 6 : 16;
             if (fabs(pos[i] - pos[i - 1]) < need) return 0;
@@ -176,7 +176,7 @@ static int ticks_fit(const ticks *t, const double *pos, int horiz)
     return 1;
 }
 
-void lin_ticks(double lo, double hi, double px, int horiz, int nmax, ticks *t)
+void svg_plot_lin_ticks(double lo, double hi, double px, int horiz, int nmax, ticks *t)
 {
     t->n = 0;
     t->step = 0;
@@ -206,7 +206,7 @@ void lin_ticks(double lo, double hi, double px, int horiz, int nmax, ticks *t)
         }
 }
 
-void log_ticks(double lo, double hi, double px, int horiz, ticks *t)
+void svg_plot_log_ticks(double lo, double hi, double px, int horiz, ticks *t)
 {
     static const int sets[4][10] = {
         {1, 2, 3, 4, 5, 6, 7, 8, 9, 0}, {1, 2, 3, 5, 0}, {1, 2, 5, 0}, {1, 0}};
@@ -214,7 +214,7 @@ void log_ticks(double lo, double hi, double px, int horiz, ticks *t)
     t->n = 0;
     t->step = 0;
     if (!(lo > 0) || !(hi > lo) || !isfinite(hi)) {
-        lin_ticks(lo, hi, px, horiz, 5, t);
+        svg_plot_lin_ticks(lo, hi, px, horiz, 5, t);
         return;
     }
     int d0 = (int)floor(log10(lo) + 1e-9), d1 = (int)ceil(log10(hi) - 1e-9);
@@ -235,10 +235,10 @@ void log_ticks(double lo, double hi, double px, int horiz, ticks *t)
         if (t->n >= 2 && ticks_fit(t, pos, horiz)) return;
         if (t->n < 2) break; /* sparser sets only lose more: linear ones */
     }
-    lin_ticks(lo, hi, px, horiz, 4, t);
+    svg_plot_lin_ticks(lo, hi, px, horiz, 4, t);
 }
 
-const char *area_unit(double hi, double *factor)
+const char *svg_plot_area_unit(double hi, double *factor)
 {
     if (!(hi < 0.1)) {
         *factor = 1;
@@ -253,7 +253,7 @@ const char *area_unit(double hi, double *factor)
 }
 
 /* viridis-like colour ramp, t in [0, 1] */
-void ramp(double t, char *buf, size_t n)
+void svg_plot_ramp(double t, char *buf, size_t n)
 {
     static const double st[6][3] = {{68, 1, 84},    {65, 68, 135},  {42, 120, 142},
                                     {34, 168, 132}, {122, 209, 81}, {253, 231, 37}};
@@ -269,7 +269,7 @@ void ramp(double t, char *buf, size_t n)
 }
 
 /* cyclic colour for an axial orientation in degrees (period 180) */
-void cyclic(double deg, char *buf, size_t n)
+void svg_plot_cyclic(double deg, char *buf, size_t n)
 {
     double h = fmod(deg + 90.0, 180.0);
     if (h < 0) h += 180;
@@ -288,20 +288,20 @@ void cyclic(double deg, char *buf, size_t n)
 
 /* ------------------------------------------------------------------ JSON numbers */
 
-double jnum(const json_t *v, double dflt)
+double svg_plot_jnum(const json_t *v, double dflt)
 {
     return json_is_number(v) ? json_number_value(v) : dflt;
 }
 
 /* reads a numeric array (NULL-safe); returns a malloc'ed copy and its length, NULL if absent */
-double *jarray(const json_t *a, size_t *n)
+double *svg_plot_jarray(const json_t *a, size_t *n)
 {
     *n = 0;
     if (!json_is_array(a) || json_array_size(a) == 0) return NULL;
     size_t m = json_array_size(a);
     double *v = malloc(m * sizeof *v);
     if (!v) return NULL;
-    for (size_t i = 0; i < m; i++) v[i] = jnum(json_array_get(a, i), NAN);
+    for (size_t i = 0; i < m; i++) v[i] = svg_plot_jnum(json_array_get(a, i), NAN);
     *n = m;
     return v;
 }
@@ -309,7 +309,7 @@ double *jarray(const json_t *a, size_t *n)
 /* ------------------------------------------------------------------ frames and axes */
 
 /* "nice" tick step for about n ticks over [lo, hi] */
-double nice_step(double lo, double hi, int n)
+double svg_plot_nice_step(double lo, double hi, int n)
 {
     double span = hi - lo;
     if (!(span > 0)) return 1;
@@ -318,13 +318,13 @@ double nice_step(double lo, double hi, int n)
     return nf * p;
 }
 
-double fx(const frame *f, double x)
+double svg_plot_fx(const frame *f, double x)
 {
     if (f->xlog) return f->x0 + (log10(x) - log10(f->xmin)) / (log10(f->xmax) - log10(f->xmin)) * f->w;
     return f->x0 + (x - f->xmin) / (f->xmax - f->xmin) * f->w;
 }
 
-double fy(const frame *f, double y)
+double svg_plot_fy(const frame *f, double y)
 {
     return f->y0 + f->h - (y - f->ymin) / (f->ymax - f->ymin) * f->h;
 }
@@ -333,10 +333,10 @@ double fy(const frame *f, double y)
 static void grid_line(sb *s, const frame *f, double at, int vertical)
 {
     if (vertical)
-        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n", at,
+        svg_plot_sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n", at,
                   f->y0, at, f->y0 + f->h);
     else
-        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n",
+        svg_plot_sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#dddddd\"/>\n",
                   f->x0, at, f->x0 + f->w, at);
 }
 
@@ -345,8 +345,8 @@ static void grid_line(sb *s, const frame *f, double at, int vertical)
 static void x_ticks(sb *s, const frame *f, int grid)
 {
     ticks t;
-    if (f->xlog) log_ticks(f->xmin, f->xmax, f->w, 1, &t);
-    else lin_ticks(f->xmin, f->xmax, f->w, 1, 7, &t);
+    if (f->xlog) svg_plot_log_ticks(f->xmin, f->xmax, f->w, 1, &t);
+    else svg_plot_lin_ticks(f->xmin, f->xmax, f->w, 1, 7, &t);
     double yb = f->y0 + f->h;
     if (f->xlog && f->w / log10(f->xmax / f->xmin) >= 40) {
         int d0 = (int)floor(log10(f->xmin)), d1 = (int)ceil(log10(f->xmax));
@@ -354,19 +354,19 @@ static void x_ticks(sb *s, const frame *f, int grid)
             for (int m = 1; m <= 9; m++) {
                 double v = m * pow(10, d);
                 if (v < f->xmin * (1 - 1e-9) || v > f->xmax * (1 + 1e-9)) continue;
-                double x = fx(f, v);
-                sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", x, yb,
+                double x = svg_plot_fx(f, v);
+                svg_plot_sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", x, yb,
                           x, yb + 3);
             }
     }
     for (int i = 0; i < t.n; i++) {
-        double x = fx(f, t.v[i]);
+        double x = svg_plot_fx(f, t.v[i]);
         char lab[64];
         if (grid) grid_line(s, f, x, 1);
-        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", x, yb, x,
+        svg_plot_sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", x, yb, x,
                   yb + 6);
-        fmt_tick(lab, sizeof lab, t.v[i], t.step);
-        text_at(s, x, yb + 19, "middle", "class=\"xtick\" stroke=\"none\"", lab);
+        svg_plot_fmt_tick(lab, sizeof lab, t.v[i], t.step);
+        svg_plot_text_at(s, x, yb + 19, "middle", "class=\"xtick\" stroke=\"none\"", lab);
     }
 }
 
@@ -374,91 +374,91 @@ static void x_ticks(sb *s, const frame *f, int grid)
 static double y_ticks(sb *s, const frame *f, int grid)
 {
     ticks t;
-    lin_ticks(f->ymin, f->ymax, f->h, 0, 6, &t);
+    svg_plot_lin_ticks(f->ymin, f->ymax, f->h, 0, 6, &t);
     double wmax = 0;
     for (int i = 0; i < t.n; i++) {
-        double y = fy(f, t.v[i]);
+        double y = svg_plot_fy(f, t.v[i]);
         char lab[64];
         if (grid) grid_line(s, f, y, 0);
-        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0 - 6, y,
+        svg_plot_sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0 - 6, y,
                   f->x0, y);
-        fmt_tick(lab, sizeof lab, t.v[i], t.step);
-        wmax = fmax(wmax, text_w(lab));
-        text_at(s, f->x0 - 9, y + 4, "end", "class=\"ytick\" stroke=\"none\"", lab);
+        svg_plot_fmt_tick(lab, sizeof lab, t.v[i], t.step);
+        wmax = fmax(wmax, svg_plot_text_w(lab));
+        svg_plot_text_at(s, f->x0 - 9, y + 4, "end", "class=\"ytick\" stroke=\"none\"", lab);
     }
     return wmax;
 }
 
 /* axes with ticks and labels; grid lines when grid. The y label stands clear of the widest
  * tick label. */
-void axes(sb *s, const frame *f, const char *xlabel, const char *ylabel, int grid)
+void svg_plot_axes(sb *s, const frame *f, const char *xlabel, const char *ylabel, int grid)
 {
-    sb_puts(s, "<g class=\"axes\" stroke=\"#000000\" stroke-width=\"1\">\n");
-    sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0, f->y0 + f->h,
+    svg_plot_sb_puts(s, "<g class=\"axes\" stroke=\"#000000\" stroke-width=\"1\">\n");
+    svg_plot_sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0, f->y0 + f->h,
               f->x0 + f->w, f->y0 + f->h);
-    sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0, f->y0, f->x0,
+    svg_plot_sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", f->x0, f->y0, f->x0,
               f->y0 + f->h);
-    sb_puts(s, "</g>\n<g class=\"ticks\" stroke=\"#000000\">\n");
+    svg_plot_sb_puts(s, "</g>\n<g class=\"ticks\" stroke=\"#000000\">\n");
     x_ticks(s, f, grid);
     double wy = y_ticks(s, f, grid);
-    sb_puts(s, "</g>\n");
-    text_at(s, f->x0 + f->w / 2, f->y0 + f->h + 38, "middle", NULL, xlabel);
-    text_up(s, f->x0 - 9 - wy - 10, f->y0 + f->h / 2, ylabel);
+    svg_plot_sb_puts(s, "</g>\n");
+    svg_plot_text_at(s, f->x0 + f->w / 2, f->y0 + f->h + 38, "middle", NULL, xlabel);
+    svg_plot_text_up(s, f->x0 - 9 - wy - 10, f->y0 + f->h / 2, ylabel);
 }
 
 /* a legend item's symbol, 22 px wide from x, for a label on baseline yy */
 static void legend_symbol(sb *s, double x, double yy, const legend_item *it)
 {
     if (!strcmp(it->style, "bar"))
-        sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"22\" height=\"10\" fill=\"%s\" "
+        svg_plot_sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"22\" height=\"10\" fill=\"%s\" "
                      "fill-opacity=\"0.7\" stroke=\"%s\"/>\n",
                   x, yy - 9, it->color, it->color);
     else
-        sb_printf(s, "<path d=\"M%.1f %.1fh22\" stroke=\"%s\" stroke-width=\"2\"%s/>\n", x, yy - 4,
+        svg_plot_sb_printf(s, "<path d=\"M%.1f %.1fh22\" stroke=\"%s\" stroke-width=\"2\"%s/>\n", x, yy - 4,
                   it->color, !strcmp(it->style, "dash") ? " stroke-dasharray=\"5 3\"" : "");
     if (!strcmp(it->style, "marker"))
-        sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"6\" height=\"6\" fill=\"%s\"/>\n", x + 8,
+        svg_plot_sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"6\" height=\"6\" fill=\"%s\"/>\n", x + 8,
                   yy - 7, it->color);
 }
 
-double legend_row(sb *s, double x, double y, const legend_item *it, int n)
+double svg_plot_legend_row(sb *s, double x, double y, const legend_item *it, int n)
 {
     double x0 = x;
-    sb_puts(s, "<g class=\"legend\">\n");
+    svg_plot_sb_puts(s, "<g class=\"legend\">\n");
     for (int i = 0; i < n; i++) {
         legend_symbol(s, x, y, &it[i]);
-        text_at(s, x + 28, y, "start", NULL, it[i].label);
-        x += 28 + text_w(it[i].label) + 20;
+        svg_plot_text_at(s, x + 28, y, "start", NULL, it[i].label);
+        x += 28 + svg_plot_text_w(it[i].label) + 20;
     }
-    sb_puts(s, "</g>\n");
+    svg_plot_sb_puts(s, "</g>\n");
     return x - x0 - 20;
 }
 
-double legend_w(const legend_item *it, int n)
+double svg_plot_legend_w(const legend_item *it, int n)
 {
     double w = 0;
-    for (int i = 0; i < n; i++) w = fmax(w, text_w(it[i].label));
+    for (int i = 0; i < n; i++) w = fmax(w, svg_plot_text_w(it[i].label));
     return w + 46;
 }
 
-void legend(sb *s, double x, double y, const legend_item *it, int n)
+void svg_plot_legend(sb *s, double x, double y, const legend_item *it, int n)
 {
-    double w = legend_w(it, n) - 46;
-    sb_printf(s, "<g class=\"legend\">\n<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" "
+    double w = svg_plot_legend_w(it, n) - 46;
+    svg_plot_sb_printf(s, "<g class=\"legend\">\n<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" "
                  "fill=\"#ffffff\" fill-opacity=\"0.85\" stroke=\"#999999\"/>\n",
               x, y, w + 46, 8 + 18 * n);
     for (int i = 0; i < n; i++) {
         double yy = y + 16 + 18 * i;
         legend_symbol(s, x + 8, yy, &it[i]);
-        text_at(s, x + 38, yy, "start", NULL, it[i].label);
+        svg_plot_text_at(s, x + 38, yy, "start", NULL, it[i].label);
     }
-    sb_puts(s, "</g>\n");
+    svg_plot_sb_puts(s, "</g>\n");
 }
 
 /* a marker as a small square path (not a <circle>, see the conventions above) */
-void marker(sb *s, double x, double y, const char *color)
+void svg_plot_marker(sb *s, double x, double y, const char *color)
 {
-    sb_printf(s, "<path d=\"M%.1f %.1fh6v6h-6z\" fill=\"%s\"/>\n", x - 3, y - 3, color);
+    svg_plot_sb_printf(s, "<path d=\"M%.1f %.1fh6v6h-6z\" fill=\"%s\"/>\n", x - 3, y - 3, color);
 }
 
 /* the colour bar's ticks: every 45 degrees for orientations, else round values */
@@ -469,24 +469,24 @@ static void colorbar_ticks(double lo, double hi, double h, int cyc, int logscale
         t->step = 45;
         for (int k = 0; k < 5; k++) t->v[k] = -90 + 45 * k;
     } else if (logscale && lo > 0) {
-        log_ticks(lo, hi, h, 0, t);
+        svg_plot_log_ticks(lo, hi, h, 0, t);
     } else {
-        lin_ticks(lo, hi, h, 0, 6, t);
+        svg_plot_lin_ticks(lo, hi, h, 0, 6, t);
     }
 }
 
-void colorbar(sb *s, double x, double y, double h, double lo, double hi, int cyc,
+void svg_plot_colorbar(sb *s, double x, double y, double h, double lo, double hi, int cyc,
                      int logscale, const char *label)
 {
-    sb_puts(s, "<defs><linearGradient id=\"cbar\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">\n");
+    svg_plot_sb_puts(s, "<defs><linearGradient id=\"cbar\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">\n");
     for (int k = 0; k <= 10; k++) {
         char c[16];
-        if (cyc) cyclic(-90 + 18.0 * k, c, sizeof c);
-        else ramp(k / 10.0, c, sizeof c);
-        sb_printf(s, "<stop offset=\"%.1f\" stop-color=\"%s\"/>\n", k / 10.0, c);
+        if (cyc) svg_plot_cyclic(-90 + 18.0 * k, c, sizeof c);
+        else svg_plot_ramp(k / 10.0, c, sizeof c);
+        svg_plot_sb_printf(s, "<stop offset=\"%.1f\" stop-color=\"%s\"/>\n", k / 10.0, c);
     }
-    sb_puts(s, "</linearGradient></defs>\n");
-    sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"16\" height=\"%.1f\" fill=\"url(#cbar)\" stroke=\"#000000\"/>\n",
+    svg_plot_sb_puts(s, "</linearGradient></defs>\n");
+    svg_plot_sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"16\" height=\"%.1f\" fill=\"url(#cbar)\" stroke=\"#000000\"/>\n",
               x, y, h);
     if (cyc) lo = -90, hi = 90;
     ticks t;
@@ -497,18 +497,18 @@ void colorbar(sb *s, double x, double y, double h, double lo, double hi, int cyc
         double u = !(hi > lo) ? 0.5 : lg ? log(t.v[k] / lo) / log(hi / lo) : (t.v[k] - lo) / (hi - lo);
         double yy = y + h - u * h;
         char lab[64];
-        fmt_tick(lab, sizeof lab, t.v[k], t.step);
-        sb_printf(s, "<line class=\"cbar-tick\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#000000\"/>\n",
+        svg_plot_fmt_tick(lab, sizeof lab, t.v[k], t.step);
+        svg_plot_sb_printf(s, "<line class=\"cbar-tick\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#000000\"/>\n",
                   x + 16, yy, x + 21, yy);
-        text_at(s, x + 25, yy + 4, "start", "class=\"cbar-label\"", lab);
-        wmax = fmax(wmax, text_w(lab));
+        svg_plot_text_at(s, x + 25, yy + 4, "start", "class=\"cbar-label\"", lab);
+        wmax = fmax(wmax, svg_plot_text_w(lab));
     }
-    text_up(s, x + 25 + wmax + 14, y + h / 2, label);
+    svg_plot_text_up(s, x + 25 + wmax + 14, y + h / 2, label);
 }
 
 /* ------------------------------------------------------------------ maps */
 
-void bounds_init(bounds *b)
+void svg_plot_bounds_init(bounds *b)
 {
     b->xmin = b->ymin = INFINITY;
     b->xmax = b->ymax = -INFINITY;
@@ -516,7 +516,7 @@ void bounds_init(bounds *b)
 
 /* (comparisons, not fmin/fmax: these see every point of every pass, and the finite test
  * already keeps NaN out) */
-void bounds_add(bounds *b, double x, double y)
+void svg_plot_bounds_add(bounds *b, double x, double y)
 {
     if (!isfinite(x) || !isfinite(y)) return;
     if (x < b->xmin) b->xmin = x;
@@ -525,7 +525,7 @@ void bounds_add(bounds *b, double x, double y)
     if (y > b->ymax) b->ymax = y;
 }
 
-void bounds_xy(bounds *b, const double *xy, size_t n)
+void svg_plot_bounds_xy(bounds *b, const double *xy, size_t n)
 {
     bounds r = *b;
     for (size_t i = 0; i < n; i++) {
@@ -539,10 +539,10 @@ void bounds_xy(bounds *b, const double *xy, size_t n)
     *b = r;
 }
 
-int bounds_ok(const bounds *b) { return b->xmax >= b->xmin && b->ymax >= b->ymin; }
+int svg_plot_bounds_ok(const bounds *b) { return b->xmax >= b->xmin && b->ymax >= b->ymin; }
 
 /* a map frame with equal scales on both axes, fitting width px */
-frame map_frame(bounds b, int width, int *height)
+frame svg_plot_map_frame(bounds b, int width, int *height)
 {
     double dx = b.xmax - b.xmin, dy = b.ymax - b.ymin;
     double d = fmax(dx, dy);
@@ -575,7 +575,7 @@ frame map_frame(bounds b, int width, int *height)
     return f;
 }
 
-frame map_frame_in(bounds b, double x0, double y0, double w, double hmax)
+frame svg_plot_map_frame_in(bounds b, double x0, double y0, double w, double hmax)
 {
     double dx = b.xmax - b.xmin, dy = b.ymax - b.ymin;
     if (!(dx > 0)) dx = dy > 0 ? dy : 1;
@@ -589,12 +589,12 @@ frame map_frame_in(bounds b, double x0, double y0, double w, double hmax)
 /* "x,y x,y ..." of a ring of n points (xy: x0 y0 x1 y1 ...), decimated to min_px (a point
  * within min_px of the last one written, in both directions, is dropped, but a ring keeps at
  * least 3 points); returns points written */
-size_t ring_points_xy(sb *s, const frame *f, const double *xy, size_t n, double min_px)
+size_t svg_plot_ring_points_xy(sb *s, const frame *f, const double *xy, size_t n, double min_px)
 {
     size_t written = 0;
     double lx = NAN, ly = NAN;
     for (size_t i = 0; i < n; i++) {
-        double x = fx(f, xy[2 * i]), y = fy(f, xy[2 * i + 1]);
+        double x = svg_plot_fx(f, xy[2 * i]), y = svg_plot_fy(f, xy[2 * i + 1]);
         if (!isfinite(x) || !isfinite(y)) continue;
         int last = i + 1 == n;
         if (written && !last && fabs(x - lx) < min_px && fabs(y - ly) < min_px) continue;
@@ -602,9 +602,9 @@ size_t ring_points_xy(sb *s, const frame *f, const double *xy, size_t n, double 
         char pt[2 * F1_MAX + 4];
         int k = 0;
         if (written) pt[k++] = ' ';
-        k += fmt_f1(pt + k, x);
+        k += svg_plot_fmt_f1(pt + k, x);
         pt[k++] = ',';
-        k += fmt_f1(pt + k, y);
+        k += svg_plot_fmt_f1(pt + k, y);
         gpd_buf_add(s, pt, (size_t)k);
         lx = x;
         ly = y;
@@ -615,7 +615,7 @@ size_t ring_points_xy(sb *s, const frame *f, const double *xy, size_t n, double 
 
 /* ------------------------------------------------------------------ histograms */
 
-void hist_free(hist *h)
+void svg_plot_hist_free(hist *h)
 {
     free(h->edges);
     free(h->target);
@@ -625,18 +625,18 @@ void hist_free(hist *h)
 }
 
 /* reads {"edges", "target", "achieved"|"counts", "mean"}; 0 ok */
-int hist_read(const json_t *o, hist *h)
+int svg_plot_hist_read(const json_t *o, hist *h)
 {
     memset(h, 0, sizeof *h);
     if (!json_is_object(o)) return -1;
     size_t ne, nt, na;
-    h->edges = jarray(json_object_get(o, "edges"), &ne);
+    h->edges = svg_plot_jarray(json_object_get(o, "edges"), &ne);
     const json_t *a = json_object_get(o, "achieved");
     if (!a) a = json_object_get(o, "counts");
-    h->achieved = jarray(a, &na);
-    h->target = jarray(json_object_get(o, "target"), &nt);
+    h->achieved = svg_plot_jarray(a, &na);
+    h->target = svg_plot_jarray(json_object_get(o, "target"), &nt);
     if (!h->edges || !h->achieved || ne != na + 1 || ne < 2) {
-        hist_free(h);
+        svg_plot_hist_free(h);
         return -1;
     }
     if (h->target && nt != na) {
@@ -656,7 +656,7 @@ int hist_read(const json_t *o, hist *h)
 }
 
 /* k equal classes over [lo, hi] of values; fractions */
-int hist_from_values(const double *v, size_t n, size_t k, double lo, double hi, hist *h)
+int svg_plot_hist_from_values(const double *v, size_t n, size_t k, double lo, double hi, hist *h)
 {
     memset(h, 0, sizeof *h);
     if (!n) return -1;
@@ -664,7 +664,7 @@ int hist_from_values(const double *v, size_t n, size_t k, double lo, double hi, 
     h->edges = malloc((k + 1) * sizeof *h->edges);
     h->achieved = calloc(k, sizeof *h->achieved);
     if (!h->edges || !h->achieved) {
-        hist_free(h);
+        svg_plot_hist_free(h);
         return -1;
     }
     for (size_t i = 0; i <= k; i++) h->edges[i] = lo + (hi - lo) * i / k;
@@ -684,7 +684,7 @@ int hist_from_values(const double *v, size_t n, size_t k, double lo, double hi, 
     return 0;
 }
 
-void minmax(const double *v, size_t n, double *lo, double *hi)
+void svg_plot_minmax(const double *v, size_t n, double *lo, double *hi)
 {
     *lo = INFINITY;
     *hi = -INFINITY;
@@ -693,35 +693,35 @@ void minmax(const double *v, size_t n, double *lo, double *hi)
 }
 
 /* bars of h->achieved (and h->achieved2 as outlines) and h->target as a line with markers */
-void draw_hist(sb *s, const frame *f, const hist *h, const char *bar_color)
+void svg_plot_draw_hist(sb *s, const frame *f, const hist *h, const char *bar_color)
 {
-    sb_printf(s, "<g class=\"bars\" fill=\"%s\" fill-opacity=\"0.7\" stroke=\"%s\">\n", bar_color, bar_color);
+    svg_plot_sb_printf(s, "<g class=\"bars\" fill=\"%s\" fill-opacity=\"0.7\" stroke=\"%s\">\n", bar_color, bar_color);
     for (size_t i = 0; i < h->k; i++) {
-        double x0 = fx(f, h->edges[i]), x1 = fx(f, h->edges[i + 1]);
-        double y = fy(f, fmax(f->ymin, fmin(f->ymax, h->achieved[i]))), y0 = fy(f, f->ymin);
+        double x0 = svg_plot_fx(f, h->edges[i]), x1 = svg_plot_fx(f, h->edges[i + 1]);
+        double y = svg_plot_fy(f, fmax(f->ymin, fmin(f->ymax, h->achieved[i]))), y0 = svg_plot_fy(f, f->ymin);
         if (!isfinite(y)) continue;
-        sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n", x0 + 0.5, y,
+        svg_plot_sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/>\n", x0 + 0.5, y,
                   fmax(0, x1 - x0 - 1), fmax(0, y0 - y));
     }
-    sb_puts(s, "</g>\n");
+    svg_plot_sb_puts(s, "</g>\n");
     if (h->achieved2) {
-        sb_puts(s, "<path class=\"achieved2\" fill=\"none\" stroke=\"#ff7f0e\" stroke-width=\"2\" d=\"");
+        svg_plot_sb_puts(s, "<path class=\"achieved2\" fill=\"none\" stroke=\"#ff7f0e\" stroke-width=\"2\" d=\"");
         for (size_t i = 0; i < h->k; i++) {
-            double x0 = fx(f, h->edges[i]), x1 = fx(f, h->edges[i + 1]);
-            double y = fy(f, fmax(f->ymin, fmin(f->ymax, h->achieved2[i])));
-            sb_printf(s, "%s%.1f %.1fH%.1f", i ? "L" : "M", x0, y, x1);
+            double x0 = svg_plot_fx(f, h->edges[i]), x1 = svg_plot_fx(f, h->edges[i + 1]);
+            double y = svg_plot_fy(f, fmax(f->ymin, fmin(f->ymax, h->achieved2[i])));
+            svg_plot_sb_printf(s, "%s%.1f %.1fH%.1f", i ? "L" : "M", x0, y, x1);
         }
-        sb_puts(s, "\"/>\n");
+        svg_plot_sb_puts(s, "\"/>\n");
     }
     if (h->target) {
-        sb_puts(s, "<path class=\"target\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\" d=\"");
+        svg_plot_sb_puts(s, "<path class=\"target\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\" d=\"");
         for (size_t i = 0; i < h->k; i++) {
-            double xc = fx(f, 0.5 * (h->edges[i] + h->edges[i + 1]));
-            sb_printf(s, "%s%.1f %.1f", i ? "L" : "M", xc, fy(f, fmin(f->ymax, h->target[i])));
+            double xc = svg_plot_fx(f, 0.5 * (h->edges[i] + h->edges[i + 1]));
+            svg_plot_sb_printf(s, "%s%.1f %.1f", i ? "L" : "M", xc, svg_plot_fy(f, fmin(f->ymax, h->target[i])));
         }
-        sb_puts(s, "\"/>\n");
+        svg_plot_sb_puts(s, "\"/>\n");
         for (size_t i = 0; i < h->k; i++)
-            marker(s, fx(f, 0.5 * (h->edges[i] + h->edges[i + 1])), fy(f, fmin(f->ymax, h->target[i])),
+            svg_plot_marker(s, svg_plot_fx(f, 0.5 * (h->edges[i] + h->edges[i + 1])), svg_plot_fy(f, fmin(f->ymax, h->target[i])),
                    "#d62728");
     }
 }
@@ -737,7 +737,7 @@ static double hist_ymax(const hist *h)
     return m > 0 ? m * 1.1 : 1;
 }
 
-frame hist_frame(double x0, double y0, double w, double h, const hist *hs)
+frame svg_plot_hist_frame(double x0, double y0, double w, double h, const hist *hs)
 {
     frame f = {x0, y0, w, h, hs->edges[0], hs->edges[hs->k], 0, hist_ymax(hs), 0};
     if (!(f.xmax > f.xmin)) f.xmax = f.xmin + 1;
@@ -746,7 +746,7 @@ frame hist_frame(double x0, double y0, double w, double h, const hist *hs)
 
 /* ------------------------------------------------------------------ cumulative distributions */
 
-void cdf_free(cdf_series *c)
+void svg_plot_cdf_free(cdf_series *c)
 {
     free(c->x);
     free(c->target);
@@ -756,7 +756,7 @@ void cdf_free(cdf_series *c)
 }
 
 /* the x range of the curves (positive values only when for_log) */
-void cdf_range(const cdf_series *c, int n, int for_log, double *lo, double *hi)
+void svg_plot_cdf_range(const cdf_series *c, int n, int for_log, double *lo, double *hi)
 {
     *lo = INFINITY;
     *hi = -INFINITY;
@@ -768,18 +768,18 @@ void cdf_range(const cdf_series *c, int n, int for_log, double *lo, double *hi)
 
 /* one curve: the target dashed, the achieved solid (the empirical CDF at the same points: its
  * jumps fall between them, so it is joined by lines as the target is) */
-void cdf_path(sb *s, const frame *f, const cdf_series *c, int achieved)
+void svg_plot_cdf_path(sb *s, const frame *f, const cdf_series *c, int achieved)
 {
     const double *y = achieved ? c->achieved : c->target;
-    sb_printf(s, "<path class=\"cdf-%s %s\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s d=\"",
+    svg_plot_sb_printf(s, "<path class=\"cdf-%s %s\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s d=\"",
               achieved ? "achieved" : "target", c->name, c->color,
               achieved ? "" : " stroke-dasharray=\"6 4\"");
     int first = 1;
     for (size_t i = 0; i < c->n; i++) {
         if (!isfinite(c->x[i]) || !isfinite(y[i]) || (f->xlog && !(c->x[i] > 0))) continue;
-        double px = fx(f, c->x[i]), py = fy(f, fmax(0, fmin(1, y[i])));
-        sb_printf(s, "%s%.1f %.1f", first ? "M" : "L", px, py);
+        double px = svg_plot_fx(f, c->x[i]), py = svg_plot_fy(f, fmax(0, fmin(1, y[i])));
+        svg_plot_sb_printf(s, "%s%.1f %.1f", first ? "M" : "L", px, py);
         first = 0;
     }
-    sb_puts(s, "\"/>\n");
+    svg_plot_sb_puts(s, "\"/>\n");
 }

@@ -6,21 +6,21 @@
 #include "svg/svg.h"
 
 /* the 2D kind (maps: svg_views2d.c; statistics: svg_stats2d.c) */
-int svg_view_packing(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+int svg_views2d_packing(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                      gpd_err *err);
-int svg_view_cells(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+int svg_views2d_cells(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                    gpd_err *err);
-int svg_view_size(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+int svg_stats2d_size(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                   gpd_err *err);
-int svg_view_orientation(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
+int svg_stats2d_orientation(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
                          int width, gpd_err *err);
-int svg_view_descriptors(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
+int svg_stats2d_descriptors(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
                          int width, gpd_err *err);
 
 /* the 3D kind (svg_views3d.c) */
-int svg_view_section(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+int svg_views3d_section(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                      gpd_err *err);
-int svg_view_psd(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+int svg_views3d_psd(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                  gpd_err *err);
 
 #endif /* GPD_SVG_VIEWS_H */

@@ -7,7 +7,7 @@
 #include "util/util.h"
 
 #define JS_CACHE (64u * 1024u)
-#define JS_KEEP (1u << 20) /* js_load keeps its buffer up to this size between calls */
+#define JS_KEEP (1u << 20) /* json_scan_load keeps its buffer up to this size between calls */
 #define JS_ERR UINT64_MAX
 
 struct js_scan {
@@ -17,7 +17,7 @@ struct js_scan {
     /* array walk */
     uint64_t apos;
     int afirst, aactive;
-    /* js_load */
+    /* json_scan_load */
     char *buf;
     size_t cap;
     unsigned char cache[]; /* JS_CACHE bytes, allocated with the scanner */
@@ -29,13 +29,13 @@ static int mem_read(void *user, uint64_t off, void *dst, size_t n)
     return 0;
 }
 
-js_source js_memory_source(const char *text, size_t len)
+js_source json_scan_memory_source(const char *text, size_t len)
 {
     js_source s = {mem_read, (void *)text, len};
     return s;
 }
 
-js_scan *js_open(const js_source *src)
+js_scan *json_scan_open(const js_source *src)
 {
     js_scan *s = malloc(sizeof *s + JS_CACHE);
     if (!s) return NULL;
@@ -44,7 +44,7 @@ js_scan *js_open(const js_source *src)
     return s;
 }
 
-void js_close(js_scan *s)
+void json_scan_close(js_scan *s)
 {
     if (s) free(s->buf);
     free(s);
@@ -145,7 +145,7 @@ static uint64_t skip_value(js_scan *s, uint64_t pos)
     return p;
 }
 
-int js_copy(js_scan *s, uint64_t off, uint64_t end, char *dst)
+int json_scan_copy(js_scan *s, uint64_t off, uint64_t end, char *dst)
 {
     if (end < off || end > s->src.size) return -1;
     size_t n = (size_t)(end - off);
@@ -156,7 +156,7 @@ int js_copy(js_scan *s, uint64_t off, uint64_t end, char *dst)
     return n ? s->src.read(s->src.user, off, dst, n) : 0;
 }
 
-int js_members(js_scan *s, js_member_fn fn, void *user)
+int json_scan_members(js_scan *s, js_member_fn fn, void *user)
 {
     uint64_t pos = skip_ws(s, 0);
     if (byte_at(s, pos) != '{') return -1;
@@ -169,7 +169,7 @@ int js_members(js_scan *s, js_member_fn fn, void *user)
         char key[256];
         uint64_t kl = kend - moff - 2;
         if (kl > sizeof key - 1) kl = sizeof key - 1;
-        if (js_copy(s, moff + 1, moff + 1 + kl, key)) return -1;
+        if (json_scan_copy(s, moff + 1, moff + 1 + kl, key)) return -1;
         key[kl] = 0;
         pos = skip_ws(s, kend);
         if (byte_at(s, pos) != ':') return -1;
@@ -185,7 +185,7 @@ int js_members(js_scan *s, js_member_fn fn, void *user)
     }
 }
 
-int js_array_begin(js_scan *s, uint64_t off)
+int json_scan_array_begin(js_scan *s, uint64_t off)
 {
     s->aactive = 0;
     uint64_t pos = skip_ws(s, off);
@@ -196,7 +196,7 @@ int js_array_begin(js_scan *s, uint64_t off)
     return 0;
 }
 
-int js_array_next(js_scan *s, uint64_t *eoff, uint64_t *eend)
+int json_scan_array_next(js_scan *s, uint64_t *eoff, uint64_t *eend)
 {
     if (!s->aactive) return 0;
     uint64_t pos = skip_ws(s, s->apos);
@@ -221,7 +221,7 @@ bad:
     return -1;
 }
 
-const char *js_span(js_scan *s, uint64_t off, uint64_t end)
+const char *json_scan_span(js_scan *s, uint64_t off, uint64_t end)
 {
     if (end < off || end > s->src.size) return NULL;
     size_t n = (size_t)(end - off);
@@ -233,15 +233,15 @@ const char *js_span(js_scan *s, uint64_t off, uint64_t end)
         s->cap = s->buf ? cap : 0;
         if (!s->buf) return NULL;
     }
-    if (js_copy(s, off, end, s->buf)) return NULL;
+    if (json_scan_copy(s, off, end, s->buf)) return NULL;
     s->buf[n] = 0;
     return s->buf;
 }
 
-json_t *js_load(js_scan *s, uint64_t off, uint64_t end)
+json_t *json_scan_load(js_scan *s, uint64_t off, uint64_t end)
 {
     if (end <= off) return NULL;
-    const char *t = js_span(s, off, end);
+    const char *t = json_scan_span(s, off, end);
     if (!t) return NULL;
     json_error_t e;
     return json_loadb(t, (size_t)(end - off), JSON_DECODE_ANY, &e);
@@ -261,7 +261,7 @@ typedef struct without_ctx {
 static int append_span(without_ctx *w, uint64_t off, uint64_t end)
 {
     size_t n = (size_t)(end - off);
-    if (gpd_buf_reserve(&w->out, n) || js_copy(w->s, off, end, w->out.buf + w->out.len)) return -1;
+    if (gpd_buf_reserve(&w->out, n) || json_scan_copy(w->s, off, end, w->out.buf + w->out.len)) return -1;
     w->out.len += n;
     w->out.buf[w->out.len] = '\0';
     return 0;
@@ -286,18 +286,18 @@ static int without_member(void *user, const char *key, uint64_t moff, uint64_t v
     return 0;
 }
 
-char *js_object_without(const js_source *src, const char *const *skip, size_t *len,
+char *json_scan_object_without(const js_source *src, const char *const *skip, size_t *len,
                         uint64_t (*spans)[2])
 {
     if (len) *len = 0;
     if (spans)
         for (const char *const *k = skip; k && *k; k++) spans[k - skip][0] = spans[k - skip][1] = 0;
-    js_scan *s = js_open(src);
+    js_scan *s = json_scan_open(src);
     if (!s) return NULL;
     without_ctx w = {s, skip, spans, {NULL, 0, 0, 0}, 0};
-    int ok = gpd_buf_add(&w.out, "{", 1) == 0 && js_members(s, without_member, &w) == 0 &&
+    int ok = gpd_buf_add(&w.out, "{", 1) == 0 && json_scan_members(s, without_member, &w) == 0 &&
              !w.fail && gpd_buf_add(&w.out, "}", 1) == 0;
-    js_close(s);
+    json_scan_close(s);
     if (!ok) {
         free(w.out.buf);
         return NULL;

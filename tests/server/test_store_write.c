@@ -5,7 +5,7 @@
  *
  * The truths: the same values written by a writer that keeps its text in memory (itself held
  * to jansson by test_result_json) -- a spilled text and a stored one must be the same bytes;
- * the summary and its spans recomputed with js_object_without over the original text; the
+ * the summary and its spans recomputed with json_scan_object_without over the original text; the
  * sizes of the database and its WAL on disk (a commit that checkpointed would have copied the
  * result into the database file); the process's peak RSS (VmHWM, reset through
  * /proc/self/clear_refs) while a result in a file is stored; rows counted with SQLite itself.
@@ -327,9 +327,9 @@ static void test_store_file(const char *want, size_t wlen)
     CHECK(store_get_summary(id, &summary, &slen, spans, st) == STORE_OK);
     CHECK(!strcmp(st, "succeeded"));
     static const char *const skip[] = STORE_SUMMARY_SKIP;
-    js_source src = js_memory_source(want, wlen);
+    js_source src = json_scan_memory_source(want, wlen);
     size_t wslen = 0;
-    char *wsum = js_object_without(&src, skip, &wslen, want_spans);
+    char *wsum = json_scan_object_without(&src, skip, &wslen, want_spans);
     CHECK(summary && wsum && slen == wslen && !memcmp(summary, wsum, slen));
     CHECK(!memcmp(spans, want_spans, sizeof spans));
     CHECK(want_spans[0][1] > want_spans[0][0] && want[want_spans[0][0]] == '[');

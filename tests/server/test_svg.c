@@ -851,13 +851,13 @@ static void test_colorbar(void)
     json_decref(r);
     /* the fixed-decimals label of a tick, and powers of ten beyond */
     char b[64];
-    fmt_tick(b, sizeof b, 0.3000000000000001, 0.1);
+    svg_plot_fmt_tick(b, sizeof b, 0.3000000000000001, 0.1);
     CHECK(!strcmp(b, "0.3"));
-    fmt_tick(b, sizeof b, 2e-5, 0);
+    svg_plot_fmt_tick(b, sizeof b, 2e-5, 0);
     CHECK(!strcmp(b, "2×10⁻⁵"));
-    fmt_tick(b, sizeof b, 1e7, 0);
+    svg_plot_fmt_tick(b, sizeof b, 1e7, 0);
     CHECK(!strcmp(b, "10⁷"));
-    fmt_tick(b, sizeof b, -1e-17, 0.5);
+    svg_plot_fmt_tick(b, sizeof b, -1e-17, 0.5);
     CHECK(!strcmp(b, "0"));
 }
 
@@ -1184,22 +1184,22 @@ static void test_json_scan(void)
 {
     const char *t = "{\"a\":\"x]\\\"}\" , \"grains\":[{\"k\":\"]\"},[1,2],3],\"b\":[1,2,{\"c\":null}],"
                     "\"n\":-1.5e3,\"cells\":[],\"z\":true}";
-    js_source src = js_memory_source(t, strlen(t));
+    js_source src = json_scan_memory_source(t, strlen(t));
     static const char *const skip[] = {"grains", "cells", "spheres", NULL};
     uint64_t sp[3][2];
     size_t len;
-    char *w = js_object_without(&src, skip, &len, sp);
+    char *w = json_scan_object_without(&src, skip, &len, sp);
     CHECK(w && !strcmp(w, "{\"a\":\"x]\\\"}\",\"b\":[1,2,{\"c\":null}],\"n\":-1.5e3,\"z\":true}"));
     CHECK(w && len == strlen(w));
     CHECK(sp[0][0] > 0 && !strncmp(t + sp[0][0], "[{\"k\"", 5) && t[sp[0][1] - 1] == ']');
     CHECK(sp[1][1] == sp[1][0] + 2 && sp[2][0] == 0 && sp[2][1] == 0);
     /* the elements of the grains array, one at a time */
-    js_scan *s = js_open(&src);
-    CHECK(s && js_array_begin(s, sp[0][0]) == 0);
+    js_scan *s = json_scan_open(&src);
+    CHECK(s && json_scan_array_begin(s, sp[0][0]) == 0);
     uint64_t a, b;
     int n = 0;
-    while (js_array_next(s, &a, &b) > 0) {
-        json_t *e = js_load(s, a, b);
+    while (json_scan_array_next(s, &a, &b) > 0) {
+        json_t *e = json_scan_load(s, a, b);
         CHECK(e != NULL);
         if (n == 0) CHECK(!strcmp(json_string_value(json_object_get(e, "k")), "]"));
         if (n == 2) CHECK(json_integer_value(e) == 3);
@@ -1207,21 +1207,21 @@ static void test_json_scan(void)
         n++;
     }
     CHECK(n == 3);
-    CHECK(js_array_begin(s, sp[1][0]) == 0 && js_array_next(s, &a, &b) == 0); /* [] */
-    CHECK(js_array_begin(s, 0) == -1);                                        /* not an array */
-    js_close(s);
+    CHECK(json_scan_array_begin(s, sp[1][0]) == 0 && json_scan_array_next(s, &a, &b) == 0); /* [] */
+    CHECK(json_scan_array_begin(s, 0) == -1);                                        /* not an array */
+    json_scan_close(s);
     free(w);
     /* every cut of the text is refused, never read past */
     for (size_t k = 0; k < strlen(t); k++) {
         char *cut = strndup(t, k);
-        js_source cs = js_memory_source(cut, k);
-        char *x = js_object_without(&cs, skip, NULL, NULL);
+        js_source cs = json_scan_memory_source(cut, k);
+        char *x = json_scan_object_without(&cs, skip, NULL, NULL);
         CHECK(x == NULL);
         free(x);
         free(cut);
     }
-    js_source bad = js_memory_source("[1,2]", 5);
-    CHECK(js_object_without(&bad, skip, NULL, NULL) == NULL);
+    js_source bad = json_scan_memory_source("[1,2]", 5);
+    CHECK(json_scan_object_without(&bad, skip, NULL, NULL) == NULL);
     /* across cache windows: a string of 200,000 bytes with escapes, then an array */
     size_t big = 200000;
     char *bt = malloc(big + big / 1000 + 64);
@@ -1231,8 +1231,8 @@ static void test_json_scan(void)
         else bt[k++] = (char)('a' + i % 26);
     }
     k += (size_t)sprintf(bt + k, "\",\"grains\":[[1],[2]]}");
-    js_source bs = js_memory_source(bt, k);
-    w = js_object_without(&bs, skip, &len, sp);
+    js_source bs = json_scan_memory_source(bt, k);
+    w = json_scan_object_without(&bs, skip, &len, sp);
     CHECK(w && len == k - strlen(",\"grains\":[[1],[2]]") && sp[0][1] == k - 1);
     free(w);
     free(bt);
@@ -1325,8 +1325,8 @@ static void check_stream_equal(json_t *result, const char *kind, const char *vie
 static void set_spans(src_ctx *c)
 {
     static const char *const skip[] = {"grains", "cells", "spheres", NULL};
-    js_source s = js_memory_source(c->text, strlen(c->text));
-    free(js_object_without(&s, skip, NULL, c->spans));
+    js_source s = json_scan_memory_source(c->text, strlen(c->text));
+    free(json_scan_object_without(&s, skip, NULL, c->spans));
 }
 
 static void test_compact_2d(void)
@@ -1397,8 +1397,8 @@ static void test_compact_2d(void)
     CHECK(gp_export_pack_2d(&s, &spec, 2650, &pack, &pack_len, &perr) == GP_OK);
     /* the summary: the result without its arrays */
     static const char *const skip[] = {"grains", "cells", "spheres", "contacts", NULL};
-    js_source ts = js_memory_source(text, strlen(text));
-    char *sum_text = js_object_without(&ts, skip, NULL, NULL);
+    js_source ts = json_scan_memory_source(text, strlen(text));
+    char *sum_text = json_scan_object_without(&ts, skip, NULL, NULL);
     json_t *summary = sum_text ? json_loads(sum_text, 0, &e) : NULL;
     CHECK(summary && !json_object_get(summary, "grains") && !json_object_get(summary, "cells"));
     json_t *copy = json_deep_copy(r);
@@ -1560,8 +1560,8 @@ static void test_item_parse(void)
             json_error_t e;
             json_t *j = json_loads(t, JSON_DECODE_ANY, &e);
             CHECK(j != NULL);
-            CHECK(svg_item_from_json(sets[s].part, &a, j) == 0);
-            CHECK(svg_item_parse(sets[s].part, &b, t, strlen(t)) == 0);
+            CHECK(svg_items_from_json(sets[s].part, &a, j) == 0);
+            CHECK(svg_items_parse(sets[s].part, &b, t, strlen(t)) == 0);
             int same = a.npts == b.npts && a.nrings == b.nrings;
             for (size_t k = 0; same && k < 2 * a.npts; k++)
                 same = (isnan(a.xy[k]) && isnan(b.xy[k])) || a.xy[k] == b.xy[k];
@@ -1579,8 +1579,8 @@ static void test_item_parse(void)
     /* (values that are skipped are only matched bracket to bracket, not checked) */
     const char *bad[] = {"{\"contour\":[[1,2]", "{\"area\":}", "{\"area\" 1}",
                          "{\"contour\":[[1,,2]]}", "{\"contour\":[[1,2],]}"};
-    for (int i = 0; i < 5; i++) CHECK(svg_item_parse(GP_SVG_GRAINS, &b, bad[i], strlen(bad[i])) == -1);
-    CHECK(svg_item_parse(GP_SVG_SPHERES, &b, "[1,2", 4) == -1);
+    for (int i = 0; i < 5; i++) CHECK(svg_items_parse(GP_SVG_GRAINS, &b, bad[i], strlen(bad[i])) == -1);
+    CHECK(svg_items_parse(GP_SVG_SPHERES, &b, "[1,2", 4) == -1);
     free(a.xy);
     free(a.rings);
     free(b.xy);
@@ -1596,7 +1596,7 @@ static void test_fmt_f1(void)
     for (size_t i = 0; i < sizeof v / sizeof *v; i++) {
         char a[400], b[400];
         snprintf(a, sizeof a, "%.1f", v[i]);
-        fmt_f1(b, v[i]);
+        svg_plot_fmt_f1(b, v[i]);
         bad += strcmp(a, b) != 0;
     }
     unsigned x = 12345;
@@ -1605,7 +1605,7 @@ static void test_fmt_f1(void)
         double d = (i % 2) ? (x % 400000) / 20.0 - 1000 : (double)x / 7919.0 - 3000;
         char a[64], b[64];
         snprintf(a, sizeof a, "%.1f", d);
-        fmt_f1(b, d);
+        svg_plot_fmt_f1(b, d);
         bad += strcmp(a, b) != 0;
     }
     CHECK(bad == 0);

@@ -664,11 +664,11 @@ static json_t *done_detail(const char *id, const void *specimen)
 }
 
 static const gpd_view views[] = {
-    {"packing", "color", svg_view_packing},
-    {"cells", "", svg_view_cells},
-    {"size", "", svg_view_size},
-    {"orientation", "", svg_view_orientation},
-    {"descriptors", "", svg_view_descriptors},
+    {"packing", "color", svg_views2d_packing},
+    {"cells", "", svg_views2d_cells},
+    {"size", "", svg_stats2d_size},
+    {"orientation", "", svg_stats2d_orientation},
+    {"descriptors", "", svg_stats2d_descriptors},
     {NULL, NULL, NULL},
 };
 

@@ -31,22 +31,22 @@ static int view_size_hist(gp_svg *g, const gp_svg_input *in, int width, gpd_err 
 {
     const json_t *stats = json_object_get(in->summary, "stats");
     hist h;
-    int have = hist_read(json_object_get(stats, "size_histogram"), &h) == 0, cells = 1;
+    int have = svg_plot_hist_read(json_object_get(stats, "size_histogram"), &h) == 0, cells = 1;
     if (have) {
         hist gh;
-        if (hist_read(json_object_get(stats, "grain_size_histogram"), &gh) == 0) {
+        if (svg_plot_hist_read(json_object_get(stats, "grain_size_histogram"), &gh) == 0) {
             if (gh.k == h.k) {
                 h.achieved2 = gh.achieved;
                 gh.achieved = NULL;
             }
-            hist_free(&gh);
+            svg_plot_hist_free(&gh);
         }
     } else {
         size_t n;
         int failed;
-        double *v = svg_collect_items(in, GP_SVG_CELLS, 0, &n, &failed);
+        double *v = svg_items_collect(in, GP_SVG_CELLS, 0, &n, &failed);
         if (!v && !failed) {
-            v = svg_collect_items(in, GP_SVG_GRAINS, 0, &n, &failed);
+            v = svg_items_collect(in, GP_SVG_GRAINS, 0, &n, &failed);
             cells = 0;
         }
         if (!v) {
@@ -55,8 +55,8 @@ static int view_size_hist(gp_svg *g, const gp_svg_input *in, int width, gpd_err 
             return -1;
         }
         double lo, hi;
-        minmax(v, n, &lo, &hi);
-        int ok = hist_from_values(v, n, n < 50 ? 8 : 20, lo, hi, &h) == 0;
+        svg_plot_minmax(v, n, &lo, &hi);
+        int ok = svg_plot_hist_from_values(v, n, n < 50 ? 8 : 20, lo, hi, &h) == 0;
         free(v);
         if (!ok) {
             gpd_err_set(err, 500, "out of memory");
@@ -65,24 +65,24 @@ static int view_size_hist(gp_svg *g, const gp_svg_input *in, int width, gpd_err 
     }
     /* the areas in a unit whose labels read as whole numbers */
     double k;
-    const char *unit = area_unit(h.edges[h.k], &k);
+    const char *unit = svg_plot_area_unit(h.edges[h.k], &k);
     for (size_t i = 0; i <= h.k; i++) h.edges[i] *= k;
     char what[64];
     snprintf(what, sizeof what, "%s area (%s)", cells ? "cell" : "grain", unit);
     int height = (int)lround(width * 0.62);
-    frame f = hist_frame(80, 40, width - 110, height - 110, &h);
+    frame f = svg_plot_hist_frame(80, 40, width - 110, height - 110, &h);
     sb *s = &g->out;
-    doc_begin(s, width, height, "Size distribution: target vs achieved");
-    axes(s, &f, what, "fraction of cells", 1);
-    draw_hist(s, &f, &h, BLUE);
+    svg_plot_doc_begin(s, width, height, "Size distribution: target vs achieved");
+    svg_plot_axes(s, &f, what, "fraction of cells", 1);
+    svg_plot_draw_hist(s, &f, &h, BLUE);
     legend_item it[3];
     int n = 0;
     it[n++] = (legend_item){have ? "achieved (cells)" : "achieved", "bar", BLUE};
     if (h.achieved2) it[n++] = (legend_item){"achieved (grains)", "line", ORANGE};
     if (h.target) it[n++] = (legend_item){"target (lognormal)", "marker", RED};
-    legend(s, f.x0 + f.w - legend_w(it, n) - 10, f.y0 + 8, it, n);
-    doc_end(s);
-    hist_free(&h);
+    svg_plot_legend(s, f.x0 + f.w - svg_plot_legend_w(it, n) - 10, f.y0 + 8, it, n);
+    svg_plot_doc_end(s);
+    svg_plot_hist_free(&h);
     return 0;
 }
 
@@ -93,22 +93,22 @@ static int cdf_read(const json_t *fit, const char *key, const char *name, const 
     memset(c, 0, sizeof *c);
     const json_t *b = json_object_get(fit, key), *cdf = json_object_get(b, "cdf");
     size_t nt, na;
-    c->x = jarray(json_object_get(cdf, "x"), &c->n);
-    c->target = jarray(json_object_get(cdf, "target"), &nt);
-    c->achieved = jarray(json_object_get(cdf, "achieved"), &na);
+    c->x = svg_plot_jarray(json_object_get(cdf, "x"), &c->n);
+    c->target = svg_plot_jarray(json_object_get(cdf, "target"), &nt);
+    c->achieved = svg_plot_jarray(json_object_get(cdf, "achieved"), &na);
     if (!c->x || !c->target || !c->achieved || c->n < 2 || nt != c->n || na != c->n) {
-        cdf_free(c);
+        svg_plot_cdf_free(c);
         return -1;
     }
     c->name = name;
     c->color = color;
     c->law = json_string_value(json_object_get(b, "law"));
-    c->ks = jnum(json_object_get(b, "ks"), NAN);
-    c->ks_critical = jnum(json_object_get(b, "ks_critical"), NAN);
-    c->w1 = jnum(json_object_get(b, "w1"), NAN);
-    c->cov = jnum(json_object_get(json_object_get(b, "achieved"), "cov"), NAN);
-    c->target_cov = jnum(json_object_get(json_object_get(b, "target"), "cov"), NAN);
-    c->count = jnum(json_object_get(b, "n"), NAN);
+    c->ks = svg_plot_jnum(json_object_get(b, "ks"), NAN);
+    c->ks_critical = svg_plot_jnum(json_object_get(b, "ks_critical"), NAN);
+    c->w1 = svg_plot_jnum(json_object_get(b, "w1"), NAN);
+    c->cov = svg_plot_jnum(json_object_get(json_object_get(b, "achieved"), "cov"), NAN);
+    c->target_cov = svg_plot_jnum(json_object_get(json_object_get(b, "target"), "cov"), NAN);
+    c->count = svg_plot_jnum(json_object_get(b, "n"), NAN);
     return 0;
 }
 
@@ -162,7 +162,7 @@ static int warning_lines(sb *s, const json_t *warnings, double x, double y, size
                 char line[512];
                 snprintf(line, sizeof line, "%s%.*s", first ? "\xe2\x9a\xa0 warning: " : "",
                          (int)(cut < 400 ? cut : 400), t);
-                text_at(s, first ? x : x + 18, y + 16 * lines, "start",
+                svg_plot_text_at(s, first ? x : x + 18, y + 16 * lines, "start",
                         "class=\"warning\" fill=\"#b35c00\" font-weight=\"bold\"", line);
             }
             lines++;
@@ -193,10 +193,10 @@ static int passing_read(const json_t *fit, passing *p)
     memset(p, 0, sizeof *p);
     const json_t *o = json_object_get(fit, "passing");
     size_t nt, na;
-    p->d = jarray(json_object_get(o, "diameters"), &p->n);
-    p->target = jarray(json_object_get(o, "target"), &nt);
-    p->achieved = jarray(json_object_get(o, "achieved"), &na);
-    p->max_pp = jnum(json_object_get(o, "max_error_pp"), NAN);
+    p->d = svg_plot_jarray(json_object_get(o, "diameters"), &p->n);
+    p->target = svg_plot_jarray(json_object_get(o, "target"), &nt);
+    p->achieved = svg_plot_jarray(json_object_get(o, "achieved"), &na);
+    p->max_pp = svg_plot_jnum(json_object_get(o, "max_error_pp"), NAN);
     if (!p->d || !p->target || !p->achieved || p->n < 2 || nt != p->n || na != p->n) {
         passing_free(p);
         return -1;
@@ -209,19 +209,19 @@ static void passing_curve(sb *s, const frame *f, const passing *p, int achieved)
 {
     const double *y = achieved ? p->achieved : p->target;
     const char *color = achieved ? ORANGE : RED;
-    sb_printf(s, "<path class=\"passing-%s\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s d=\"",
+    svg_plot_sb_printf(s, "<path class=\"passing-%s\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s d=\"",
               achieved ? "achieved" : "target", color, achieved ? "" : " stroke-dasharray=\"6 4\"");
     int first = 1;
     for (size_t i = 0; i < p->n; i++) {
         if (!(p->d[i] > 0) || !isfinite(y[i])) continue;
-        sb_printf(s, "%s%.1f %.1f", first ? "M" : "L", fx(f, p->d[i] * 1e3),
-                  fy(f, fmax(0, fmin(100, y[i]))));
+        svg_plot_sb_printf(s, "%s%.1f %.1f", first ? "M" : "L", svg_plot_fx(f, p->d[i] * 1e3),
+                  svg_plot_fy(f, fmax(0, fmin(100, y[i]))));
         first = 0;
     }
-    sb_puts(s, "\"/>\n");
+    svg_plot_sb_puts(s, "\"/>\n");
     for (size_t i = 0; i < p->n; i++)
         if (p->d[i] > 0 && isfinite(y[i]))
-            marker(s, fx(f, p->d[i] * 1e3), fy(f, fmax(0, fmin(100, y[i]))), color);
+            svg_plot_marker(s, svg_plot_fx(f, p->d[i] * 1e3), svg_plot_fy(f, fmax(0, fmin(100, y[i]))), color);
 }
 
 /* the passing panel: target sieve curve and the grains' achieved one, by mass, its legend
@@ -238,9 +238,9 @@ static void passing_panel(sb *s, const frame *f0, const passing *p)
     f.ymin = 0;
     f.ymax = 100;
     f.xlog = 1;
-    text_at(s, f.x0 + f.w / 2, f.y0 - 10, "middle", "font-weight=\"bold\"",
+    svg_plot_text_at(s, f.x0 + f.w / 2, f.y0 - 10, "middle", "font-weight=\"bold\"",
             "Grains passing by mass (sieve law)");
-    axes(s, &f, "equivalent diameter \xe2\x88\x9a(4A/\xcf\x80) (mm, log scale)",
+    svg_plot_axes(s, &f, "equivalent diameter \xe2\x88\x9a(4A/\xcf\x80) (mm, log scale)",
          "percent passing by mass (%)", 1);
     passing_curve(s, &f, p, 0);
     passing_curve(s, &f, p, 1);
@@ -248,7 +248,7 @@ static void passing_panel(sb *s, const frame *f0, const passing *p)
     if (isfinite(p->max_pp)) snprintf(lab, sizeof lab, "achieved, max error %.2g pp", p->max_pp);
     else snprintf(lab, sizeof lab, "achieved");
     legend_item it[2] = {{"target (sieve curve)", "dash", RED}, {lab, "marker", ORANGE}};
-    legend(s, f.x0, f.y0 + f.h + 50, it, 2);
+    svg_plot_legend(s, f.x0, f.y0 + f.h + 50, it, 2);
 }
 
 /* the CDF panel: both series, and their legend with the KS under the plot (a CDF of a narrow
@@ -257,19 +257,19 @@ static double cdf_panel(sb *s, const frame *f, const cdf_series *c, int nc, cons
 {
     char xl[64];
     snprintf(xl, sizeof xl, "area (%s%s)", unit, f->xlog ? ", log scale" : "");
-    axes(s, f, xl, "cumulative fraction (by number)", 1);
+    svg_plot_axes(s, f, xl, "cumulative fraction (by number)", 1);
     legend_item it[4];
     char names[4][96];
     for (int k = 0; k < nc; k++) {
-        cdf_path(s, f, &c[k], 0);
-        cdf_path(s, f, &c[k], 1);
+        svg_plot_cdf_path(s, f, &c[k], 0);
+        svg_plot_cdf_path(s, f, &c[k], 1);
         snprintf(names[2 * k], sizeof names[0], "%s: target (%s)", c[k].name,
                  c[k].law ? c[k].law : "law");
         ks_label(names[2 * k + 1], sizeof names[0], &c[k]);
         it[2 * k] = (legend_item){names[2 * k], "dash", c[k].color};
         it[2 * k + 1] = (legend_item){names[2 * k + 1], "line", c[k].color};
     }
-    legend(s, f->x0, f->y0 + f->h + 50, it, 2 * nc);
+    svg_plot_legend(s, f->x0, f->y0 + f->h + 50, it, 2 * nc);
     return 8 + 18 * 2 * nc;
 }
 
@@ -277,11 +277,11 @@ static int view_size_fit(gp_svg *g, const json_t *res, cdf_series *c, int nc, co
                          int width)
 {
     double lo, hi, k;
-    cdf_range(c, nc, 1, &lo, &hi);
+    svg_plot_cdf_range(c, nc, 1, &lo, &hi);
     int xlog = lo > 0 && hi > lo; /* areas are positive: a log axis, as sizes are read */
-    if (!xlog) cdf_range(c, nc, 0, &lo, &hi);
+    if (!xlog) svg_plot_cdf_range(c, nc, 0, &lo, &hi);
     if (!(hi > lo)) lo = isfinite(lo) ? lo - 0.5 : 0, hi = lo + 1;
-    const char *unit = area_unit(hi, &k);
+    const char *unit = svg_plot_area_unit(hi, &k);
     for (int j = 0; j < nc; j++)
         for (size_t i = 0; i < c[j].n; i++) c[j].x[i] *= k;
     const json_t *warnings = json_object_get(res, "warnings");
@@ -294,7 +294,7 @@ static int view_size_fit(gp_svg *g, const json_t *res, cdf_series *c, int nc, co
     int height = (int)ceil(y_lines + 16 * (nc + nwarn));
     frame f = {80, 40, width - 110.0, cdf_h, lo * k, hi * k, 0, 1, xlog};
     sb *s = &g->out;
-    doc_begin(s, width, height, "Size distribution: target law vs achieved (CDF)");
+    svg_plot_doc_begin(s, width, height, "Size distribution: target law vs achieved (CDF)");
     cdf_panel(s, &f, c, nc, unit);
     if (p) {
         frame fp = {80, y_pass, width - 110.0, pass_h, 0, 1, 0, 100, 1};
@@ -304,17 +304,17 @@ static int view_size_fit(gp_svg *g, const json_t *res, cdf_series *c, int nc, co
     for (int j = 0; j < nc; j++, y += 16) {
         char line[320];
         int over = fit_line(line, sizeof line, &c[j]);
-        text_at(s, 20, y, "start",
+        svg_plot_text_at(s, 20, y, "start",
                 over ? "class=\"fit ks-over\" fill=\"#d62728\"" : "class=\"fit\"", line);
     }
     warning_lines(s, warnings, 20, y, maxch);
-    doc_end(s);
+    svg_plot_doc_end(s);
     return 0;
 }
 
 /* the size view: CDFs from stats.fit when the result has them, else histograms (results stored
  * before stats.fit, or without it) */
-int svg_view_size(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+int svg_stats2d_size(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                   gpd_err *err)
 {
     const json_t *res = in->summary;
@@ -327,7 +327,7 @@ int svg_view_size(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, 
     passing p;
     int have_p = passing_read(fit, &p) == 0;
     int rc = view_size_fit(g, res, c, nc, have_p ? &p : NULL, width);
-    for (int k = 0; k < nc; k++) cdf_free(&c[k]);
+    for (int k = 0; k < nc; k++) svg_plot_cdf_free(&c[k]);
     passing_free(&p);
     return rc;
 }
@@ -394,14 +394,14 @@ static void rose_fit(rose *ro, const json_t *fit)
     for (int j = 0; j < 2; j++) {
         const json_t *b = json_object_get(fit, keys[(first + j) % 2]);
         const json_t *t = json_object_get(b, "target");
-        double m = jnum(json_object_get(t, "mean_deg"), NAN), a = jnum(json_object_get(t, "anisotropy"), NAN);
+        double m = svg_plot_jnum(json_object_get(t, "mean_deg"), NAN), a = svg_plot_jnum(json_object_get(t, "anisotropy"), NAN);
         if (!isfinite(m) || !(a > 0)) continue;
         ro->has_target = 1;
         ro->mean_deg = m;
         ro->anis = a;
         if (j == 0) { /* the KS of the population drawn, not of the other */
-            ro->ks = jnum(json_object_get(b, "ks"), NAN);
-            ro->crit = jnum(json_object_get(b, "ks_critical"), NAN);
+            ro->ks = svg_plot_jnum(json_object_get(b, "ks"), NAN);
+            ro->crit = svg_plot_jnum(json_object_get(b, "ks_critical"), NAN);
         }
         return;
     }
@@ -432,7 +432,7 @@ static void rose_bin(rose *ro)
 static void rose_hist_target(rose *ro, const json_t *stats)
 {
     hist h;
-    if (hist_read(json_object_get(stats, "orientation_histogram"), &h)) return;
+    if (svg_plot_hist_read(json_object_get(stats, "orientation_histogram"), &h)) return;
     if (h.target && h.k <= ROSE_FINE) {
         ro->has_target = 1;
         ro->tk = (int)h.k;
@@ -442,15 +442,15 @@ static void rose_hist_target(rose *ro, const json_t *stats)
             ro->tgt[i] = w > 0 ? 100 * h.target[i] / w : 0;
         }
     }
-    hist_free(&h);
+    svg_plot_hist_free(&h);
 }
 
 /* an old result without items: stats.orientation_histogram's classes (fractions) */
 static int rose_from_hist(rose *ro, const json_t *stats)
 {
     hist h;
-    if (hist_read(json_object_get(stats, "orientation_histogram"), &h) || h.k > ROSE_FINE) {
-        if (h.k > ROSE_FINE) hist_free(&h);
+    if (svg_plot_hist_read(json_object_get(stats, "orientation_histogram"), &h) || h.k > ROSE_FINE) {
+        if (h.k > ROSE_FINE) svg_plot_hist_free(&h);
         return -1;
     }
     ro->k = ro->tk = (int)h.k;
@@ -462,7 +462,7 @@ static int rose_from_hist(rose *ro, const json_t *stats)
         ro->ach[i] = w > 0 ? 100 * h.achieved[i] / w : 0;
         ro->tgt[i] = w > 0 && h.target ? 100 * h.target[i] / w : 0;
     }
-    hist_free(&h);
+    svg_plot_hist_free(&h);
     return 0;
 }
 
@@ -475,9 +475,9 @@ static int rose_read(rose *ro, const gp_svg_input *in, gpd_err *err)
     static const gp_svg_part parts[2] = {GP_SVG_GRAINS, GP_SVG_CELLS};
     for (int p = 0; p < 2; p++) {
         int failed;
-        gp_svg_items *it = svg_open_light(in, parts[p], &failed);
+        gp_svg_items *it = svg_items_open_light(in, parts[p], &failed);
         if (failed) {
-            gpd_err_set(err, 500, "cannot read the %s of the result", SVG_PART_NAME[parts[p]]);
+            gpd_err_set(err, 500, "cannot read the %s of the result", svg_items_part_name[parts[p]]);
             return -1;
         }
         if (!it) continue;
@@ -485,7 +485,7 @@ static int rose_read(rose *ro, const gp_svg_input *in, gpd_err *err)
         gp_svg_items_close(it);
         if (r) return svg_part_error(err, parts[p]);
         if (ro->n > 0) {
-            ro->who = SVG_PART_NAME[parts[p]];
+            ro->who = svg_items_part_name[parts[p]];
             rose_fit(ro, json_object_get(stats, "fit"));
             rose_bin(ro);
             if (!ro->has_target) rose_hist_target(ro, stats);
@@ -503,15 +503,15 @@ static int rose_read(rose *ro, const gp_svg_input *in, gpd_err *err)
 static void rose_outline(sb *s, double cx, double cy, double scale, const double *edges,
                          const double *d, int k, const char *attrs)
 {
-    sb_printf(s, "<path %s d=\"", attrs);
+    svg_plot_sb_printf(s, "<path %s d=\"", attrs);
     for (int m = 0, first = 1; m < 2; m++)
         for (int i = 0; i < k; i++, first = 0) {
             double r = fmax(0, d[i]) * scale;
             double a0 = (edges[i] + 180 * m) * M_PI / 180, a1 = (edges[i + 1] + 180 * m) * M_PI / 180;
-            sb_printf(s, "%s%.2f %.2fA%.2f %.2f 0 0 0 %.2f %.2f", first ? "M" : "L",
+            svg_plot_sb_printf(s, "%s%.2f %.2fA%.2f %.2f 0 0 0 %.2f %.2f", first ? "M" : "L",
                       cx + r * cos(a0), cy - r * sin(a0), r, r, cx + r * cos(a1), cy - r * sin(a1));
         }
-    sb_puts(s, "z\"/>\n");
+    svg_plot_sb_puts(s, "z\"/>\n");
 }
 
 /* the grid of the rose: rings at round densities (labelled along the direction the target
@@ -519,26 +519,26 @@ static void rose_outline(sb *s, double cx, double cy, double scale, const double
 static void rose_grid(sb *s, double cx, double cy, double R, const ticks *t, double rmax,
                       double label_deg)
 {
-    sb_puts(s, "<g class=\"grid\" fill=\"none\" stroke=\"#cccccc\">\n");
+    svg_plot_sb_puts(s, "<g class=\"grid\" fill=\"none\" stroke=\"#cccccc\">\n");
     for (int i = 0; i < t->n; i++) {
         double pr = R * t->v[i] / rmax;
         if (!(pr > 0)) continue;
-        sb_printf(s, "<path class=\"ring\" d=\"M%.2f %.2fa%.2f %.2f 0 1 0 %.2f 0a%.2f %.2f 0 1 0 %.2f 0z\"/>\n",
+        svg_plot_sb_printf(s, "<path class=\"ring\" d=\"M%.2f %.2fa%.2f %.2f 0 1 0 %.2f 0a%.2f %.2f 0 1 0 %.2f 0z\"/>\n",
                   cx - pr, cy, pr, pr, 2 * pr, pr, pr, -2 * pr);
     }
     for (int a = 0; a < 360; a += 30) {
         double r = a * M_PI / 180;
-        sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", cx, cy,
+        svg_plot_sb_printf(s, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\"/>\n", cx, cy,
                   cx + R * cos(r), cy - R * sin(r));
     }
-    sb_puts(s, "</g>\n");
+    svg_plot_sb_puts(s, "</g>\n");
     char lab[64];
     double la = label_deg * M_PI / 180;
     for (int i = 0; i < t->n; i++) {
         double pr = R * t->v[i] / rmax;
         if (!(pr > 0)) continue;
-        fmt_tick(lab, sizeof lab, t->v[i], t->step);
-        text_at(s, cx + pr * cos(la), cy - pr * sin(la) + 4, "middle",
+        svg_plot_fmt_tick(lab, sizeof lab, t->v[i], t->step);
+        svg_plot_text_at(s, cx + pr * cos(la), cy - pr * sin(la) + 4, "middle",
                 "class=\"ring-label\" font-size=\"11\" fill=\"#444444\" stroke=\"#ffffff\" "
                 "stroke-width=\"3\" paint-order=\"stroke\"",
                 lab);
@@ -546,7 +546,7 @@ static void rose_grid(sb *s, double cx, double cy, double R, const ticks *t, dou
     for (int a = -90; a <= 90; a += 30) {
         double r = a * M_PI / 180;
         snprintf(lab, sizeof lab, "%d°", a);
-        text_at(s, cx + (R + 20) * cos(r), cy - (R + 20) * sin(r) + 4, "middle", NULL, lab);
+        svg_plot_text_at(s, cx + (R + 20) * cos(r), cy - (R + 20) * sin(r) + 4, "middle", NULL, lab);
     }
 }
 
@@ -568,13 +568,13 @@ static void rose_legend(sb *s, const rose *ro, double x, double y)
                       ro->anis);
         it[n++] = (legend_item){t, "dash", RED};
     }
-    legend(s, x, y, it, n);
-    text_at(s, x, y + 8 + 18 * n + 16, "start", "class=\"caption\" fill=\"#444444\"",
+    svg_plot_legend(s, x, y, it, n);
+    svg_plot_text_at(s, x, y + 8 + 18 * n + 16, "start", "class=\"caption\" fill=\"#444444\"",
             "radius: probability density (% per degree); directions are axial, drawn at "
             "\xce\xb8 and \xce\xb8 + 180°");
 }
 
-int svg_view_orientation(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
+int svg_stats2d_orientation(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
                          int width, gpd_err *err)
 {
     rose ro;
@@ -588,11 +588,11 @@ int svg_view_orientation(gp_svg *g, const gp_svg_input *in, const gp_svg_options
     for (int i = 0; ro.has_target && i < ro.tk; i++) m = fmax(m, ro.tgt[i]);
     if (!(m > 0)) m = 1;
     ticks t; /* rings: their labels keep apart along any direction (horizontal widths) */
-    lin_ticks(0, m, R, 1, 5, &t);
+    svg_plot_lin_ticks(0, m, R, 1, 5, &t);
     double rmax = t.step > 0 ? ceil(m / t.step - 1e-9) * t.step : m;
     if (t.step > 0 && t.v[t.n - 1] < rmax - t.step * 1e-9 && t.n < TICKS_MAX) t.v[t.n++] = rmax;
     sb *s = &g->out;
-    doc_begin(s, width, height, "Orientation rose: target vs achieved");
+    svg_plot_doc_begin(s, width, height, "Orientation rose: target vs achieved");
     double label_deg = isfinite(ro.mean_deg) ? ro.mean_deg + 90 : 90;
     label_deg = fmod(fmod(label_deg, 180) + 180, 180) + 7.5; /* between two spokes' labels */
     rose_grid(s, cx, cy, R, &t, rmax, label_deg);
@@ -604,7 +604,7 @@ int svg_view_orientation(gp_svg *g, const gp_svg_input *in, const gp_svg_options
                      "class=\"target\" fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\" "
                      "stroke-dasharray=\"6 4\"");
     rose_legend(s, &ro, 20, rose_h);
-    doc_end(s);
+    svg_plot_doc_end(s);
     return 0;
 }
 
@@ -697,7 +697,7 @@ static void desc_bins(dstat *d)
 static int desc_read(dpass *p, const gp_svg_input *in, gpd_err *err)
 {
     int failed;
-    gp_svg_items *it = svg_open_light(in, GP_SVG_GRAINS, &failed);
+    gp_svg_items *it = svg_items_open_light(in, GP_SVG_GRAINS, &failed);
     if (!it) {
         if (failed) return svg_part_error(err, GP_SVG_GRAINS);
         return 1;
@@ -722,7 +722,7 @@ static int desc_hist(const dstat *d, hist *h)
     h->edges = malloc((size_t)(d->k + 1) * sizeof *h->edges);
     h->achieved = malloc((size_t)d->k * sizeof *h->achieved);
     if (!h->edges || !h->achieved) {
-        hist_free(h);
+        svg_plot_hist_free(h);
         return -1;
     }
     for (int i = 0; i <= d->k; i++) h->edges[i] = d->x0 + d->step * i;
@@ -752,8 +752,8 @@ static void hist_zoom(hist *h)
 /* a vertical marker line across the frame at x = v */
 static void vline(sb *s, const frame *f, double v, const char *cls, const char *style)
 {
-    double x = fx(f, v);
-    sb_printf(s, "<line class=\"%s\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" %s/>\n", cls, x,
+    double x = svg_plot_fx(f, v);
+    svg_plot_sb_printf(s, "<line class=\"%s\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" %s/>\n", cls, x,
               f->y0, x, f->y0 + f->h, style);
 }
 
@@ -762,7 +762,7 @@ static void vline(sb *s, const frame *f, double v, const char *cls, const char *
 static void desc_panel(sb *s, double ox, double oy, double pw, double ph, const char *name,
                        const hist *h, double sd, double target)
 {
-    frame f = hist_frame(ox + 62, oy + 26, pw - 82, ph - 76, h);
+    frame f = svg_plot_hist_frame(ox + 62, oy + 26, pw - 82, ph - 76, h);
     if (isfinite(target)) {
         double st = (f.xmax - f.xmin) / h->k;
         if (target < f.xmin) f.xmin = floor(target / st) * st;
@@ -772,9 +772,9 @@ static void desc_panel(sb *s, double ox, double oy, double pw, double ph, const 
     int k = snprintf(t, sizeof t, "%s", name);
     if (h->has_mean) k += snprintf(t + k, sizeof t - (size_t)k, ": mean %.3g", h->mean);
     if (isfinite(sd)) snprintf(t + k, sizeof t - (size_t)k, ", sd %.2g", sd);
-    text_at(s, f.x0 + f.w / 2, oy + 14, "middle", "class=\"panel-title\" font-weight=\"bold\"", t);
-    axes(s, &f, name, "fraction of grains", 0);
-    draw_hist(s, &f, h, GREEN);
+    svg_plot_text_at(s, f.x0 + f.w / 2, oy + 14, "middle", "class=\"panel-title\" font-weight=\"bold\"", t);
+    svg_plot_axes(s, &f, name, "fraction of grains", 0);
+    svg_plot_draw_hist(s, &f, h, GREEN);
     if (h->has_mean && h->mean >= f.xmin && h->mean <= f.xmax)
         vline(s, &f, h->mean, "mean", "stroke=\"#000000\" stroke-width=\"1.5\" stroke-dasharray=\"5 3\"");
     if (isfinite(target))
@@ -791,7 +791,7 @@ static int desc_of(const dpass *p, int have, const json_t *stored, int k, hist *
         *sd = d->n > 1 ? sqrt(fmax(0, var) * d->n / (d->n - 1)) : 0;
         return desc_hist(d, h);
     }
-    if (hist_read(stored, h)) return 1;
+    if (svg_plot_hist_read(stored, h)) return 1;
     hist_zoom(h);
     return 0;
 }
@@ -799,26 +799,26 @@ static int desc_of(const dpass *p, int have, const json_t *stored, int k, hist *
 static void desc_draw(sb *s, int width, int height, hist *h, const double *sd,
                       const double *target)
 {
-    doc_begin(s, width, height, "Shape descriptors of the grains");
+    svg_plot_doc_begin(s, width, height, "Shape descriptors of the grains");
     legend_item it[3] = {{"achieved (fraction of grains per bin)", "bar", GREEN},
                          {"mean", "dash", "#000000"},
                          {"target", "line", RED}};
     int any_target = 0;
     for (int k = 0; k < 4; k++) any_target |= isfinite(target[k]);
-    legend_row(s, 40, 44, it, any_target ? 3 : 2);
+    svg_plot_legend_row(s, 40, 44, it, any_target ? 3 : 2);
     double pw = (width - 40) / 2.0, ph = (height - 60) / 2.0;
     for (int k = 0; k < 4; k++) {
         double ox = 20 + (k % 2) * pw, oy = 56 + (k / 2) * ph;
         if (!h[k].k) {
-            text_at(s, ox + pw / 2, oy + ph / 2, "middle", NULL, "(not in the result)");
+            svg_plot_text_at(s, ox + pw / 2, oy + ph / 2, "middle", NULL, "(not in the result)");
             continue;
         }
-        desc_panel(s, ox, oy, pw, ph, SVG_DESC_NAME[k], &h[k], sd[k], target[k]);
+        desc_panel(s, ox, oy, pw, ph, svg_items_desc_name[k], &h[k], sd[k], target[k]);
     }
-    doc_end(s);
+    svg_plot_doc_end(s);
 }
 
-int svg_view_descriptors(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
+int svg_stats2d_descriptors(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
                          int width, gpd_err *err)
 {
     const json_t *d = json_object_get(json_object_get(in->summary, "stats"), "descriptors");
@@ -836,8 +836,8 @@ int svg_view_descriptors(gp_svg *g, const gp_svg_input *in, const gp_svg_options
     double sd[4], target[4];
     int any = 0, oom = 0;
     for (int k = 0; k < 4; k++) {
-        const json_t *o = json_object_get(d, SVG_DESC_NAME[k]);
-        target[k] = jnum(json_object_get(o, "target"), NAN);
+        const json_t *o = json_object_get(d, svg_items_desc_name[k]);
+        target[k] = svg_plot_jnum(json_object_get(o, "target"), NAN);
         int r = desc_of(p, rc == 0, o, k, &h[k], &sd[k]);
         if (r) memset(&h[k], 0, sizeof h[k]);
         oom |= r < 0;
@@ -845,7 +845,7 @@ int svg_view_descriptors(gp_svg *g, const gp_svg_input *in, const gp_svg_options
     }
     free(p);
     if (any && !oom) desc_draw(&g->out, width, (int)lround(width * 0.75) + 20, h, sd, target);
-    for (int k = 0; k < 4; k++) hist_free(&h[k]);
+    for (int k = 0; k < 4; k++) svg_plot_hist_free(&h[k]);
     if (oom) gpd_err_set(err, 500, "out of memory");
     else if (!any)
         gpd_err_set(err, 409, "view \"descriptors\" needs the descriptors: the spec did not ask for output \"descriptors\"");

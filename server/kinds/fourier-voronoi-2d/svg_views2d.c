@@ -13,16 +13,16 @@
 
 /* ------------------------------------------------------------------ the container */
 
-/* "x,y x,y ..." of a JSON ring [[x,y],...] (ring_points_xy) */
+/* "x,y x,y ..." of a JSON ring [[x,y],...] (svg_plot_ring_points_xy) */
 static size_t ring_points(sb *s, const frame *f, const json_t *ring, double min_px)
 {
     svg_item pts = {0};
     size_t w = 0;
-    if (svg_item_ring(&pts, ring))
+    if (svg_items_ring(&pts, ring))
         s->oom = 1;
     else
-        w = ring_points_xy(s, f, pts.xy, pts.npts, min_px);
-    svg_item_free(&pts);
+        w = svg_plot_ring_points_xy(s, f, pts.xy, pts.npts, min_px);
+    svg_items_free(&pts);
     return w;
 }
 
@@ -33,29 +33,29 @@ static void container_outline(sb *s, const frame *f, const json_t *container)
     const json_t *circle = json_object_get(container, "circle");
     if (json_is_object(circle)) {
         const json_t *c = json_object_get(circle, "center");
-        double cx = jnum(json_array_get(c, 0), NAN), cy = jnum(json_array_get(c, 1), NAN);
-        double r = jnum(json_object_get(circle, "radius"), NAN);
+        double cx = svg_plot_jnum(json_array_get(c, 0), NAN), cy = svg_plot_jnum(json_array_get(c, 1), NAN);
+        double r = svg_plot_jnum(json_object_get(circle, "radius"), NAN);
         if (!isfinite(cx) || !isfinite(cy) || !(r > 0)) return;
-        double px = fx(f, cx), py = fy(f, cy), pr = fx(f, cx + r) - px;
-        sb_printf(s, "<path class=\"container\" d=\"M%.1f %.1fa%.1f %.1f 0 1 0 %.1f 0a%.1f %.1f 0 1 0 %.1f 0z\" "
+        double px = svg_plot_fx(f, cx), py = svg_plot_fy(f, cy), pr = svg_plot_fx(f, cx + r) - px;
+        svg_plot_sb_printf(s, "<path class=\"container\" d=\"M%.1f %.1fa%.1f %.1f 0 1 0 %.1f 0a%.1f %.1f 0 1 0 %.1f 0z\" "
                      "fill=\"none\" stroke=\"#000000\" stroke-width=\"1.5\"/>\n",
                   px - pr, py, pr, pr, 2 * pr, pr, pr, -2 * pr);
         return;
     }
     const json_t *poly = json_object_get(container, "polygon");
     if (!json_is_array(poly)) return;
-    sb_puts(s, "<path class=\"container\" fill=\"none\" stroke=\"#000000\" stroke-width=\"1.5\" d=\"");
-    sb_puts(s, "M");
+    svg_plot_sb_puts(s, "<path class=\"container\" fill=\"none\" stroke=\"#000000\" stroke-width=\"1.5\" d=\"");
+    svg_plot_sb_puts(s, "M");
     ring_points(s, f, poly, 0);
-    sb_puts(s, "z");
+    svg_plot_sb_puts(s, "z");
     size_t i;
     const json_t *h;
     json_array_foreach(json_object_get(container, "holes"), i, h) {
-        sb_puts(s, " M");
+        svg_plot_sb_puts(s, " M");
         ring_points(s, f, h, 0);
-        sb_puts(s, "z");
+        svg_plot_sb_puts(s, "z");
     }
-    sb_puts(s, "\"/>\n");
+    svg_plot_sb_puts(s, "\"/>\n");
 }
 
 static void bounds_ring(bounds *b, const json_t *ring)
@@ -63,7 +63,7 @@ static void bounds_ring(bounds *b, const json_t *ring)
     size_t i;
     const json_t *p;
     json_array_foreach(ring, i, p) {
-        bounds_add(b, jnum(json_array_get(p, 0), NAN), jnum(json_array_get(p, 1), NAN));
+        svg_plot_bounds_add(b, svg_plot_jnum(json_array_get(p, 0), NAN), svg_plot_jnum(json_array_get(p, 1), NAN));
     }
 }
 
@@ -73,10 +73,10 @@ static void container_bounds(bounds *b, const json_t *container)
     const json_t *circle = json_object_get(container, "circle");
     if (circle) {
         const json_t *c = json_object_get(circle, "center");
-        double cx = jnum(json_array_get(c, 0), NAN), cy = jnum(json_array_get(c, 1), NAN);
-        double r = jnum(json_object_get(circle, "radius"), NAN);
-        bounds_add(b, cx - r, cy - r);
-        bounds_add(b, cx + r, cy + r);
+        double cx = svg_plot_jnum(json_array_get(c, 0), NAN), cy = svg_plot_jnum(json_array_get(c, 1), NAN);
+        double r = svg_plot_jnum(json_object_get(circle, "radius"), NAN);
+        svg_plot_bounds_add(b, cx - r, cy - r);
+        svg_plot_bounds_add(b, cx + r, cy + r);
         return;
     }
     bounds_ring(b, json_object_get(container, "polygon"));
@@ -153,9 +153,9 @@ static void inset_window(svg_inset *in, bounds b, size_t n)
 static int in_window(const svg_inset *in, const svg_item *c)
 {
     bounds ib;
-    bounds_init(&ib);
-    bounds_xy(&ib, c->xy, c->npts);
-    return bounds_ok(&ib) && ib.xmax >= in->x0 && ib.xmin <= in->x1 && ib.ymax >= in->y0 &&
+    svg_plot_bounds_init(&ib);
+    svg_plot_bounds_xy(&ib, c->xy, c->npts);
+    return svg_plot_bounds_ok(&ib) && ib.xmax >= in->x0 && ib.xmin <= in->x1 && ib.ymax >= in->y0 &&
            ib.ymin <= in->y1;
 }
 
@@ -169,10 +169,10 @@ static int map_pass(gp_svg *g, const gp_svg_input *in, gp_svg_part part, const c
 {
     if (svg_open_part(g, in, part, view, err)) return -1;
     svg_inset *ins = &g->inset;
-    bounds_init(b);
+    svg_plot_bounds_init(b);
     container_bounds(b, json_object_get(in->summary, "container"));
     ins->gb = *b;
-    ins->grid_on = bounds_ok(b) && b->xmax > b->xmin && b->ymax > b->ymin;
+    ins->grid_on = svg_plot_bounds_ok(b) && b->xmax > b->xmin && b->ymax > b->ymin;
     double amin = INFINITY, amax = -INFINITY;
     *n = 0;
     int r = svg_pass_begin(g);
@@ -180,12 +180,12 @@ static int map_pass(gp_svg *g, const gp_svg_input *in, gp_svg_part part, const c
         while ((r = g->items->next(g->items)) > 0) {
             const svg_item *c = &g->items->cur;
             bounds ib;
-            bounds_init(&ib);
-            bounds_xy(&ib, c->xy, c->npts);
+            svg_plot_bounds_init(&ib);
+            svg_plot_bounds_xy(&ib, c->xy, c->npts);
             (*n)++;
-            if (bounds_ok(&ib)) {
-                bounds_add(b, ib.xmin, ib.ymin);
-                bounds_add(b, ib.xmax, ib.ymax);
+            if (svg_plot_bounds_ok(&ib)) {
+                svg_plot_bounds_add(b, ib.xmin, ib.ymin);
+                svg_plot_bounds_add(b, ib.xmax, ib.ymax);
                 int i, j;
                 if (ins->grid_on &&
                     grid_cell(ins, (ib.xmin + ib.xmax) / 2, (ib.ymin + ib.ymax) / 2, &i, &j) == 0)
@@ -194,7 +194,7 @@ static int map_pass(gp_svg *g, const gp_svg_input *in, gp_svg_part part, const c
             if (c->area > 0) amin = fmin(amin, c->area), amax = fmax(amax, c->area);
         }
     if (r < 0) return svg_part_error(err, part);
-    if (!bounds_ok(b)) b->xmin = b->ymin = 0, b->xmax = b->ymax = 1;
+    if (!svg_plot_bounds_ok(b)) b->xmin = b->ymin = 0, b->xmax = b->ymax = 1;
     if (!(amax >= amin)) amin = amax = 1;
     g->amin = amin;
     g->amax = amax;
@@ -212,18 +212,18 @@ static void map_head(gp_svg *g, bounds b, size_t n, const gp_svg_options *opt, i
     svg_inset *ins = &g->inset;
     ins->on = n > INSET_MIN;
     if (!ins->on) {
-        g->f = map_frame(b, width, &height);
+        g->f = svg_plot_map_frame(b, width, &height);
     } else {
         if (!opt || opt->width <= 0) width = 1200;
         double pw = (width - 80 - 130 - 50) / 2.0;
         inset_window(ins, b, n);
-        g->f = map_frame_in(b, 80, 60, pw, 2 * pw);
+        g->f = svg_plot_map_frame_in(b, 80, 60, pw, 2 * pw);
         bounds wb = {ins->x0, ins->x1, ins->y0, ins->y1};
-        ins->f = map_frame_in(wb, 80 + pw + 50, 60, pw, pw);
+        ins->f = svg_plot_map_frame_in(wb, 80 + pw + 50, 60, pw, pw);
         height = (int)ceil(fmax(g->f.h, ins->f.h) + 60 + 60);
     }
-    doc_begin(&g->out, width, height, title);
-    axes(&g->out, &g->f, "x (m)", "y (m)", 0);
+    svg_plot_doc_begin(&g->out, width, height, title);
+    svg_plot_axes(&g->out, &g->f, "x (m)", "y (m)", 0);
 }
 
 /* the colour of a grain or cell of area a: the ramp over g->amin..g->amax (log when
@@ -235,11 +235,11 @@ static void area_color(const gp_svg *g, double a, char *col, size_t n)
     if (g->amax > g->amin)
         t = g->logscale ? log(a / g->amin) / log(g->amax / g->amin)
                         : (a - g->amin) / (g->amax - g->amin);
-    ramp(t, col, n);
+    svg_plot_ramp(t, col, n);
 }
 
 /* the end of a map: the container's outline and a colour bar (cyc: orientations, else the
- * areas g->amin..g->amax, in the unit area_unit picks) into the tail; then the drawing pass
+ * areas g->amin..g->amax, in the unit svg_plot_area_unit picks) into the tail; then the drawing pass
  * begins, by step */
 static int map_end(gp_svg *g, const gp_svg_input *in, int cyc, const char *what,
                    int (*step)(gp_svg *g), gpd_err *err)
@@ -248,15 +248,15 @@ static int map_end(gp_svg *g, const gp_svg_input *in, int cyc, const char *what,
     container_outline(&g->tail, f, json_object_get(in->summary, "container"));
     double cbx = fr->x0 + fr->w + 20, cbh = fmin(fmax(f->h, fr->h) - 30, 300);
     if (cyc) {
-        colorbar(&g->tail, cbx, f->y0 + 24, cbh, -90, 90, 1, 0, what);
+        svg_plot_colorbar(&g->tail, cbx, f->y0 + 24, cbh, -90, 90, 1, 0, what);
     } else {
         double k;
         char label[96];
-        const char *unit = area_unit(g->amax, &k);
+        const char *unit = svg_plot_area_unit(g->amax, &k);
         snprintf(label, sizeof label, "%s (%s)", what, unit);
-        colorbar(&g->tail, cbx, f->y0 + 24, cbh, g->amin * k, g->amax * k, 0, g->logscale, label);
+        svg_plot_colorbar(&g->tail, cbx, f->y0 + 24, cbh, g->amin * k, g->amax * k, 0, g->logscale, label);
     }
-    doc_end(&g->tail);
+    svg_plot_doc_end(&g->tail);
     return svg_start_steps(g, step, err);
 }
 
@@ -269,21 +269,21 @@ static void inset_open(gp_svg *g, const char *attrs)
     const svg_inset *in = &g->inset;
     sb *s = &g->out;
     const frame *f = &g->f, *fi = &in->f;
-    double x0 = fx(f, in->x0), x1 = fx(f, in->x1), y0 = fy(f, in->y1), y1 = fy(f, in->y0);
-    sb_printf(s, "<path class=\"inset-link\" fill=\"none\" stroke=\"#888888\" stroke-dasharray=\"3 3\" "
+    double x0 = svg_plot_fx(f, in->x0), x1 = svg_plot_fx(f, in->x1), y0 = svg_plot_fy(f, in->y1), y1 = svg_plot_fy(f, in->y0);
+    svg_plot_sb_printf(s, "<path class=\"inset-link\" fill=\"none\" stroke=\"#888888\" stroke-dasharray=\"3 3\" "
                  "d=\"M%.1f %.1fL%.1f %.1fM%.1f %.1fL%.1f %.1f\"/>\n",
               x1, y0, fi->x0, fi->y0, x1, y1, fi->x0, fi->y0 + fi->h);
-    sb_printf(s, "<rect class=\"inset-window\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
+    svg_plot_sb_printf(s, "<rect class=\"inset-window\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
                  "fill=\"none\" stroke=\"#d62728\" stroke-width=\"2\"/>\n",
               x0, y0, x1 - x0, y1 - y0);
-    sb_printf(s, "<g class=\"inset\">\n<desc>detail window: x from %.9g to %.9g m, y from %.9g to %.9g m</desc>\n",
+    svg_plot_sb_printf(s, "<g class=\"inset\">\n<desc>detail window: x from %.9g to %.9g m, y from %.9g to %.9g m</desc>\n",
               in->x0, in->x1, in->y0, in->y1);
-    sb_printf(s, "<defs><clipPath id=\"inset-clip\"><rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" "
+    svg_plot_sb_printf(s, "<defs><clipPath id=\"inset-clip\"><rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" "
                  "height=\"%.1f\"/></clipPath></defs>\n",
               fi->x0, fi->y0, fi->w, fi->h);
-    sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#ffffff\"/>\n",
+    svg_plot_sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#ffffff\"/>\n",
               fi->x0, fi->y0, fi->w, fi->h);
-    sb_printf(s, "<g clip-path=\"url(#inset-clip)\" stroke=\"#222222\" stroke-width=\"0.8\"%s>\n", attrs);
+    svg_plot_sb_printf(s, "<g clip-path=\"url(#inset-clip)\" stroke=\"#222222\" stroke-width=\"0.8\"%s>\n", attrs);
 }
 
 /* a scale bar of a round length, about a quarter of the inset wide, at its lower left */
@@ -296,11 +296,11 @@ static void scale_bar(sb *s, const frame *fi)
     char lab[64];
     if (len >= 1) snprintf(lab, sizeof lab, "%g m", len);
     else snprintf(lab, sizeof lab, "%g mm", len * 1e3);
-    sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"24\" fill=\"#ffffff\" fill-opacity=\"0.85\"/>\n",
-              x - 6, y - 18, fmax(px, text_w(lab)) + 12);
-    sb_printf(s, "<path class=\"scale-bar\" d=\"M%.1f %.1fh%.1f\" stroke=\"#000000\" stroke-width=\"3\"/>\n",
+    svg_plot_sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"24\" fill=\"#ffffff\" fill-opacity=\"0.85\"/>\n",
+              x - 6, y - 18, fmax(px, svg_plot_text_w(lab)) + 12);
+    svg_plot_sb_printf(s, "<path class=\"scale-bar\" d=\"M%.1f %.1fh%.1f\" stroke=\"#000000\" stroke-width=\"3\"/>\n",
               x, y, px);
-    text_at(s, x + px / 2, y - 6, "middle", "font-size=\"11\"", lab);
+    svg_plot_text_at(s, x + px / 2, y - 6, "middle", "font-size=\"11\"", lab);
 }
 
 /* after the inset's pass: its frame, scale bar and caption (with the count now known) */
@@ -309,25 +309,25 @@ static void inset_close(gp_svg *g, const char *what)
     const svg_inset *in = &g->inset;
     const frame *fi = &in->f;
     sb *s = &g->out;
-    sb_puts(s, "</g>\n");
-    sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" "
+    svg_plot_sb_puts(s, "</g>\n");
+    svg_plot_sb_printf(s, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" "
                  "stroke=\"#d62728\" stroke-width=\"2\"/>\n",
               fi->x0, fi->y0, fi->w, fi->h);
     scale_bar(s, fi);
     char cap[200];
     double zoom = (fi->w / (fi->xmax - fi->xmin)) / (g->f.w / (g->f.xmax - g->f.xmin));
     snprintf(cap, sizeof cap, "Detail (\xc3\x97%.3g): %zu %s in the red square", zoom, in->n, what);
-    text_at(s, fi->x0 + fi->w / 2, fi->y0 - 8, "middle", "class=\"inset-caption\"", cap);
-    sb_puts(s, "</g>\n");
+    svg_plot_text_at(s, fi->x0 + fi->w / 2, fi->y0 - 8, "middle", "class=\"inset-caption\"", cap);
+    svg_plot_sb_puts(s, "</g>\n");
 }
 
 /* one item's ring as a path in the inset (paths, not polygons: a picture's <polygon>s are its
  * items, each once) */
 static void inset_ring(gp_svg *g, const double *xy, size_t n, const char *col)
 {
-    sb_printf(&g->out, "<path fill=\"%s\" d=\"M", col);
-    ring_points_xy(&g->out, &g->inset.f, xy, n, 0.3);
-    sb_puts(&g->out, "z\"/>\n");
+    svg_plot_sb_printf(&g->out, "<path fill=\"%s\" d=\"M", col);
+    svg_plot_ring_points_xy(&g->out, &g->inset.f, xy, n, 0.3);
+    svg_plot_sb_puts(&g->out, "z\"/>\n");
 }
 
 /* Keeps a ring of n points (n = 0: a seed, the one point at xy) of an item in the window for
@@ -402,7 +402,7 @@ static int step_packing(gp_svg *g)
     if (g->section == 3) {
         if (!inset_from_kept(g)) return 0;
         inset_close(g, "grains");
-        sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
+        svg_plot_sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
         return 1;
     }
     size_t start = g->out.len;
@@ -410,28 +410,28 @@ static int step_packing(gp_svg *g)
     while (g->out.len - start < STEP_BYTES && (r = g->items->next(g->items)) > 0) {
         const svg_item *c = &g->items->cur;
         char col[16];
-        if (g->by_orient) cyclic(isnan(c->orientation_deg) ? 0 : c->orientation_deg, col, sizeof col);
+        if (g->by_orient) svg_plot_cyclic(isnan(c->orientation_deg) ? 0 : c->orientation_deg, col, sizeof col);
         else area_color(g, c->area, col, sizeof col);
         int in = g->inset.on && in_window(&g->inset, c);
         if (g->section == 2) {
             if (in) g->inset.n++, inset_ring(g, c->xy, c->npts, col);
             continue;
         }
-        sb_printf(&g->out, "<polygon fill=\"%s\" points=\"", col);
-        ring_points_xy(&g->out, &g->f, c->xy, c->npts, g->min_px);
-        sb_puts(&g->out, "\"/>\n");
+        svg_plot_sb_printf(&g->out, "<polygon fill=\"%s\" points=\"", col);
+        svg_plot_ring_points_xy(&g->out, &g->f, c->xy, c->npts, g->min_px);
+        svg_plot_sb_puts(&g->out, "\"/>\n");
         if (in) g->inset.n++, inset_keep(&g->inset, c->xy, c->npts, col);
     }
     if (r < 0) return svg_pass_failed(g);
     if (r > 0) return 0;
-    if (g->section == 0) sb_puts(&g->out, "</g>\n");
+    if (g->section == 0) svg_plot_sb_puts(&g->out, "</g>\n");
     if (g->section == 0 && g->inset.on) return inset_begin(g, "");
     if (g->section == 2) inset_close(g, "grains");
-    sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
+    svg_plot_sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
     return 1;
 }
 
-int svg_view_packing(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+int svg_views2d_packing(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                      gpd_err *err)
 {
     const char *color = opt && opt->color && *opt->color ? opt->color : "size";
@@ -446,13 +446,13 @@ int svg_view_packing(gp_svg *g, const gp_svg_input *in, const gp_svg_options *op
     char title[160];
     const json_t *sfj = json_object_get(json_object_get(in->summary, "stats"), "solid_fraction");
     if (json_is_object(sfj)) sfj = json_object_get(sfj, "achieved"); /* {"target", "achieved"} */
-    double sf = jnum(sfj, NAN);
+    double sf = svg_plot_jnum(sfj, NAN);
     if (isfinite(sf))
         snprintf(title, sizeof title, "Packing: %zu grains, solid fraction %.3f", ng, sf);
     else
         snprintf(title, sizeof title, "Packing: %zu grains", ng);
     map_head(g, b, ng, opt, width, title);
-    sb_puts(&g->out, "<g class=\"grains\" stroke=\"#222222\" stroke-width=\"0.4\">\n");
+    svg_plot_sb_puts(&g->out, "<g class=\"grains\" stroke=\"#222222\" stroke-width=\"0.4\">\n");
     g->by_orient = by_orient;
     g->logscale = g->amax > 10 * g->amin;
     g->section = 0;
@@ -464,7 +464,7 @@ int svg_view_packing(gp_svg *g, const gp_svg_input *in, const gp_svg_options *op
 static void cell_color(const gp_svg *g, const svg_item *c, char *col, size_t n)
 {
     double a = isnan(c->area) ? g->amin : c->area;
-    ramp(g->amax > g->amin ? (a - g->amin) / (g->amax - g->amin) : 0.5, col, n);
+    svg_plot_ramp(g->amax > g->amin ? (a - g->amin) / (g->amax - g->amin) : 0.5, col, n);
 }
 
 /* a cell's parts in the map, or (inset) in the inset; keep: kept for the inset too */
@@ -478,17 +478,17 @@ static void cell_rings(gp_svg *g, const svg_item *c, int inset, int keep)
             inset_ring(g, c->xy + 2 * k, c->rings[j], col);
             continue;
         }
-        sb_printf(&g->out, "<polygon fill=\"%s\" points=\"", col);
-        ring_points_xy(&g->out, &g->f, c->xy + 2 * k, c->rings[j], g->min_px);
-        sb_puts(&g->out, "\"/>\n");
+        svg_plot_sb_printf(&g->out, "<polygon fill=\"%s\" points=\"", col);
+        svg_plot_ring_points_xy(&g->out, &g->f, c->xy + 2 * k, c->rings[j], g->min_px);
+        svg_plot_sb_puts(&g->out, "\"/>\n");
     }
 }
 
 /* a seed in the inset: a small square path (the picture's circles are the seeds, each once) */
 static void inset_seed(gp_svg *g, double x, double y)
 {
-    sb_printf(&g->out, "<path fill=\"#d62728\" fill-opacity=\"1\" stroke=\"none\" d=\"M%.1f %.1fh4v4h-4z\"/>\n",
-              fx(&g->inset.f, x) - 2, fy(&g->inset.f, y) - 2);
+    svg_plot_sb_printf(&g->out, "<path fill=\"#d62728\" fill-opacity=\"1\" stroke=\"none\" d=\"M%.1f %.1fh4v4h-4z\"/>\n",
+              svg_plot_fx(&g->inset.f, x) - 2, svg_plot_fy(&g->inset.f, y) - 2);
 }
 
 /* a cell's seed on the map, or (inset) in the inset */
@@ -497,8 +497,8 @@ static void cell_seed(gp_svg *g, const svg_item *c, int inset)
     double x = c->seed[0], y = c->seed[1];
     if (!isfinite(x) || !isfinite(y)) return;
     if (inset) inset_seed(g, x, y);
-    else sb_printf(&g->out, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"%.1f\"/>\n", fx(&g->f, x),
-                   fy(&g->f, y), g->seed_r);
+    else svg_plot_sb_printf(&g->out, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"%.1f\"/>\n", svg_plot_fx(&g->f, x),
+                   svg_plot_fy(&g->f, y), g->seed_r);
 }
 
 /* the cells and their seeds: pass 1 bounds, area range and count; the head; step_cells draws
@@ -509,7 +509,7 @@ static int step_cells(gp_svg *g)
     if (g->section == 3) {
         if (!inset_from_kept(g)) return 0;
         inset_close(g, "cells");
-        sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
+        svg_plot_sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
         return 1;
     }
     size_t start = g->out.len;
@@ -534,18 +534,18 @@ static int step_cells(gp_svg *g)
     if (r < 0) return svg_pass_failed(g);
     if (r > 0) return 0;
     if (g->section == 0) {
-        sb_puts(&g->out, g->mid.buf ? g->mid.buf : "");
+        svg_plot_sb_puts(&g->out, g->mid.buf ? g->mid.buf : "");
         g->section = 1;
         return svg_pass_begin(g);
     }
-    if (g->section == 1) sb_puts(&g->out, "</g>\n"); /* the seeds' */
+    if (g->section == 1) svg_plot_sb_puts(&g->out, "</g>\n"); /* the seeds' */
     if (g->section == 1 && g->inset.on) return inset_begin(g, " fill-opacity=\"0.55\"");
     if (g->section == 2) inset_close(g, "cells");
-    sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
+    svg_plot_sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
     return 1;
 }
 
-int svg_view_cells(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+int svg_views2d_cells(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                    gpd_err *err)
 {
     bounds b;
@@ -554,8 +554,8 @@ int svg_view_cells(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
     char title[160];
     snprintf(title, sizeof title, "Voronoi cells: %zu cells and their seeds", nc);
     map_head(g, b, nc, opt, width, title);
-    sb_puts(&g->out, "<g class=\"cells\" stroke=\"#333333\" stroke-width=\"0.5\" fill-opacity=\"0.55\">\n");
-    sb_puts(&g->mid, "</g>\n<g class=\"seeds\" fill=\"#d62728\">\n");
+    svg_plot_sb_puts(&g->out, "<g class=\"cells\" stroke=\"#333333\" stroke-width=\"0.5\" fill-opacity=\"0.55\">\n");
+    svg_plot_sb_puts(&g->mid, "</g>\n<g class=\"seeds\" fill=\"#d62728\">\n");
     g->seed_r = nc > 2000 ? 0.8 : nc > 200 ? 1.5 : 2.5;
     g->section = 0;
     g->logscale = 0;

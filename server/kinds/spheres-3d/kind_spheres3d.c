@@ -266,8 +266,8 @@ static const char example[] =
     " \"tiling\": [4, 4, 4], \"outputs\": [\"spheres\", \"contacts\", \"fabric\", \"stress\"]}";
 
 static const gpd_view views[] = {
-    {"section", "z", svg_view_section},
-    {"psd", "", svg_view_psd},
+    {"section", "z", svg_views3d_section},
+    {"psd", "", svg_views3d_psd},
     {NULL, NULL, NULL},
 };
 

@@ -25,14 +25,14 @@ static int step_section(gp_svg *g)
                        ? (g->logscale ? log(2 * r_ / g->dmin) / log(g->dmax / g->dmin)
                                       : (2 * r_ - g->dmin) / (g->dmax - g->dmin))
                        : 0.5;
-        ramp(t, c, sizeof c);
-        sb_printf(&g->out, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"%s\"/>\n",
-                  fx(&g->f, isnan(q[0]) ? 0 : q[0]), fy(&g->f, isnan(q[1]) ? 0 : q[1]),
+        svg_plot_ramp(t, c, sizeof c);
+        svg_plot_sb_printf(&g->out, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"%s\"/>\n",
+                  svg_plot_fx(&g->f, isnan(q[0]) ? 0 : q[0]), svg_plot_fy(&g->f, isnan(q[1]) ? 0 : q[1]),
                   rc * g->scale, c);
     }
     if (r < 0) return svg_pass_failed(g);
     if (r > 0) return 0;
-    sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
+    svg_plot_sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
     return 1;
 }
 
@@ -42,7 +42,7 @@ static int read_box(const json_t *res, double box[3])
     const json_t *jb = json_object_get(res, "box");
     int have_box = json_is_array(jb) && json_array_size(jb) == 3;
     for (int a = 0; a < 3; a++) {
-        if (have_box) box[a] = jnum(json_array_get(jb, (size_t)a), NAN);
+        if (have_box) box[a] = svg_plot_jnum(json_array_get(jb, (size_t)a), NAN);
         if (!(box[a] > 0)) have_box = 0;
     }
     return have_box;
@@ -51,7 +51,7 @@ static int read_box(const json_t *res, double box[3])
 /* the tiling's count along z (result "tiling": [nx, ny, nz]); 1 when untiled or absent */
 static int read_tiles_z(const json_t *res)
 {
-    double nz = jnum(json_array_get(json_object_get(res, "tiling"), 2), 1);
+    double nz = svg_plot_jnum(json_array_get(json_object_get(res, "tiling"), 2), 1);
     return nz >= 1 && nz <= 1e6 ? (int)nz : 1;
 }
 
@@ -122,9 +122,9 @@ static double psd_d(const double *d, const double *c, size_t n, double p)
 static void psd_summary(const json_t *psd, char *buf, size_t len)
 {
     size_t n, nt, na;
-    double *d = jarray(json_object_get(psd, "diameters"), &n);
-    double *t = jarray(json_object_get(psd, "target_weight"), &nt);
-    double *a = jarray(json_object_get(psd, "achieved_weight"), &na);
+    double *d = svg_plot_jarray(json_object_get(psd, "diameters"), &n);
+    double *t = svg_plot_jarray(json_object_get(psd, "target_weight"), &nt);
+    double *a = svg_plot_jarray(json_object_get(psd, "achieved_weight"), &na);
     buf[0] = 0;
     if (d && a && na == n) {
         double d10 = psd_d(d, a, n, 10), d50 = psd_d(d, a, n, 50), d60 = psd_d(d, a, n, 60);
@@ -153,8 +153,8 @@ static void section_subtitle(const json_t *res, const sphere_scan *sc, double ar
                              double hz, int nz, char *l1, char *l2, size_t n)
 {
     const json_t *po = json_object_get(json_object_get(res, "stats"), "porosity");
-    double p = jnum(json_is_object(po) ? json_object_get(po, "achieved") : po, NAN);
-    double pt = jnum(json_is_object(po) ? json_object_get(po, "target") : NULL, NAN);
+    double p = svg_plot_jnum(json_is_object(po) ? json_object_get(po, "achieved") : po, NAN);
+    double pt = svg_plot_jnum(json_is_object(po) ? json_object_get(po, "target") : NULL, NAN);
     char psd[160];
     psd_summary(json_object_get(json_object_get(res, "stats"), "psd"), psd, sizeof psd);
     int k = isfinite(p) ? snprintf(l1, n, "porosity %.3f", p) : snprintf(l1, n, "porosity");
@@ -177,7 +177,7 @@ static void section_frame(gp_svg *g, const json_t *res, bounds b, int width,
                           const sphere_scan *sc, double hz, int nz)
 {
     int height;
-    frame f = map_frame(b, width, &height);
+    frame f = svg_plot_map_frame(b, width, &height);
     f.y0 += 36; /* room for two subtitle lines */
     height += 36;
     sb *s = &g->out;
@@ -186,19 +186,19 @@ static void section_frame(gp_svg *g, const json_t *res, bounds b, int width,
              sc->n);
     section_subtitle(res, sc, (b.xmax - b.xmin) * (b.ymax - b.ymin), g->z, hz, nz, l1, l2,
                      sizeof l1);
-    doc_begin(s, width, height, title);
-    text_at(s, width / 2.0, 42, "middle", "class=\"subtitle\"", l1);
-    text_at(s, width / 2.0, 58, "middle", "class=\"subtitle\" fill=\"#444444\"", l2);
-    axes(s, &f, "x (m)", "y (m)", 0);
-    sb_printf(s, "<rect class=\"box\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#f4f4f4\" "
+    svg_plot_doc_begin(s, width, height, title);
+    svg_plot_text_at(s, width / 2.0, 42, "middle", "class=\"subtitle\"", l1);
+    svg_plot_text_at(s, width / 2.0, 58, "middle", "class=\"subtitle\" fill=\"#444444\"", l2);
+    svg_plot_axes(s, &f, "x (m)", "y (m)", 0);
+    svg_plot_sb_printf(s, "<rect class=\"box\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#f4f4f4\" "
                  "stroke=\"#000000\" stroke-width=\"1.5\"/>\n",
-              fx(&f, b.xmin), fy(&f, b.ymax), fx(&f, b.xmax) - fx(&f, b.xmin), fy(&f, b.ymin) - fy(&f, b.ymax));
-    sb_puts(s, "<g class=\"spheres\" stroke=\"#222222\" stroke-width=\"0.4\">\n");
-    sb_puts(&g->tail, "</g>\n");
+              svg_plot_fx(&f, b.xmin), svg_plot_fy(&f, b.ymax), svg_plot_fx(&f, b.xmax) - svg_plot_fx(&f, b.xmin), svg_plot_fy(&f, b.ymin) - svg_plot_fy(&f, b.ymax));
+    svg_plot_sb_puts(s, "<g class=\"spheres\" stroke=\"#222222\" stroke-width=\"0.4\">\n");
+    svg_plot_sb_puts(&g->tail, "</g>\n");
     double k = g->dmax < 1 ? 1000 : 1;
-    colorbar(&g->tail, f.x0 + f.w + 20, f.y0 + 24, fmin(f.h - 30, 300), g->dmin * k, g->dmax * k,
+    svg_plot_colorbar(&g->tail, f.x0 + f.w + 20, f.y0 + 24, fmin(f.h - 30, 300), g->dmin * k, g->dmax * k,
              0, g->logscale, k > 1 ? "diameter (mm)" : "diameter (m)");
-    doc_end(&g->tail);
+    svg_plot_doc_end(&g->tail);
     g->f = f;
     g->scale = f.w / (f.xmax - f.xmin);
 }
@@ -206,7 +206,7 @@ static void section_frame(gp_svg *g, const json_t *res, bounds b, int width,
 /* The section at z (opt->z, else default_z): pass 1 diameter range, bounds (when the result
  * has no box), count and the spheres cut (once z is known); the head; step_section draws the
  * cut spheres, then the tail. */
-int svg_view_section(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+int svg_views3d_section(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                      gpd_err *err)
 {
     if (svg_open_part(g, in, GP_SVG_SPHERES, "section", err)) return -1;
@@ -242,7 +242,7 @@ int svg_view_section(gp_svg *g, const gp_svg_input *in, const gp_svg_options *op
 }
 
 /* the sieve curves of stats.psd: percent passing against the sieve diameter (log scale) */
-int svg_view_psd(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+int svg_views3d_psd(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                  gpd_err *err)
 {
     const json_t *res = in->summary;
@@ -252,10 +252,10 @@ int svg_view_psd(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, i
                                     "achieved, by number"};
     static const char *colors[4] = {"#1f77b4", "#1f77b4", "#d62728", "#d62728"};
     size_t nd = 0, nc[4] = {0};
-    double *d = jarray(json_object_get(psd, "diameters"), &nd);
+    double *d = svg_plot_jarray(json_object_get(psd, "diameters"), &nd);
     double *c[4] = {NULL};
     for (int k = 0; k < 4; k++) {
-        c[k] = jarray(json_object_get(psd, keys[k]), &nc[k]);
+        c[k] = svg_plot_jarray(json_object_get(psd, keys[k]), &nc[k]);
         if (c[k] && nc[k] != nd) {
             free(c[k]);
             c[k] = NULL;
@@ -279,32 +279,32 @@ int svg_view_psd(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, i
     int height = (int)lround(width * 0.62);
     frame f = {80, 40, width - 110.0, height - 110.0, xlo, xhi, 0, 100, 1};
     sb *s = &g->out;
-    doc_begin(s, width, height, "Grain-size distribution: target vs achieved");
-    axes(s, &f, unit > 1 ? "sieve diameter (mm, log scale)" : "sieve diameter (m, log scale)",
+    svg_plot_doc_begin(s, width, height, "Grain-size distribution: target vs achieved");
+    svg_plot_axes(s, &f, unit > 1 ? "sieve diameter (mm, log scale)" : "sieve diameter (m, log scale)",
          "percent passing (%)", 1);
     for (int k = 0; k < 4; k++) {
         if (!c[k]) continue;
         int dashed = k % 2 == 0;
-        sb_printf(s, "<path class=\"%s\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s d=\"", keys[k],
+        svg_plot_sb_printf(s, "<path class=\"%s\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"%s d=\"", keys[k],
                   colors[k], dashed ? " stroke-dasharray=\"6 4\"" : "");
         int first = 1;
         for (size_t i = 0; i < nd; i++) {
             if (!(d[i] > 0) || !isfinite(c[k][i])) continue;
-            sb_printf(s, "%s%.1f %.1f", first ? "M" : "L", fx(&f, d[i] * unit), fy(&f, fmax(0, fmin(100, c[k][i]))));
+            svg_plot_sb_printf(s, "%s%.1f %.1f", first ? "M" : "L", svg_plot_fx(&f, d[i] * unit), svg_plot_fy(&f, fmax(0, fmin(100, c[k][i]))));
             first = 0;
         }
-        sb_puts(s, "\"/>\n");
+        svg_plot_sb_puts(s, "\"/>\n");
         if (!dashed)
             for (size_t i = 0; i < nd; i++)
                 if (d[i] > 0 && isfinite(c[k][i]))
-                    marker(s, fx(&f, d[i] * unit), fy(&f, fmax(0, fmin(100, c[k][i]))), colors[k]);
+                    svg_plot_marker(s, svg_plot_fx(&f, d[i] * unit), svg_plot_fy(&f, fmax(0, fmin(100, c[k][i]))), colors[k]);
     }
     legend_item it[4];
     int n = 0;
     for (int k = 0; k < 4; k++)
         if (c[k]) it[n++] = (legend_item){labels[k], k % 2 == 0 ? "dash" : "marker", colors[k]};
-    legend(s, f.x0 + 10, f.y0 + 8, it, n);
-    doc_end(s);
+    svg_plot_legend(s, f.x0 + 10, f.y0 + 8, it, n);
+    svg_plot_doc_end(s);
     free(d);
     for (int k = 0; k < 4; k++) free(c[k]);
     return 0;
