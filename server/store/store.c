@@ -94,10 +94,26 @@ json_t *store_list(const char *status, int limit, const char *after, store_rc *r
     return be->list(status, limit, after, rc);
 }
 
+static const char *const status_names[STORE_NSTATUS] = {"queued", "running", "succeeded",
+                                                        "failed", "cancelled"};
+
+int store_status_slot(const char *status)
+{
+    for (int i = 0; status && i < STORE_NSTATUS; i++)
+        if (!strcmp(status, status_names[i])) return i;
+    return -1;
+}
+
 store_rc store_counts(long *queued, long *running, long *succeeded, long *failed,
                       long *cancelled)
 {
-    return be->counts(queued, running, succeeded, failed, cancelled);
+    long n[STORE_NSTATUS] = {0};
+    store_rc rc = be->counts(n);
+    if (rc != STORE_OK) return rc;
+    long *out[STORE_NSTATUS] = {queued, running, succeeded, failed, cancelled};
+    for (int i = 0; i < STORE_NSTATUS; i++)
+        if (out[i]) *out[i] = n[i];
+    return STORE_OK;
 }
 
 store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts)
@@ -144,7 +160,58 @@ int store_size(long long *bytes) { return be->size(bytes); }
 store_rc store_stream_open(const char *id, const char *what, size_t small, store_stream **out,
                            char **text, size_t *text_len, char status[16])
 {
-    return be->stream_open(id, what, small, out, text, text_len, status);
+    *out = NULL;
+    *text = NULL;
+    *text_len = 0;
+    status[0] = 0;
+    int is_pack = !strcmp(what, "pack");
+    if (!is_pack && strcmp(what, "result")) return STORE_ERROR;
+    return be->stream_open(id, is_pack, small, out, text, text_len, status);
+}
+
+store_rc store_stream_settle(store_rc rc, store_stream **out, size_t small, char **text,
+                             size_t *text_len)
+{
+    if (rc != STORE_OK || be->stream_size(*out) > small) return rc;
+    rc = store_stream_read_whole(*out, text, text_len);
+    *out = NULL;
+    return rc;
+}
+
+/* ------------------------------------------------------------------ a connection a thread */
+
+int store_tls_init(store_tls *t)
+{
+    if (t->made) return 0;
+    if (pthread_key_create(&t->key, t->destroy)) return -1;
+    t->made = 1;
+    return 0;
+}
+
+void *store_tls_peek(const store_tls *t) { return t->made ? pthread_getspecific(t->key) : NULL; }
+
+void *store_tls_get(store_tls *t)
+{
+    void *rec = store_tls_peek(t);
+    if (rec || !t->made) return rec;
+    void *h = t->open();
+    if (!h) return NULL;
+    rec = calloc(1, t->size);
+    if (!rec) {
+        t->close(h);
+        return NULL;
+    }
+    memcpy(rec, &h, sizeof h); /* the record's first member, the handle */
+    pthread_setspecific(t->key, rec);
+    return rec;
+}
+
+void store_tls_drop(store_tls *t)
+{
+    void *rec = store_tls_peek(t);
+    if (!rec) return;
+    t->destroy(rec);
+    pthread_setspecific(t->key, NULL);
 }
 
 uint64_t store_stream_size(const store_stream *s) { return be->stream_size(s); }

@@ -16,7 +16,12 @@
 #ifndef GPD_STORE_IMPL_H
 #define GPD_STORE_IMPL_H
 
+#include <pthread.h>
+
 #include "store/store.h"
+
+/* The statuses in the order of store_counts' arguments. */
+enum { STORE_NSTATUS = 5 };
 
 typedef struct store_backend {
     const char *name; /* "sqlite", "postgresql" */
@@ -30,8 +35,8 @@ typedef struct store_backend {
     json_t *(*get_job)(const char *id, store_rc *rc);
     store_rc (*get_text)(const char *id, const char *column, char **text, char status[16]);
     json_t *(*list)(const char *status, int limit, const char *after, store_rc *rc);
-    store_rc (*counts)(long *queued, long *running, long *succeeded, long *failed,
-                       long *cancelled);
+    /* adds each status's count at n[store_status_slot(status)] (n zeroed by store.c) */
+    store_rc (*counts)(long n[STORE_NSTATUS]);
     store_rc (*claim)(char id[33], char **kind, char **spec_json, int *attempts);
     store_rc (*progress)(const char *id, const char *progress_json);
     /* store_succeed after the shared part: summary (may be NULL) of slen bytes and its arrays'
@@ -52,7 +57,9 @@ typedef struct store_backend {
     int (*count_by_kind)(void (*fn)(void *user, const char *kind, const char *status, long n),
                          void *user);
     int (*size)(long long *bytes);
-    store_rc (*stream_open)(const char *id, const char *what, size_t small, store_stream **out,
+    /* store_stream_open after store.c checked `what` and cleared the outputs; a value in parts
+     * within small bytes is left to store_stream_settle */
+    store_rc (*stream_open)(const char *id, int is_pack, size_t small, store_stream **out,
                             char **text, size_t *text_len, char status[16]);
     uint64_t (*stream_size)(const store_stream *s);
     int (*stream_read)(store_stream *s, uint64_t off, void *dst, size_t n);
@@ -87,6 +94,40 @@ void store_parts_free(store_parts *p);
 /* Reads stream s (of at most a few hundred KB: a value in parts that store_stream_open was
  * asked to return whole) into *text (malloc'ed, NUL-terminated), and closes it. */
 store_rc store_stream_read_whole(store_stream *s, char **text, size_t *text_len);
+
+/* A stream a back end just opened (rc): when rc is STORE_OK and the value is within small
+ * bytes, it is read whole into *text and closed (*out NULL). Returns the outcome. */
+store_rc store_stream_settle(store_rc rc, store_stream **out, size_t small, char **text,
+                             size_t *text_len);
+
+/* The index of a status name in store_counts' order, or -1. */
+int store_status_slot(const char *status);
+
+/* The jobs table's columns that both databases declare alike (between the key and the result). */
+#define STORE_JOBS_COMMON_COLUMNS                                                              \
+    " id TEXT NOT NULL UNIQUE, kind TEXT NOT NULL, spec TEXT NOT NULL, status TEXT NOT NULL,"  \
+    " progress TEXT, created_at TEXT NOT NULL, started_at TEXT, finished_at TEXT, error TEXT,"
+
+/* ---- one database connection a thread ---- */
+/* A back end's connection record begins with its database handle (a pointer: PGconn *,
+ * sqlite3 *); each thread opens its own on first use and closes it when it ends
+ * (thread_done) or its thread exits. */
+typedef struct store_tls {
+    void *(*open)(void);        /* a new handle, or NULL (logged) */
+    void (*close)(void *handle);
+    size_t size;                /* of the record, handle first, the rest zeroed */
+    void (*destroy)(void *rec); /* closes the handle and frees the record (and what it holds) */
+    pthread_key_t key;
+    int made;
+} store_tls;
+/* Once, from the back end's open, before any thread: 0, or -1. */
+int store_tls_init(store_tls *t);
+/* This thread's record, or NULL when it has none. */
+void *store_tls_peek(const store_tls *t);
+/* This thread's record, opened when it has none; NULL when the database cannot be reached. */
+void *store_tls_get(store_tls *t);
+/* Closes this thread's record, if any (the next store_tls_get opens a new one). */
+void store_tls_drop(store_tls *t);
 
 /* Calls the hook of store_on_cancel, if any (store_pg's listener). */
 void store_cancel_seen(const char *id);

@@ -40,8 +40,6 @@ static char *conninfo = NULL;    /* the URL; set by pg_open, freed by pg_close *
 static char owner[160];          /* this daemon's id: host/boot/pid/random */
 static size_t owner_host_len;    /* the length of its "host/boot/" prefix */
 static long long max_value = 0;  /* the largest value stored (PostgreSQL: 1 GB a field) */
-static pthread_key_t conn_key;
-static int key_made = 0;
 
 #define PG_STMT_CACHE 48
 #define PG_MAX_VALUE 1000000000LL /* under PostgreSQL's 1 GB limit of one field */
@@ -74,28 +72,17 @@ static PGconn *connect_new(void)
     return pg;
 }
 
-static pg_conn *conn(void)
-{
-    pg_conn *c = key_made ? pthread_getspecific(conn_key) : NULL;
-    if (c) return c;
-    PGconn *pg = connect_new();
-    if (!pg) return NULL;
-    c = calloc(1, sizeof *c);
-    if (!c) {
-        PQfinish(pg);
-        return NULL;
-    }
-    c->pg = pg;
-    pthread_setspecific(conn_key, c);
-    return c;
-}
+static void close_handle(void *pg) { PQfinish(pg); }
+static void *open_handle(void) { return connect_new(); }
+static store_tls tls = {open_handle, close_handle, sizeof(pg_conn), conn_destroy, 0, 0};
+
+static pg_conn *conn(void) { return store_tls_get(&tls); }
 
 /* After a failure: a connection that broke is dropped (the next call makes a new one). */
 static void check_broken(pg_conn *c)
 {
     if (PQstatus(c->pg) == CONNECTION_OK) return;
-    conn_destroy(c);
-    pthread_setspecific(conn_key, NULL);
+    store_tls_drop(&tls);
 }
 
 static int ok_result(const PGresult *r)
@@ -169,7 +156,7 @@ static int simple(const char *sql)
 static store_rc end_tx(store_rc rc)
 {
     if (rc == STORE_OK) return simple("COMMIT") ? STORE_ERROR : STORE_OK;
-    pg_conn *c = key_made ? pthread_getspecific(conn_key) : NULL;
+    pg_conn *c = store_tls_peek(&tls);
     if (c && PQtransactionStatus(c->pg) != PQTRANS_IDLE) simple("ROLLBACK");
     return rc;
 }
@@ -188,15 +175,7 @@ static const char *SCHEMA_SQL =
     "SELECT pg_advisory_xact_lock(7401861);"
     "CREATE TABLE IF NOT EXISTS jobs("
     " seq BIGSERIAL PRIMARY KEY,"
-    " id TEXT NOT NULL UNIQUE,"
-    " kind TEXT NOT NULL,"
-    " spec TEXT NOT NULL,"
-    " status TEXT NOT NULL,"
-    " progress TEXT,"
-    " created_at TEXT NOT NULL,"
-    " started_at TEXT,"
-    " finished_at TEXT,"
-    " error TEXT,"
+    STORE_JOBS_COMMON_COLUMNS
     " result BYTEA,"
     " attempts INTEGER NOT NULL DEFAULT 0,"
     " brief TEXT,"
@@ -345,17 +324,12 @@ static void lease_stop(void)
 
 static void pg_thread_done(void)
 {
-    if (!key_made) return;
-    conn_destroy(pthread_getspecific(conn_key));
-    pthread_setspecific(conn_key, NULL);
+    store_tls_drop(&tls);
 }
 
 static int pg_open(const char *url)
 {
-    if (!key_made) {
-        if (pthread_key_create(&conn_key, conn_destroy)) return -1;
-        key_made = 1;
-    }
+    if (store_tls_init(&tls)) return -1;
     const char *lim = getenv("GRAINPACK_TEST_SQLITE_MAX_LENGTH"); /* the same testing hook */
     max_value = lim && atoll(lim) > 0 ? atoll(lim) : PG_MAX_VALUE;
     free(conninfo);
@@ -585,27 +559,15 @@ static json_t *pg_list(const char *status, int limit, const char *after, store_r
     return json_pack("{s:o, s:o}", "jobs", jobs, "next", next);
 }
 
-static store_rc pg_counts(long *queued, long *running, long *succeeded, long *failed,
-                          long *cancelled)
+static store_rc pg_counts(long n[STORE_NSTATUS])
 {
     PGresult *r = run("SELECT status, count(*) FROM jobs GROUP BY status", 0, NULL, NULL, NULL, 0);
     if (!r) return STORE_ERROR;
-    long q = 0, ru = 0, su = 0, f = 0, c = 0;
     for (int i = 0; i < PQntuples(r); i++) {
-        const char *k = PQgetvalue(r, i, 0);
-        long n = atol(PQgetvalue(r, i, 1));
-        if (!strcmp(k, "queued")) q = n;
-        else if (!strcmp(k, "running")) ru = n;
-        else if (!strcmp(k, "succeeded")) su = n;
-        else if (!strcmp(k, "failed")) f = n;
-        else if (!strcmp(k, "cancelled")) c = n;
+        int k = store_status_slot(PQgetvalue(r, i, 0));
+        if (k >= 0) n[k] = atol(PQgetvalue(r, i, 1));
     }
     PQclear(r);
-    if (queued) *queued = q;
-    if (running) *running = ru;
-    if (succeeded) *succeeded = su;
-    if (failed) *failed = f;
-    if (cancelled) *cancelled = c;
     return STORE_OK;
 }
 
@@ -858,7 +820,7 @@ static store_rc pg_succeed(const char *id, const store_text *result, const char 
     store_rc rc = mark_succeeded(id, &rv, progress_json, brief_json, seq);
     if (rc == STORE_OK) rc = succeed_extras(seq, &rv, &pv, summary, slen, arrays);
     free(rv.buf);
-    pg_conn *c = key_made ? pthread_getspecific(conn_key) : NULL;
+    pg_conn *c = store_tls_peek(&tls);
     char em[300];
     snprintf(em, sizeof em, "%s", c ? PQerrorMessage(c->pg) : "no connection");
     rc = end_tx(rc);
@@ -1121,15 +1083,9 @@ static store_rc read_small(int is_pack, const char *seq, char **text, size_t *te
     return rc;
 }
 
-static store_rc pg_stream_open(const char *id, const char *what, size_t small, store_stream **out,
+static store_rc pg_stream_open(const char *id, int is_pack, size_t small, store_stream **out,
                                char **text, size_t *text_len, char status[16])
 {
-    *out = NULL;
-    *text = NULL;
-    *text_len = 0;
-    status[0] = 0;
-    int is_pack = !strcmp(what, "pack");
-    if (!is_pack && strcmp(what, "result")) return STORE_ERROR;
     const char *v[1] = {id};
     /* octet_length of a TOASTed bytea reads its header, not the value */
     PGresult *r = run(is_pack ? "SELECT j.status, j.seq, octet_length(e.pack), EXISTS (SELECT 1 "
@@ -1157,10 +1113,7 @@ static store_rc pg_stream_open(const char *id, const char *what, size_t small, s
         is_pack ? "SELECT octet_length(pack) FROM exports WHERE seq=$1::bigint"
                 : "SELECT octet_length(result) FROM jobs WHERE seq=$1::bigint",
         seq, is_pack ? STORE_VALUE_PACK : STORE_VALUE_RESULT, out);
-    if (rc != STORE_OK || pg_stream_size(*out) > small) return rc;
-    rc = store_stream_read_whole(*out, text, text_len);
-    *out = NULL;
-    return rc;
+    return store_stream_settle(rc, out, small, text, text_len);
 }
 
 static int pg_stream_read(store_stream *s, uint64_t off, void *dst, size_t n)

@@ -35,7 +35,6 @@ static long query_long(sqlite3 *db, const char *sql)
 }
 
 static char *db_path = NULL;
-static pthread_key_t conn_key;
 static int closed = 0; /* guarded by path_mu */
 static pthread_mutex_t path_mu = PTHREAD_MUTEX_INITIALIZER;
 static int lock_fd = -1; /* holds the database lock from store_open to store_close */
@@ -83,15 +82,7 @@ static void conn_destroy(void *p)
 static const char *SCHEMA_SQL =
     "CREATE TABLE IF NOT EXISTS jobs("
     " seq INTEGER PRIMARY KEY AUTOINCREMENT,"
-    " id TEXT NOT NULL UNIQUE,"
-    " kind TEXT NOT NULL,"
-    " spec TEXT NOT NULL,"
-    " status TEXT NOT NULL,"
-    " progress TEXT,"
-    " created_at TEXT NOT NULL,"
-    " started_at TEXT,"
-    " finished_at TEXT,"
-    " error TEXT,"
+    STORE_JOBS_COMMON_COLUMNS
     " result TEXT,"
     " attempts INTEGER NOT NULL DEFAULT 0);"
     "CREATE INDEX IF NOT EXISTS jobs_status_seq ON jobs(status, seq);"
@@ -184,21 +175,11 @@ static sqlite3 *conn_open(void)
     return db;
 }
 
-static conn_t *conn_t_get(void)
-{
-    conn_t *c = pthread_getspecific(conn_key);
-    if (c) return c;
-    sqlite3 *db = conn_open();
-    if (!db) return NULL;
-    c = calloc(1, sizeof *c);
-    if (!c) {
-        sqlite3_close_v2(db);
-        return NULL;
-    }
-    c->db = db;
-    pthread_setspecific(conn_key, c);
-    return c;
-}
+static void close_handle(void *db) { sqlite3_close_v2(db); }
+static void *open_handle(void) { return conn_open(); }
+static store_tls tls = {open_handle, close_handle, sizeof(conn_t), conn_destroy, 0, 0};
+
+static conn_t *conn_t_get(void) { return store_tls_get(&tls); }
 
 static sqlite3 *conn(void)
 {
@@ -264,11 +245,7 @@ static int lock_take(const char *path)
 
 static int sq_open(const char *path)
 {
-    static int key_made = 0; /* store_open is called once, from main, before any thread */
-    if (!key_made) {
-        if (pthread_key_create(&conn_key, conn_destroy) != 0) return -1;
-        key_made = 1;
-    }
+    if (store_tls_init(&tls)) return -1; /* store_open runs once, from main, before any thread */
     test_max_length = env_long("GRAINPACK_TEST_SQLITE_MAX_LENGTH");
     test_max_pages = env_long("GRAINPACK_TEST_SQLITE_MAX_PAGES");
     __atomic_store_n(&schema_made, 0, __ATOMIC_RELEASE);
@@ -322,11 +299,7 @@ static int sq_open(const char *path)
 
 static void sq_thread_done(void)
 {
-    conn_t *c = pthread_getspecific(conn_key);
-    if (c) {
-        conn_destroy(c);
-        pthread_setspecific(conn_key, NULL);
-    }
+    store_tls_drop(&tls);
 }
 
 static void sq_close(void)
@@ -349,7 +322,7 @@ static void sq_close(void)
  * back with done(). */
 static sqlite3_stmt *prep(sqlite3 *db, const char *sql)
 {
-    conn_t *c = pthread_getspecific(conn_key);
+    conn_t *c = store_tls_peek(&tls);
     if (c && c->db == db)
         for (int i = 0; i < c->n; i++)
             if (c->sql[i] == sql) return c->st[i];
@@ -369,7 +342,7 @@ static sqlite3_stmt *prep(sqlite3 *db, const char *sql)
 static void done(sqlite3_stmt *st)
 {
     if (!st) return;
-    conn_t *c = pthread_getspecific(conn_key);
+    conn_t *c = store_tls_peek(&tls);
     if (c)
         for (int i = 0; i < c->n; i++)
             if (c->st[i] == st) {
@@ -632,33 +605,19 @@ static json_t *sq_list(const char *status, int limit, const char *after, store_r
     return json_pack("{s:o, s:o}", "jobs", jobs, "next", next);
 }
 
-static store_rc sq_counts(long *queued, long *running, long *succeeded, long *failed,
-                      long *cancelled)
+static store_rc sq_counts(long n[STORE_NSTATUS])
 {
     sqlite3 *db = conn();
     if (!db) return STORE_ERROR;
     sqlite3_stmt *st = prep(db, "SELECT status, count(*) FROM jobs GROUP BY status");
     if (!st) return STORE_ERROR;
-    long q = 0, r = 0, su = 0, f = 0, c = 0;
     int s;
     while ((s = sqlite3_step(st)) == SQLITE_ROW) {
-        const char *k = (const char *)sqlite3_column_text(st, 0);
-        long n = (long)sqlite3_column_int64(st, 1);
-        if (!k) continue;
-        if (!strcmp(k, "queued")) q = n;
-        else if (!strcmp(k, "running")) r = n;
-        else if (!strcmp(k, "succeeded")) su = n;
-        else if (!strcmp(k, "failed")) f = n;
-        else if (!strcmp(k, "cancelled")) c = n;
+        int k = store_status_slot((const char *)sqlite3_column_text(st, 0));
+        if (k >= 0) n[k] = (long)sqlite3_column_int64(st, 1);
     }
     done(st);
-    if (s != SQLITE_DONE) return STORE_ERROR;
-    if (queued) *queued = q;
-    if (running) *running = r;
-    if (succeeded) *succeeded = su;
-    if (failed) *failed = f;
-    if (cancelled) *cancelled = c;
-    return STORE_OK;
+    return s == SQLITE_DONE ? STORE_OK : STORE_ERROR;
 }
 
 static store_rc sq_claim(char id[33], char **kind, char **spec_json, int *attempts)
@@ -1088,16 +1047,9 @@ static int read_small(sqlite3_blob *b, uint64_t size, char **text, size_t *text_
     return 0;
 }
 
-static store_rc sq_stream_open(const char *id, const char *what, size_t small,
-                               store_stream **out, char **text, size_t *text_len,
-                               char status[16])
+static store_rc sq_stream_open(const char *id, int is_pack, size_t small, store_stream **out,
+                               char **text, size_t *text_len, char status[16])
 {
-    *out = NULL;
-    *text = NULL;
-    *text_len = 0;
-    status[0] = 0;
-    int is_pack = !strcmp(what, "pack");
-    if (!is_pack && strcmp(what, "result")) return STORE_ERROR;
     sqlite3 *db = conn();
     if (!db) return STORE_ERROR;
     sqlite3_stmt *st;
@@ -1122,10 +1074,7 @@ static store_rc sq_stream_open(const char *id, const char *what, size_t small,
     }
     sqlite3_blob_close(b);
     rc = open_private(table, column, seq, kind, out);
-    if (rc != STORE_OK || sq_stream_size(*out) > small) return rc;
-    rc = store_stream_read_whole(*out, text, text_len);
-    *out = NULL;
-    return rc;
+    return store_stream_settle(rc, out, small, text, text_len);
 }
 
 static uint64_t sq_stream_size(const store_stream *s)
