@@ -394,17 +394,22 @@ static int inset_begin(gp_svg *g, const char *attrs)
     return svg_pass_begin(g);
 }
 
+/* the last section of a map: the inset drawn from what was kept, then the tail (1 when done,
+ * 0 while the inset still draws) */
+static int finish_inset(gp_svg *g, const char *what)
+{
+    if (!inset_from_kept(g)) return 0;
+    inset_close(g, what);
+    svg_plot_sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
+    return 1;
+}
+
 /* the packing: grains coloured by area or orientation. Pass 1: bounds, area range, count;
  * then the head; step_packing draws the grains (section 0), the inset (section 2, a pass of
  * its own) and stages the tail. */
 static int step_packing(gp_svg *g)
 {
-    if (g->section == 3) {
-        if (!inset_from_kept(g)) return 0;
-        inset_close(g, "grains");
-        svg_plot_sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
-        return 1;
-    }
+    if (g->section == 3) return finish_inset(g, "grains");
     size_t start = g->out.len;
     int r = 1;
     while (g->out.len - start < STEP_BYTES && (r = g->items->next(g->items)) > 0) {
@@ -506,12 +511,7 @@ static void cell_seed(gp_svg *g, const svg_item *c, int inset)
  * pass), the inset (section 3 from what was kept, or section 2, a third pass), then the tail */
 static int step_cells(gp_svg *g)
 {
-    if (g->section == 3) {
-        if (!inset_from_kept(g)) return 0;
-        inset_close(g, "cells");
-        svg_plot_sb_puts(&g->out, g->tail.buf ? g->tail.buf : "");
-        return 1;
-    }
+    if (g->section == 3) return finish_inset(g, "cells");
     size_t start = g->out.len;
     int r = 1;
     while (g->out.len - start < STEP_BYTES && (r = g->items->next(g->items)) > 0) {
