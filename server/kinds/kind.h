@@ -23,7 +23,7 @@
 #include "gp_spec.h"
 #include "jobs/progress.h"
 #include "jobs/result_json.h"
-#include "svg/svg.h"
+#include "svg/svg_view.h"
 
 /* A view of the SVG renderer: ?view=name draws it. */
 typedef struct gpd_view {

@@ -90,15 +90,9 @@
 #include <jansson.h>
 
 #include "gp_export.h"
+#include "svg/svg_view.h"
 #include "util/json_scan.h"
 #include "util/util.h"
-
-typedef struct gp_svg_options {
-    const char *color;  /* packing: "size" (default) or "orientation"; NULL = default */
-    int has_z;          /* section: cut at z (m) instead of the middle of the box */
-    double z;
-    int width;          /* picture width in px; 0 = default (800) */
-} gp_svg_options;
 
 /* Renders view of a result of the given kind (a name of kind.h's table; NULL or "" = the
  * result's "kind", else guessed from its members: gpd_kind_guess). opt may be NULL (defaults).
@@ -115,11 +109,6 @@ char *gp_svg_render(const json_t *result, const char *kind, const char *view,
                     const gp_svg_options *opt, size_t *len, gpd_err *err);
 
 /* ---- item sources: a result's geometry, one item at a time ---- */
-
-/* "grains", "cells" or "spheres" */
-typedef enum gp_svg_part { GP_SVG_GRAINS = 0, GP_SVG_CELLS, GP_SVG_SPHERES } gp_svg_part;
-
-typedef struct gp_svg_items gp_svg_items;
 
 /* The elements of array (a result's "grains", "cells" or "spheres"), which must outlive the
  * source; NULL when array is not an array. */
@@ -138,26 +127,6 @@ gp_svg_items *gp_svg_items_pack(const gp_export_source *pack, gp_svg_part part);
 void gp_svg_items_close(gp_svg_items *it);
 
 /* ---- rendering as a pull stream ---- */
-
-/* What a view reads. summary: the result's small members (or the whole result: its arrays
- * are then the items when open is NULL); it must outlive the rendering.
- * open(user, part, &failed): the items of a part when a view needs them (the rendering closes
- * them); NULL when the result has no such part, with failed = 1 when they could not be read
- * (a 500). NULL open: the arrays of summary. */
-typedef struct gp_svg_input {
-    const char *kind;
-    const json_t *summary;
-    gp_svg_items *(*open)(void *user, gp_svg_part part, int *failed);
-    void *user;
-} gp_svg_input;
-
-typedef struct gp_svg gp_svg;
-
-/* A view of a kind (kind.h: gpd_view.open): prepares g to draw view of in, reading what it
- * needs (its statistics, its items' bounds and ranges), at width px (320..4000). 0, or -1 with
- * err (the statuses of gp_svg_render). */
-typedef int (*gp_svg_view_fn)(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
-                              int width, gpd_err *err);
 
 /* Prepares view and returns a stream of the SVG document; NULL with err as gp_svg_render. */
 gp_svg *gp_svg_open(const gp_svg_input *in, const char *view, const gp_svg_options *opt,

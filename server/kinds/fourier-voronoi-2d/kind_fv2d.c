@@ -523,7 +523,7 @@ static json_t *brief(const json_t *spec, const json_t *stats)
                                (bench_specimen2d fill: 0.24 to 0.37 of the first pass) */
 #define COST_ODEC_S 0.3e-3  /* its ODEC discs (0.2 to 0.46 of its filling, measured) */
 #define COST_DESC_S 0.3e-3  /* its descriptors */
-/* the shape (issue #17), timed through the daemon (one worker) on a shared, loaded 2-core
+/* the shape phase, timed through the daemon (one worker) on a shared, loaded 2-core
  * machine (figures +-30 %) whose fill and descriptors ran 1.06x and 1.27x the figures above:
  * these are divided by ~1.15 to be at their speed.
  * - shape.descriptors, phase "shape": gp_shapemap_fit, a table search (milliseconds) and

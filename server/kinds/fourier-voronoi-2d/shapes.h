@@ -1,4 +1,4 @@
-/* shapes.h -- POST /v1/shapes/analyze (issue #17): the Fourier spectrum and descriptors of real
+/* shapes.h -- POST /v1/shapes/analyze: the Fourier spectrum and descriptors of real
  * grain outlines, answered at once (no job), so that a user sees what a job with
  * shape.outlines would make before submitting it.
  *
