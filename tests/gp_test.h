@@ -1,7 +1,8 @@
 /* gp_test.h -- a minimal test harness: CHECK macros that count, and a summary line.
  *
  * Each test program calls its checks from main() and ends with `return gp_test_summary();`,
- * which prints "N passed, N failed" and returns non-zero if anything failed. Failures print
+ * which prints "N passed, N failed" and returns non-zero if anything failed or if no check ran
+ * at all ("no check ran": a program that checked nothing must not pass). Failures print
  * file:line and the values involved, so a red CI log says what went wrong.
  */
 #ifndef GP_TEST_H
@@ -53,6 +54,12 @@ static int gp_test_failed_ = 0;
 static inline int gp_test_summary(void)
 {
     printf("%d passed, %d failed\n", gp_test_passed_, gp_test_failed_);
+    if (gp_test_passed_ + gp_test_failed_ == 0) {
+        /* a program that checked nothing proves nothing: a skipped body, a main() that
+         * returns early, a loop over an empty table */
+        fprintf(stderr, "no check ran: a test program must run at least one CHECK\n");
+        return 1;
+    }
     return gp_test_failed_ ? 1 : 0;
 }
 

@@ -12,6 +12,12 @@ as user postgres), every database path a test names becomes a fresh database on 
 DATABASE, one per path per test), and the daemon gets its postgresql:// URL. The server is
 stopped and removed at exit, also after a failure. A test meaningless there (the SQLite file's
 lock, size or page limit) is listed in PG_SKIP and skipped with its reason.
+
+Skips: the only ways a test is skipped are PG_SKIP (above) and `raise gpd.Skip(reason)` from
+the test itself, for a condition of the machine the test cannot change (never for a missing
+program: need() fails instead). main() prints "SKIP <name> <reason>" for each and counts them in
+its last line, "N passed, N failed, N skipped"; a test that only prints that it skipped would be
+counted as passed.
 """
 import atexit
 import glob
@@ -413,6 +419,11 @@ class Env:
             shutil.rmtree(self.dir, ignore_errors=True)
 
 
+class Skip(Exception):
+    """Raised by a test that cannot run here (its reason the message): main() counts it as
+    skipped, not as passed or failed."""
+
+
 def need(binary, package):
     """The path of a program the test runs (LAMMPS, mpirun, ...); a clear failure when it is
     missing: these tests never skip."""
@@ -463,9 +474,11 @@ def main(tests):
         sys.exit(2)
     binary = sys.argv[1]
     failed = 0
+    skipped = 0
     t_all = time.time()
     for t in tests:
         if PG and t.__name__ in PG_SKIP:
+            skipped += 1
             print("SKIP %-40s on PostgreSQL: %s" % (t.__name__, PG_SKIP[t.__name__]), flush=True)
             continue
         env = Env(binary)
@@ -474,6 +487,10 @@ def main(tests):
             t(env)
             print("PASS %-40s %.2fs" % (t.__name__, time.time() - t0), flush=True)
             env.close()
+        except Skip as e:
+            skipped += 1
+            print("SKIP %-40s %s" % (t.__name__, e), flush=True)
+            env.close()
         except Exception:
             failed += 1
             print("FAIL %-40s %.2fs" % (t.__name__, time.time() - t0), flush=True)
@@ -481,7 +498,6 @@ def main(tests):
             for d in env.daemons:
                 print("---- daemon log %s ----\n%s" % (d.log_path, d.read_log()))
             env.close()
-    skipped = sum(1 for t in tests if PG and t.__name__ in PG_SKIP)
     print("%d passed, %d failed, %d skipped (%s, %.1fs)" % (
         len(tests) - failed - skipped, failed, skipped, DB_MODE, time.time() - t_all))
     if _pg is not None:

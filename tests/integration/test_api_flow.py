@@ -152,13 +152,14 @@ def test_health_schema_dashboard(env):
 
 def test_spheres_3d(env):
     d = env.daemon(workers=1)
-    st, _, j = d.json("POST", "/v1/jobs", gpd.SMALL_3D)
-    if st == 501:
-        print("    SKIP: spheres-3d is not in this build")
-        return
-    assert st == 201, (st, j)
+    st, h, j = d.json("POST", "/v1/jobs", gpd.SMALL_3D)
+    assert st == 201, (st, j)  # spheres-3d is always built in, like fourier-voronoi-2d
+    assert j["status"] == "queued" and j["kind"] == "spheres-3d", j
+    assert h["Location"] == "/v1/jobs/" + j["id"], h["Location"]
+    gpd.check_job_object(j)
     job = d.wait(j["id"], timeout=150)
     assert job["status"] == "succeeded", job
+    assert job["kind"] == "spheres-3d" and job["error"] is None, job
     st, _, r = d.json("GET", "/v1/jobs/%s/result" % j["id"])
     assert st == 200, st
     for k in ("porosity", "coordination_number", "fabric", "psd", "particles"):

@@ -42,7 +42,7 @@ PHASES = [
     ("result", 2.5, dict(gpd.SMALL_3D, tiling=[16, 16, 16], outputs=["spheres", "contacts"])),
 ]
 
-# The result is written as it is read from the specimen (server/result_json.h), at ~100 MB/s:
+# The result is written as it is read from the specimen (server/jobs/result_json.h), at ~100 MB/s:
 # even the largest results above leave their result phase within a second or two, before a
 # DELETE or a second job's phase can land there. The testing hook pauses the writing at each of
 # its looks at the cancel flag (every 4,096 numbers): the 2D result of 3 million points then

@@ -172,11 +172,16 @@ def test_host_checked(env):
 
 def test_host_wildcard(env):
     """A daemon on 0.0.0.0 answers to any IP address and to the machine's name, not to others."""
+    # a sandbox may forbid the wildcard address: that (and only that) is a counted skip; a
+    # daemon that fails to start where a plain socket can bind is a failure
+    probe = socket.socket()
     try:
-        d = env.daemon(workers=1, listen="0.0.0.0:0")
-    except (RuntimeError, AssertionError) as e:
-        print("cannot listen on 0.0.0.0 here (%s): skipped" % str(e).splitlines()[0])
-        return
+        probe.bind(("0.0.0.0", 0))
+    except OSError as e:
+        raise gpd.Skip("cannot listen on 0.0.0.0 here (%s)" % e)
+    finally:
+        probe.close()
+    d = env.daemon(workers=1, listen="0.0.0.0:0")
     port = d.port()
     for host in ("192.0.2.7:%d" % port, "0.0.0.0:%d" % port, "[2001:db8::1]:%d" % port,
                  socket.gethostname().lower(), "localhost"):
@@ -238,32 +243,30 @@ def b64sha(text):
 def test_security_headers(env):
     d = env.daemon(workers=1)
     st, h, body = d.request("GET", "/")
-    if st == 501:
-        print("no dashboard in this build: its CSP is not checked")
-    else:
-        assert st == 200 and h.get("Content-Type", "").startswith("text/html"), (st, dict(h))
-        page = body.decode()
-        csp = h.get("Content-Security-Policy", "")
-        assert h.get("X-Frame-Options") == "DENY", dict(h)
-        assert h.get("X-Content-Type-Options") == "nosniff", dict(h)
-        assert csp_sources(csp, "default-src") == ["'self'"], csp
-        assert csp_sources(csp, "frame-ancestors") == ["'none'"], csp
-        assert csp_sources(csp, "object-src") == ["'none'"], csp
-        # the inline script and style are allowed by hash, nothing inline beyond them
-        script_src = csp_sources(csp, "script-src")
-        scripts = re.findall(r"<script>(.*?)</script>", page, re.S)
-        assert scripts and sorted(script_src) == sorted(b64sha(s) for s in scripts), (
-            script_src, len(scripts))
-        style_src = csp_sources(csp, "style-src")
-        assert "'unsafe-inline'" not in style_src, csp
-        for s in re.findall(r"<style>(.*?)</style>", page, re.S):
-            assert b64sha(s) in style_src, (style_src, s[:80])
-        attrs = re.findall(r'\sstyle="([^"]*)"', re.sub(r"<script>.*?</script>", "", page,
-                                                         flags=re.S))
-        for a in attrs:
-            assert b64sha(a) in style_src and "'unsafe-hashes'" in style_src, (a, style_src)
-        st, h, _ = d.request("HEAD", "/")
-        assert st == 200 and h.get("Content-Security-Policy") == csp, dict(h)
+    # the dashboard (always built in): its page and its CSP
+    assert st == 200 and h.get("Content-Type", "").startswith("text/html"), (st, dict(h))
+    page = body.decode()
+    csp = h.get("Content-Security-Policy", "")
+    assert h.get("X-Frame-Options") == "DENY", dict(h)
+    assert h.get("X-Content-Type-Options") == "nosniff", dict(h)
+    assert csp_sources(csp, "default-src") == ["'self'"], csp
+    assert csp_sources(csp, "frame-ancestors") == ["'none'"], csp
+    assert csp_sources(csp, "object-src") == ["'none'"], csp
+    # the inline script and style are allowed by hash, nothing inline beyond them
+    script_src = csp_sources(csp, "script-src")
+    scripts = re.findall(r"<script>(.*?)</script>", page, re.S)
+    assert scripts and sorted(script_src) == sorted(b64sha(s) for s in scripts), (
+        script_src, len(scripts))
+    style_src = csp_sources(csp, "style-src")
+    assert "'unsafe-inline'" not in style_src, csp
+    for s in re.findall(r"<style>(.*?)</style>", page, re.S):
+        assert b64sha(s) in style_src, (style_src, s[:80])
+    attrs = re.findall(r'\sstyle="([^"]*)"', re.sub(r"<script>.*?</script>", "", page,
+                                                     flags=re.S))
+    for a in attrs:
+        assert b64sha(a) in style_src and "'unsafe-hashes'" in style_src, (a, style_src)
+    st, h, _ = d.request("HEAD", "/")
+    assert st == 200 and h.get("Content-Security-Policy") == csp, dict(h)
     # every other response: nosniff, no framing, nothing runs
     jid = d.submit(gpd.SMALL_2D)
     d.wait(jid)
