@@ -1,15 +1,12 @@
 /* main.c -- grainpackd: options, start-up, signals, graceful shutdown.
  *
  *   grainpackd [--listen HOST:PORT] [--db PATH] [--workers N] [--log-level L] ...
- * Settings come from the command line, else the environment (GRAINPACK_*), else the defaults.
+ * Settings come from the command line, else the environment (GRAINPACK_*), else the defaults:
+ * the options are one table, util/options.c, which --help and --help-markdown print.
  * With port 0 the kernel picks a free port; the first line on stdout is always
  *   listening on http://HOST:PORT
  * Logs go to stderr. SIGTERM/SIGINT: stop accepting, requeue running jobs, close the database.
  */
-#include <errno.h>
-#include <getopt.h>
-#include <limits.h>
-#include <math.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
@@ -21,6 +18,7 @@
 #include "kinds/kind.h"
 #include "jobs/maint.h"
 #include "store/store.h"
+#include "util/options.h"
 #include "util/util.h"
 #include "jobs/workers.h"
 
@@ -28,57 +26,15 @@
 
 static void usage(FILE *f)
 {
+    fputs("usage: grainpackd [options]\n"
+          "\n"
+          "The grainpack job service: accepts packing specs over HTTP (see /v1/schema),\n"
+          "queues them in SQLite, runs them on worker threads, serves results and SVG.\n"
+          "\n"
+          "options (environment variable in brackets; the command line wins):\n",
+          f);
+    gpd_options_help(f);
     fprintf(f,
-            "usage: grainpackd [options]\n"
-            "\n"
-            "The grainpack job service: accepts packing specs over HTTP (see /v1/schema),\n"
-            "queues them in SQLite, runs them on worker threads, serves results and SVG.\n"
-            "\n"
-            "options (environment variable in brackets; the command line wins):\n"
-            "  --listen HOST:PORT     address to listen on [GRAINPACK_LISTEN]\n"
-            "                         (default 127.0.0.1:8080; port 0 = pick a free port;\n"
-            "                         the first stdout line is 'listening on http://HOST:PORT')\n"
-            "  --db PATH|URL          the job database [GRAINPACK_DB]: a file path is SQLite\n"
-            "                         (default ./grainpack.db, one daemon per file); a URL\n"
-            "                         postgresql://user@host:port/dbname is PostgreSQL, where\n"
-            "                         many daemons (on any hosts) share one queue\n"
-            "  --lease S              PostgreSQL: seconds a running job stays claimed without\n"
-            "                         its daemon renewing it (every S/3 s); a job whose lease\n"
-            "                         lapsed is taken over by another daemon [GRAINPACK_LEASE]\n"
-            "                         (default 30)\n"
-            "  --workers N            worker threads running jobs [GRAINPACK_WORKERS]\n"
-            "                         (default: the number of CPU cores)\n"
-            "  --job-threads N        threads each job runs on (the IMC, filling, ODEC and\n"
-            "                         descriptors of a 2D job, the DEM of a 3D one; results\n"
-            "                         are the same whatever N) [GRAINPACK_JOB_THREADS]\n"
-            "                         (default 0: the CPU cores over the workers, at least 1)\n"
-            "  --log-level LEVEL      error|warn|info|debug [GRAINPACK_LOG_LEVEL] (default info;\n"
-            "                         debug logs every request)\n"
-            "  --http-threads N       HTTP thread pool size [GRAINPACK_HTTP_THREADS] (default 4)\n"
-            "  --max-connections N    concurrent connection limit [GRAINPACK_MAX_CONNECTIONS]\n"
-            "                         (default 1024)\n"
-            "  --timeout S            idle timeout per connection, seconds [GRAINPACK_TIMEOUT]\n"
-            "                         (default 30)\n"
-            "  --max-body BYTES       request body limit, 413 above [GRAINPACK_MAX_BODY]\n"
-            "                         (default 1048576)\n"
-            "  --max-result-mb MB     refuse (422 too_large) a spec whose result would be\n"
-            "                         larger, which bounds the disk one job takes\n"
-            "                         [GRAINPACK_MAX_RESULT_MB] (default 8192)\n"
-            "  --job-timeout S        a job whose run lasts longer fails with error code\n"
-            "                         'timeout' (per run attempt; 0 = no limit)\n"
-            "                         [GRAINPACK_JOB_TIMEOUT] (default 3600)\n"
-            "  --retain-days N        purge finished jobs (their results and exports) N days\n"
-            "                         after they finished; a real number (0.5 = 12 hours);\n"
-            "                         checked at start-up and every minute\n"
-            "                         [GRAINPACK_RETAIN_DAYS] (default 0 = keep every job)\n"
-            "  --max-queued N         a submit while N jobs are queued gets 503 queue_full\n"
-            "                         with Retry-After [GRAINPACK_MAX_QUEUED] (default 10000)\n"
-            "  --allow-origin ORIGIN  also serve pages at ORIGIN (scheme://host[:port], e.g. a\n"
-            "                         lab dashboard served elsewhere); repeatable or comma-\n"
-            "                         separated [GRAINPACK_ALLOW_ORIGIN]. Any other Origin, and\n"
-            "                         a Host naming another server, get 403 (see README)\n"
-            "  --version              print the version and exit\n"
-            "  --help                 this text\n"
             "\n"
             "Restart rule: jobs found 'running' at start-up (the daemon crashed) are queued again,\n"
             "up to %d attempts; a job interrupted %d times fails with error code 'interrupted'.\n"
@@ -89,100 +45,19 @@ static void usage(FILE *f)
             STORE_MAX_ATTEMPTS, STORE_MAX_ATTEMPTS);
 }
 
-static int parse_long(const char *name, const char *s, long lo, long hi, long *out)
+/* Reads the options (util/options.h; --allow-origin's go to the HTTP server's list) into *o;
+ * -1 to go on, else the exit status (--help, --version, --help-markdown, a bad option). */
+static int read_options(int argc, char **argv, gpd_options *o)
 {
-    char *end = NULL;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || !end || *end || end == s || v < lo || v > hi) {
-        fprintf(stderr, "grainpackd: %s expects an integer in [%ld, %ld], got \"%s\"\n", name,
-                lo, hi, s);
-        return -1;
+    switch (gpd_options_parse(argc, argv, o, gpd_allow_origins)) {
+    case GPD_OPTS_RUN: return -1;
+    case GPD_OPTS_HELP: usage(stdout); return 0;
+    case GPD_OPTS_VERSION: printf("grainpackd %s\n", GPD_VERSION); return 0;
+    case GPD_OPTS_HELP_MARKDOWN: gpd_options_markdown(stdout); return 0;
+    case GPD_OPTS_USAGE: usage(stderr); return 2;
+    case GPD_OPTS_BAD: break;
     }
-    *out = v;
-    return 0;
-}
-
-static int parse_days(const char *name, const char *s, double *out)
-{
-    char *end = NULL;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (errno || !end || *end || end == s || !isfinite(v) || v < 0 || v > 36500) {
-        fprintf(stderr, "grainpackd: %s expects a number of days in [0, 36500] (0 = keep "
-                        "forever; 0.5 = 12 hours), got \"%s\"\n",
-                name, s);
-        return -1;
-    }
-    *out = v;
-    return 0;
-}
-
-static const char *env_or(const char *name, const char *dflt)
-{
-    const char *v = getenv(name);
-    return (v && *v) ? v : dflt;
-}
-
-/* the settings as given: the command line, else the environment, else the defaults */
-typedef struct settings {
-    const char *listen, *db, *workers, *level, *threads, *maxconn, *timeout, *maxbody, *maxres,
-        *jobto, *retain, *maxq, *lease, *jthreads;
-} settings;
-
-/* Reads the command line over st (the environment's values); -1 to go on, else the exit
- * status (--help, --version, a bad option or origin). */
-static int read_args(int argc, char **argv, settings *st)
-{
-    const char *origins_env = env_or("GRAINPACK_ALLOW_ORIGIN", NULL);
-    int origins_flag = 0; /* any --allow-origin replaces GRAINPACK_ALLOW_ORIGIN */
-    static const struct option opts[] = {
-        {"listen", required_argument, 0, 'l'},       {"db", required_argument, 0, 'd'},
-        {"workers", required_argument, 0, 'w'},      {"log-level", required_argument, 0, 'L'},
-        {"http-threads", required_argument, 0, 't'}, {"max-connections", required_argument, 0, 'c'},
-        {"timeout", required_argument, 0, 'T'},      {"max-body", required_argument, 0, 'b'},
-        {"max-result-mb", required_argument, 0, 'R'},
-        {"job-timeout", required_argument, 0, 'J'},
-        {"retain-days", required_argument, 0, 1002},
-        {"max-queued", required_argument, 0, 1003},
-        {"lease", required_argument, 0, 1004},
-        {"job-threads", required_argument, 0, 1005},
-        {"allow-origin", required_argument, 0, 1001},
-        {"help", no_argument, 0, 'h'},               {"version", no_argument, 0, 'V'},
-        {0, 0, 0, 0}};
-    int ch;
-    while ((ch = getopt_long(argc, argv, "l:d:w:L:t:c:T:b:R:J:hV", opts, NULL)) != -1) {
-        switch (ch) {
-        case 'l': st->listen = optarg; break;
-        case 'd': st->db = optarg; break;
-        case 'w': st->workers = optarg; break;
-        case 'L': st->level = optarg; break;
-        case 't': st->threads = optarg; break;
-        case 'c': st->maxconn = optarg; break;
-        case 'T': st->timeout = optarg; break;
-        case 'b': st->maxbody = optarg; break;
-        case 'R': st->maxres = optarg; break;
-        case 'J': st->jobto = optarg; break;
-        case 1002: st->retain = optarg; break;
-        case 1003: st->maxq = optarg; break;
-        case 1004: st->lease = optarg; break;
-        case 1005: st->jthreads = optarg; break;
-        case 1001:
-            if (gpd_allow_origins(optarg)) return 2;
-            origins_flag = 1;
-            break;
-        case 'h': usage(stdout); return 0;
-        case 'V': printf("grainpackd %s\n", GPD_VERSION); return 0;
-        default: usage(stderr); return 2;
-        }
-    }
-    if (!origins_flag && origins_env && gpd_allow_origins(origins_env)) return 2;
-    if (optind < argc) {
-        fprintf(stderr, "grainpackd: unexpected argument \"%s\"\n", argv[optind]);
-        usage(stderr);
-        return 2;
-    }
-    return -1;
+    return 2;
 }
 
 /* The --db value as it may be logged: a URL's password (user:PASSWORD@host) as "***". */
@@ -269,47 +144,14 @@ static int start(gpd_http_config *cfg, long nworkers, long jobto, double retain_
 
 int main(int argc, char **argv)
 {
-    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-    if (ncpu < 1) ncpu = 1;
-    char ncpu_s[24];
-    snprintf(ncpu_s, sizeof ncpu_s, "%ld", ncpu);
-    settings st = {env_or("GRAINPACK_LISTEN", "127.0.0.1:8080"),
-                   env_or("GRAINPACK_DB", "./grainpack.db"),
-                   env_or("GRAINPACK_WORKERS", ncpu_s),
-                   env_or("GRAINPACK_LOG_LEVEL", "info"),
-                   env_or("GRAINPACK_HTTP_THREADS", "4"),
-                   env_or("GRAINPACK_MAX_CONNECTIONS", "1024"),
-                   env_or("GRAINPACK_TIMEOUT", "30"),
-                   env_or("GRAINPACK_MAX_BODY", "1048576"),
-                   env_or("GRAINPACK_MAX_RESULT_MB", "8192"),
-                   env_or("GRAINPACK_JOB_TIMEOUT", "3600"),
-                   env_or("GRAINPACK_RETAIN_DAYS", "0"),
-                   env_or("GRAINPACK_MAX_QUEUED", "10000"),
-                   env_or("GRAINPACK_LEASE", "30"),
-                   env_or("GRAINPACK_JOB_THREADS", "0")};
-    int rc = read_args(argc, argv, &st);
+    gpd_options o;
+    int rc = read_options(argc, argv, &o);
     if (rc >= 0) return rc;
-    long nworkers, nthreads, maxconn, timeout, maxbody, maxres, jobto, maxq, lease, jthreads;
-    double retain_days;
-    if (parse_long("--workers", st.workers, 1, 1024, &nworkers) ||
-        parse_long("--http-threads", st.threads, 1, 256, &nthreads) ||
-        parse_long("--max-connections", st.maxconn, 1, 1000000, &maxconn) ||
-        parse_long("--timeout", st.timeout, 1, 86400, &timeout) ||
-        parse_long("--max-body", st.maxbody, 1024, 1L << 30, &maxbody) ||
-        parse_long("--max-result-mb", st.maxres, 1, 1L << 20, &maxres) ||
-        parse_long("--job-timeout", st.jobto, 0, 31622400, &jobto) ||
-        parse_long("--max-queued", st.maxq, 1, 1000000000, &maxq) ||
-        parse_long("--lease", st.lease, 1, 86400, &lease) ||
-        parse_long("--job-threads", st.jthreads, 0, 1024, &jthreads) ||
-        parse_days("--retain-days", st.retain, &retain_days))
-        return 2;
-    int level = gpd_log_parse_level(st.level);
-    if (level < 0) {
-        fprintf(stderr, "grainpackd: --log-level expects error|warn|info|debug, got \"%s\"\n",
-                st.level);
-        return 2;
-    }
-    gpd_log_set_level((gpd_log_level)level);
+    const char *listen = o.v[GPD_OPT_LISTEN].text, *db = o.v[GPD_OPT_DB].text;
+    long nworkers = o.v[GPD_OPT_WORKERS].n, nthreads = o.v[GPD_OPT_HTTP_THREADS].n;
+    long jthreads = o.v[GPD_OPT_JOB_THREADS].n, jobto = o.v[GPD_OPT_JOB_TIMEOUT].n;
+    double retain_days = o.v[GPD_OPT_RETAIN_DAYS].x;
+    gpd_log_set_level((gpd_log_level)o.v[GPD_OPT_LOG_LEVEL].n);
 
     /* Signals are handled by sigwait() in this thread only: block them before any thread. */
     sigset_t set;
@@ -321,22 +163,23 @@ int main(int argc, char **argv)
 
     /* the cores the workers leave idle go to each job's threads (filling, ODEC, descriptors and
      * the DEM run in parallel inside a job; the result is the same whatever their number) */
+    long ncpu = gpd_options_cpus();
     if (jthreads == 0) jthreads = ncpu / nworkers > 1 ? ncpu / nworkers : 1;
     workers_set_job_threads((int)jthreads);
-    store_set_lease((double)lease);
-    if (open_store(st.db)) return 1;
+    store_set_lease((double)o.v[GPD_OPT_LEASE].n);
+    if (open_store(db)) return 1;
     gpd_http_config cfg = {.threads = (unsigned)nthreads,
-                           .max_connections = (unsigned)maxconn,
-                           .timeout_s = (unsigned)timeout,
-                           .max_body = (size_t)maxbody,
-                           .max_result_mb = (double)maxres,
-                           .max_queued = maxq,
-                           .listen = st.listen};
+                           .max_connections = (unsigned)o.v[GPD_OPT_MAX_CONNECTIONS].n,
+                           .timeout_s = (unsigned)o.v[GPD_OPT_TIMEOUT].n,
+                           .max_body = (size_t)o.v[GPD_OPT_MAX_BODY].n,
+                           .max_result_mb = (double)o.v[GPD_OPT_MAX_RESULT_MB].n,
+                           .max_queued = o.v[GPD_OPT_MAX_QUEUED].n,
+                           .listen = listen};
     if (start(&cfg, nworkers, jobto, retain_days)) return 1;
     printf("listening on http://%s:%d\n", cfg.host, cfg.port);
     fflush(stdout);
     char shown[512];
-    db_for_log(st.db, shown, sizeof shown);
+    db_for_log(db, shown, sizeof shown);
     gpd_log(GPD_LOG_INFO, "grainpackd %s: http://%s:%d, db %s (%s), %ld workers of %ld thread(s), "
             "%ld http threads",
             GPD_VERSION, cfg.host, cfg.port, shown, store_backend_name(), nworkers, jthreads,
