@@ -14,11 +14,10 @@
  * work, never decide how the work is done.
  *
  * Ownership: gp_team_create starts size - 1 threads, fewer when the machine has fewer CPUs
- * online than size (a thread that spins while another waits for its CPU only slows the round:
- * the IMC at N = 1,000 ran 25.6k steps/s on 3 threads on 2 CPUs, 137k on 2, 92k on 1) or when
- * the system refuses some; gp_team_size says how many the team has, at least 1.
- * gp_team_destroy joins them. One caller at a time (gp_team_run is not reentrant, nor thread-safe). No global
- * state.
+ * online than size (a thread that spins while another waits for its CPU only slows the round,
+ * by far: docs/design/imc.md "Threads") or when the system refuses some; gp_team_size says
+ * how many the team has, at least 1. gp_team_destroy joins them. One caller at a time
+ * (gp_team_run is not reentrant, nor thread-safe). No global state.
  */
 #ifndef GP_TEAM_H
 #define GP_TEAM_H

@@ -7,9 +7,8 @@
  * insert or erase is a memmove and BMAX / CH updates. The directory lists the blocks in order
  * with each one's first (key, id) for the binary search, and a Fenwick tree over directory
  * positions gives the count and w-sum of the blocks before a position. A rank query is then
- * two binary searches (directory, block) and one Fenwick prefix: a few cache lines, where the
- * treap it replaces walked ~log2 N nodes scattered over the heap (45 % of an IMC step at
- * N = 100,000 was cache misses there).
+ * two binary searches (directory, block) and one Fenwick prefix: a few cache lines, where a
+ * balanced tree walks ~log2 N nodes scattered over the heap (docs/design/adstat.md).
  *
  * Balance: every block is non-empty and any two neighbours hold more than BMERGE together
  * (else they are merged), so there are at most 2 n / (BMERGE + 1) + 1 blocks. That bounds the
@@ -34,11 +33,9 @@ __extension__ typedef __int128 i128;
 #define FIX_SCALE 0x1p46          /* g and h in units of 2^-46 */
 #define LOG_LIMIT 65535.0         /* |g|, |h| clamped to 2^16 - 1: |fixed w| < 2^63 */
 #define CAP_MAX ((size_t)1 << 29) /* N^2 2^63 + ...: the sums of a2_of stay inside i128 */
-#define BMAX 32                   /* elements a block holds: 64 and 128 took the same
+#define BMAX 32                   /* elements a block holds: larger blocks take no fewer
                                    * instructions a step, and an insert or erase moves half the
-                                   * bytes of the next size up (32 against 64, with the new
-                                   * values' blocks prefetched too: N = 100,000, one thread,
-                                   * 48.5k-50.5k steps/s against 47.4k-49.4k, 5 runs each) */
+                                   * bytes of the next size up (docs/design/adstat.md) */
 #define BMERGE 20                 /* neighbours holding no more than BMERGE together merge:
                                    * low, so that merges are rare */
 #define CH 8                      /* elements per prefix-sum chunk of a block */

@@ -39,7 +39,7 @@
  *
  * Ownership: one object per statistic; not thread-safe (one writer). No global state.
  * Memory: about 90 bytes per element of capacity (per-id record 32, extras' tree 16-32, blocks
- * ~30 at their usual fill; the treap before took 136).
+ * ~30 at their usual fill). Why blocks and not a balanced tree: docs/design/adstat.md.
  */
 #ifndef GP_ADSTAT_H
 #define GP_ADSTAT_H

@@ -1,24 +1,20 @@
 /* gp_fill.c -- optimised filling of one cell with a Fourier grain. See gp_fill.h for the
- * method. The hot objective is kept cheap (issue #16; instruction counts from callgrind on
- * Example 1's fill and refills, 7.9e9 before): the shape factor rho_i is a fixed part (modes
- * outside 2..7, once per cell) plus six modes summed on a quarter of the rays and spread to
- * the rest by the symmetry of the Fourier basis (optimised_modes_quadrant); the grain's area is
- * a constant of the spectrum (see spectrum_area); the grain's support along an edge is taken
- * on the arc of rays that can hold it; the centre LP restarts from the last optimum's rows,
- * which the next evaluation mostly keeps; and the final containment check first tries the
- * cell's kernel (inside_kernel), ~10x cheaper than the general test. Fewer evaluations: a
- * simplex run also stops once it has gained less than STALL_REL in STALL_EVALS evaluations,
- * which is where cells that cannot reach F_S spent most of theirs. Together: 3.3e9
- * instructions for the same work, the same cells meeting F_S.
- * Then (issue #16, second pass; callgrind on bench_specimen2d phases 2000 1, the fill 10.4e9
- * -> ~5.2e9 instructions): the six phases' sin and cos inline (sincos_fast, a third of an
- * evaluation in libm before); the quadrant sums and rays in SSE2, or AVX where the CPU has
- * it (the same operations, so the same bits), with rho's smallest and largest taken on the
- * way and the doubled copy lp_fit's arcs read written there too; the supports' maximum two
- * products at a time; and Nelder-Mead on plain arrays (GSL's nmsimplex2 moves; its gsl_vector
- * and CBLAS bookkeeping was a sixth of the fill). The libm sincos -> sincos_fast change moves
- * the phases in the last bits, so the searches take other (equally good) paths: the solid
- * fraction and cells meeting F_S of bench_specimen2d are unchanged. */
+ * method.
+ *
+ * The objective is evaluated thousands of times a cell, so it is kept cheap: the shape factor
+ * rho_i is a fixed part (modes outside 2..7, once per cell) plus six modes summed on a quarter
+ * of the rays and spread to the rest by the symmetry of the Fourier basis
+ * (optimised_modes_quadrant), in SSE2, or AVX where the CPU has it (the same operations, so the
+ * same bits), with rho's smallest and largest and the doubled copy lp_fit's arcs read written
+ * on the way; the six phases' sin and cos inline (sincos_fast); the grain's area a constant of
+ * the spectrum (spectrum_area); the grain's support along an edge taken on the arc of rays that
+ * can hold it, two products at a time; the centre LP restarted from the last optimum's rows,
+ * which the next evaluation mostly keeps; Nelder-Mead on plain arrays (nm_simplex); and the
+ * final containment check tried first on the cell's kernel (inside_kernel). Fewer evaluations:
+ * a simplex run also stops once it has gained less than STALL_REL in STALL_EVALS evaluations,
+ * which is where cells that cannot reach F_S would spend most of theirs.
+ * sincos_fast and libm's sincos differ in the last bits, so the searches take other (equally
+ * good) paths than libm would give them. What each of these saves: docs/design/fill.md. */
 #include "gp_fill.h"
 
 #include <float.h>
@@ -45,22 +41,15 @@
 /* Restarts of a simplex from its own best point while that still improves (a fresh simplex
  * escapes the collapse Nelder-Mead suffers in narrow valleys). */
 #define FILL_RESTARTS 2
-/* Extra random starts, spent only on cells whose best is within CLOSE of F_S. Measured on
- * Example 1 (seeds 1-8, mean solid fraction): none 0.6216; two for the cells within 10 %
- * 0.6219 for 30 % more evaluations; two for every cell 0.6224 for 77 % more. A third start
- * (with the stall stop below) wins back cells that met F_S before it. */
+/* Extra random starts, spent only on cells whose best is within CLOSE of F_S: starts for every
+ * cell cost far more evaluations for little more solid fraction; a third start (with the stall
+ * stop below) wins back the cells the stall stop would lose (docs/design/fill.md). */
 #define RANDOM_STARTS 3
 #define CLOSE 0.9
 /* A simplex run stops when its best has not grown by STALL_REL (relative) in STALL_EVALS
- * evaluations. Before, runs went on to their budget or a 1e-4 simplex: cells short of F_S
- * took 2,000 evaluations against 120 for the others, 87 % of the total. Measured on Examples
- * 1 and 2, seeds 2012 and 7 (the first pass and the specimen's refills; evaluations saved,
- * cells meeting F_S, first-pass solid fraction and mean grain-cell orientation gap of
- * Example 1, seed 2012, against 1,434 / 318 / 0.61981 / 7.08 deg before):
- *   30: 32-37 % / 318 / 0.61956 / 7.48 (seed 7 also loses one cell with two starts)
- *   45: 18-23 % / 318 / 0.61977 / 7.03 (seed 7: 324 cells for 323, gap 7.50 for 7.79)
- *   60: 10-15 % / 318 / 0.61981 / 7.11
- * The stop trades the grains' alignment for speed below 45, so 45. */
+ * evaluations: run to their budget or a collapsed simplex, the cells short of F_S would take
+ * most of the evaluations. Below 45 the stop trades the grains' alignment with their cells for
+ * speed (docs/design/fill.md), so 45. */
 #define STALL_EVALS 45
 #define STALL_REL 1e-4
 #define SUPPORT_ARC 16 /* rays either side of an edge's normal that support() scans at once */
@@ -555,9 +544,9 @@ static void optimised_modes_all(gp_fill_workspace *ws, const double *ca, const d
 }
 
 /* sin and cos of x to within an ulp or two (fdlibm's kernels on [-pi/4, pi/4] after a
- * two-part Cody-Waite reduction by pi/2, exact for |x| < 2^20 pi/2), inline: the six phases
- * of every evaluation went through libm's sincos, 30 % of the objective's instructions
- * (issue #16). Larger |x| (a simplex wandering far) goes to libm. */
+ * two-part Cody-Waite reduction by pi/2, exact for |x| < 2^20 pi/2), inline: through libm's
+ * sincos the six phases of every evaluation would be a large part of the objective
+ * (docs/design/fill.md). Larger |x| (a simplex wandering far) goes to libm. */
 static inline void sincos_fast(double x, double *s, double *c)
 {
     if (!(fabs(x) < 1e6)) {
@@ -908,10 +897,9 @@ static double objective8(gp_fill_workspace *ws, const double *x)
 /* ------------------------------------------------------------------ Nelder-Mead */
 
 /* GSL's nmsimplex2 (the moves, coefficients, incremental centre and size of its simplex2.c)
- * on plain arrays: through gsl_vector, gsl_matrix and CBLAS calls its bookkeeping cost a sixth
- * of the fill's instructions (issue #16), more than the shape factor's sums. The objective is
- * always finite here (0 where the phases are not admissible), so GSL's non-finite branches
- * are left out. */
+ * on plain arrays: through gsl_vector, gsl_matrix and CBLAS calls its bookkeeping would cost
+ * more than the shape factor's sums (docs/design/fill.md). The objective is always finite here
+ * (0 where the phases are not admissible), so GSL's non-finite branches are left out. */
 enum { NM_MAX = NOPT + 2 };
 typedef double (*nm_fn)(gp_fill_workspace *ws, const double *x);
 
@@ -1159,8 +1147,7 @@ static double search_convex(gp_fill_workspace *ws, const double *dft, candidate 
 {
     double ph[NOPT], f;
     /* Half the budget per run: with the centre exact the 6-phase simplex needs fewer steps
-     * (Example 1, seeds 1 and 7: 200 per run reach the solid fraction of 400 within 1e-4 with
-     * 0.62 of the evaluations). */
+     * (docs/design/fill.md). */
     int budget = ws->p.max_evals / 2 > 0 ? ws->p.max_evals / 2 : 1;
     memcpy(ph, dft, sizeof ph);
     best->f = -1.0;
@@ -1192,8 +1179,8 @@ static double search_convex(gp_fill_workspace *ws, const double *dft, candidate 
  * that point with the best centre for each shape, as (B), and no other start. Why not the cold
  * search where this falls short: the specimen refills every cell that met F_S to one higher
  * fraction, so a cell that cannot get there from its own grain leaves its share to the next
- * refill pass; with the cold search as well, a refill cost ~500 evaluations a cell on Example 1
- * (507 without the warm start), against ~60 from the grain alone (bench_specimen2d fill). */
+ * refill pass, and the cold search would cost a refill some eight times the evaluations
+ * (docs/design/fill.md). */
 static double search_convex_warm(gp_fill_workspace *ws, const double *start, size_t rot,
                                  candidate *best, double target)
 {
@@ -1372,9 +1359,8 @@ static uint64_t fixed_part(gp_fill_workspace *ws, const double *phases)
  * r(theta) ~ sum A_n cos(n theta) + B_n sin(n theta) = |.| cos(n theta - atan2(B, A)), except
  * mode 2, whose axis (delta_2 / 2, the grain's long axis) is set along the cell's own
  * orientation, its minimum-caliper direction (Fig. 1a), which the specimen compares the
- * grain's with: the radius function's mode-2 axis differs from it in irregular cells.
- * Measured on the paper's examples (seeds 1-5): mean gap Ex. 1 8.3 -> 6.7 deg, Ex. 2 11.0 ->
- * 9.2 deg, solid fraction unchanged. */
+ * grain's with: the radius function's mode-2 axis differs from it in irregular cells. This
+ * narrows the grain-cell orientation gap at the same solid fraction (docs/design/fill.md). */
 static void start_phases(gp_fill_workspace *ws, const double *phases, double *dft)
 {
     size_t np = ws->np;
@@ -1418,11 +1404,12 @@ static double place(gp_fill_workspace *ws, gp_vec2 *c)
     return r0_target;
 }
 
-/* A sufficient test of gp_poly_inside_poly, ~10x cheaper: every vertex of a strictly on the
- * inner side of every edge of the simple polygon b (orientation `turn`, +1 counter-clockwise),
- * exactly (gp_orient2d). The inner half-planes of a simple polygon's edges meet in its kernel,
- * which lies in the polygon, and the kernel is convex, so a holds all of a. When it answers 0
- * (a vertex on or past an edge line, as in a non-convex cell) the full test decides. */
+/* A sufficient test of gp_poly_inside_poly, an order of magnitude cheaper: every vertex of a
+ * strictly on the inner side of every edge of the simple polygon b (orientation `turn`, +1
+ * counter-clockwise), exactly (gp_orient2d). The inner half-planes of a simple polygon's edges
+ * meet in its kernel, which lies in the polygon, and the kernel is convex, so a holds all of a.
+ * When it answers 0 (a vertex on or past an edge line, as in a non-convex cell) the full test
+ * decides. */
 static int inside_kernel(const gp_vec2 *a, size_t na, const gp_vec2 *b, size_t nb, int turn)
 {
     for (size_t k = 0; k < nb; k++) {

@@ -26,12 +26,12 @@
  * cell-aligned modes 2..7 (phi); (D) for cells close to F_S, three random starts seeded from
  * the caller's phases.
  * Each simplex run ends at F_S, at its budget, or once its best has stalled (grown by less
- * than 1e-4 in 45 evaluations): most of the work went to cells that cannot reach F_S, whose
- * runs crawl to a collapsed simplex (issue #16: a fifth fewer evaluations, the same cells
- * meeting F_S). No bound on the reachable fraction is used to stop earlier: the cheap one
- * (the cell's least width over the grain's least possible width, its even modes 2, 4, 6 all
- * aligned) ignores that such a grain's support lies off that axis and by a hand estimate is
- * some 30 % loose for Example 1's spectrum -- too loose to stop on (not measured).
+ * than 1e-4 in 45 evaluations): most of the work would go to cells that cannot reach F_S,
+ * whose runs crawl to a collapsed simplex (docs/design/fill.md). No bound on the reachable
+ * fraction is used to stop earlier: the cheap one (the cell's least width over the grain's
+ * least possible width, its even modes 2, 4, 6 all aligned) ignores that such a grain's
+ * support lies off that axis and by a hand estimate is some 30 % loose for Example 1's
+ * spectrum -- too loose to stop on.
  * A non-convex cell instead moves the centre inside the simplex (rays from it). A grain
  * smaller than the largest is centred with the largest clearance to the cell's edges.
  *
@@ -69,7 +69,7 @@ typedef struct gp_fill_workspace gp_fill_workspace;
 gp_fill_workspace *gp_fill_workspace_create(const gp_fill_params *p, gp_error *err);
 void gp_fill_workspace_destroy(gp_fill_workspace *ws);
 
-/* Gives the workspace another spectrum of the same nmodes (a grain's own, issue #17 spread):
+/* Gives the workspace another spectrum of the same nmodes (a grain's own: gp_grainshape.h):
  * D (not copied; it must outlive the fills that use it) is checked as at creation.
  * GP_ERR_INVALID leaves the workspace as it was. */
 gp_status gp_fill_workspace_set_spectrum(gp_fill_workspace *ws, const double *D, gp_error *err);

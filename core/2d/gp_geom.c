@@ -320,7 +320,7 @@ static int point_class(const gp_vec2 *p, size_t n, gp_vec2 q, double tol)
 /* point_class(p, n, q, tol) >= 0 for tol >= 0, n >= 2: an edge matters to it only when q lies
  * in its bounding box widened by tol or its ends straddle q's line; two edges at a time are
  * screened for that (most are neither) and only those go through point_class's own tests, in
- * the same order. A few times faster (ODEC checks every disc centre, issue #16). */
+ * the same order: ODEC checks every disc centre, so this test is hot (docs/design/geometry.md). */
 static int contains_screened(const gp_vec2 *p, size_t n, gp_vec2 q, double tol)
 {
 #if defined(__SSE2__)
@@ -1003,8 +1003,7 @@ static int mic_make(const mic_poly *P, const mic_src *src, double x, double y, d
  * bound of mic_lp_bound); the grid over the bounding box is refined, best bound first, until no
  * cell's bound exceeds the best distance found by more than tol. Rounding adds about 1e-15 of
  * the polygon's size. The centre returned is strictly inside (its distance is r > 0).
- * Cost (measured, 2.4 GHz EPYC, shared): ~5 us for a regular 128-gon, 30-45 us for grain-like
- * 128-gons at tol = 1e-4 of the size, nearly the same at 1e-6; ~0.3 ms for 1024-gons. */
+ * Cost: little more at tol = 1e-6 than at 1e-4 of the size (docs/design/geometry.md). */
 gp_status gp_max_inscribed_circle(const gp_vec2 *p, size_t n, double tol, gp_vec2 *center,
                                   double *radius, gp_error *err)
 {

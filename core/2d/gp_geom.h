@@ -124,8 +124,8 @@ double gp_axis_angle(double ex, double ey);
 size_t gp_convex_hull_star(const gp_vec2 *p, size_t n, gp_vec2 *h);
 
 /* gp_min_caliper of a polygon star-shaped about an interior point (gp_convex_hull_star's
- * condition: a Fourier grain's contour): the same result from the O(n) hull (a 128-point
- * grain: ~6x fewer instructions than the sorting hull). Undefined for other polygons. */
+ * condition: a Fourier grain's contour): the same result from the O(n) hull, several times
+ * cheaper than the sorting hull (docs/design/geometry.md). Undefined for other polygons. */
 gp_status gp_min_caliper_star(const gp_vec2 *p, size_t n, double *width, double *angle_rad,
                               double *length, gp_error *err);
 

@@ -1,5 +1,5 @@
-/* gp_grainshape.h -- each grain's own amplitude spectrum (issue #17, "spread"): the grains of a
- * specimen vary around a mean spectrum as the grains of a real material do.
+/* gp_grainshape.h -- each grain's own amplitude spectrum (api.md "2D shape", spread): the
+ * grains of a specimen vary around a mean spectrum as the grains of a real material do.
  *
  * Law. For grain g and mode n >= 1, D_n = mean_n exp(sigma_n z_n - sigma_n^2 / 2) with
  * sigma_n^2 = ln(1 + cov_n^2): the lognormal law whose mean is mean_n and whose coefficient of
@@ -20,9 +20,8 @@
  * (r > 0 on the continuous curve, checked on 4 Np points with a margin). Otherwise all modes
  * are drawn again, up to GP_GRAINSHAPE_TRIES draws. Why redraw and not clip each draw: a
  * clipped draw piles grains at the bound, a redraw only thins the far tail, where there is
- * one. Measured on specimens of 300 grains: no redraw for the spectra of test_shapemap.c's
- * targets up to D2 = 0.2 even at spread 0.5; 33 grains redrawn at D2 = 0.58, spread 0.5; 71 at
- * D2 = 0.87 (elongation 0.42), spread 0.2; none clipped. If every draw fails, the last one is
+ * one; redraws are rare, and clipping rarer still (docs/design/shape.md). If every draw
+ * fails, the last one is
  * clipped: pulled toward the mean in log space, D_n = mean_n exp(lambda (sigma_n z_n -
  * sigma_n^2 / 2)) with lambda = 1/2, 1/4, 1/8, 1/16, and the first star-shaped one is kept;
  * failing that, the mean spectrum itself (which the cell filling then handles as without

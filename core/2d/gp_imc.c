@@ -6,51 +6,22 @@
  * (O(log N) each, gp_adstat.h, exact integer sums). Both are exact functions of the cells, so
  * a rollback restores the error bit for bit and nothing drifts. No allocation per step.
  *
- * Profile (callgrind, bench_imc's speed case: unit square, COV 0.8, seed 1; instructions per
- * step over the first 10,000 steps of a run -- `bench_imc 0 S N` for S = 0 and 10,000 --, of
- * which 11 % are accepted at N = 1,000 and 42 % at N = 100,000):
- *                                          N = 1,000            N = 100,000
- *     grid candidates                      139k (voronoi 109k)  169k (voronoi 103k)
- *     neighbour lists, AD on a treap        72k (voronoi  42k)  107k (voronoi  42k)
- *     AD on sorted blocks                   68k (voronoi  42k)   82k (voronoi  41k)
- *     leaner clipping and search            65k (voronoi ~38k)   79k (voronoi ~38k)
- *     unchanged orientations kept (now)     61.2k                75.6k
- * The last row (one thread; the per-step streams draw other moves, so its steps are not the
- * rows' above): recompute 19.0k / 18.2k, cell_finish 9.8k / 9.9k, the min caliper 5.9k / 5.9k,
- * gp_adstat_a2_if 10.4k / 14.1k, gp_adstat_set 1.0k / 5.2k. The instructions grow 1.24x from
- * N = 1,000 to 100,000, the time 2.7-2.9x: the rest is memory (blocks in key order, cells in
- * a 66 MB tessellation) and accepted steps.
- * Before, N = 1,000 / 100,000: the tessellation ~38k (clipping ~8k, canonical lines 5.7k,
- * min caliper 5.9k and atan2 1.3k, the moved seed's search ~4k, the rest cell bookkeeping),
- * the what-if of the two statistics (gp_adstat_a2_if) 15k / 18k (treap: 17k / 27k), the
- * cells' CDF values and logs 7.4k, committing accepted moves (gp_adstat_set) 1.9k / 12.6k
- * (treap: 3.6k / 29k; 2 x 9 cells an accepted step, ~1,600 instructions each at N = 100,000).
- * Each of the ~9 cells recomputed a step really changes; twice the rate would take another
+ * Where a step's time goes: recomputing its ~9 cells (each of which really changes), the
+ * what-if of the two AD statistics, and for an accepted step their commits. What grows with N
+ * is the commits (with the acceptance rate) and the cache misses, hence the memory order:
+ * seeds numbered along a Hilbert curve and swept in that order (hilbert_sort, sweep_seed),
+ * each cell's data kept in place across moves (gp_voronoi.h "Memory"), the AD statistics in
+ * contiguous sorted blocks (gp_adstat.c). A step much cheaper than this would take another
  * kind of update (a Delaunay structure kept by edge flips instead of re-clipping the cells).
- * What still grows with N is the commits, by the acceptance rate as much as by N, and the
- * cache misses: the treap's pointer walks (perf: 45 % of the time at N = 100,000 in its rank queries) are now binary
- * searches in contiguous blocks (of 32 since the sweep: gp_adstat.c, BMAX).
- * Threads (issue #16, gp_imc.h "Threads"): lanes evaluate the next steps at once on replicas
- * of the tessellation. bench_imc, N = 1,000 (1 % of steps accepted): 91.5k steps/s on one
- * thread, 129k-138k on two -- not 2x: a round lasts as long as its slowest lane (a jump
- * recomputes ~18 cells, a short move ~9), and the settling (rollbacks, the accepted move's
- * statistics and its copies into the replicas) is serial; perf showed 24 % of both threads'
- * time waiting. A step evaluated after an accepted one in the same round is kept when its
- * footprint is clear of the accepted move's cells (gp_voronoi_footprint), and only judged
- * again; yet while a third of the steps are accepted (N = 100,000, its first 10^5 steps) two
- * threads gain only 6 % (36.4k steps/s against 34.2k), 8 % at N = 10,000 (12 % accepted):
- * the settling is serial, and an accepted step's part of it -- 2 x 9 cells into the AD
- * statistics, its copy into 3 replicas, the next lane judged again (20 rank queries) -- is as
- * long as a step at that N (perf: the helper waits 22 % of its time). Splitting that work
- * between the threads (the two statistics are independent, each replica could take its copy
- * on its own thread) is what is left.
- * Memory order (issue #16): generated seeds are numbered along a Hilbert curve (hilbert_sort),
- * and gp_voronoi keeps each cell's data in place across moves, so a step's ~9 cells lie
- * together. Cachegrind, N = 100,000, per step over steps 20,000-60,000, with a 512 KiB last
- * level (the L2 of the machine it was measured on): misses 673 -> 546 (instructions 77k
- * either way), of which the tessellation's 141 -> 89 and the AD what-if's
- * (gp_adstat_a2_if) 316 -> 285: now more than half of them, in its (key)-ordered blocks and
- * Fenwick tree, which no numbering of the cells can make local.
+ *
+ * Threads (gp_imc.h "Threads"): lanes evaluate the next steps at once on replicas of the
+ * tessellation. A round lasts as long as its slowest lane (a jump recomputes ~18 cells, a
+ * short move ~9), and its settling (rollbacks, the accepted move's statistics and its copies
+ * into the replicas) is serial: two threads gain while few steps are accepted, little while
+ * many are. Left to gain: splitting the settling between the threads (the two statistics are
+ * independent, and each replica could take its copy on its own thread).
+ *
+ * The profiles, speeds and cache measurements behind these choices: docs/design/imc.md.
  */
 #include "gp_imc.h"
 
@@ -69,15 +40,16 @@
 #define GP_IMC_KMAX 20
 #define GP_IMC_KMIN 3
 #define GP_IMC_PROGRESS_EVERY 4096
-/* The cancel flag is read before every step: a step costs 30 us at least and up to ~50 ms in a
- * container of 10^4 edges with few cells (every cell clipped against thousands of edges), where
- * 256 steps took 12.7 s after a cancel; one relaxed load a step costs nothing next to that. */
+/* The cancel flag is read before every step: a step can take tens of milliseconds (a container
+ * of 10^4 edges with few cells clips every cell against thousands of edges), so that polling
+ * every few hundred steps would answer a cancel seconds late; one relaxed load a step costs
+ * nothing next to a step. */
 #define GP_IMC_CANCEL_EVERY 1
 /* Default AD threshold: the excess A^2 over N's floor at which to stop. A^2 grows like N D^2
  * for a KS distance D, so a fixed threshold keeps D / (1.36 / sqrt(N)) fixed at every N: at 0.1
- * the cell-area KS is 5-20 % of its 5 % critical value and the COV within 1.4 % of the best
- * sample's (bench_imc's table). Lower thresholds stall on the orientations of near-regular
- * cells (COV 0.1: excess 0.066 after 1e5 steps). */
+ * the cell-area KS lies well inside its 5 % critical value and the COV close to the best
+ * sample's (docs/design/imc.md). Lower thresholds stall on the orientations of near-regular
+ * cells. */
 #define GP_IMC_AD_THRESHOLD 0.1
 
 void gp_imc_params_defaults(gp_imc_params *p)
@@ -374,10 +346,9 @@ static void hist_errors(const imc_state *s, int kind, double *es, double *et)
 }
 
 /* N (COV / COV_q - 1)^2: the second moment, which the tails carry. A^2 alone leaves the
- * largest cells of a wide law short: COV 1.2 at N = 500 came out 6-11 % low at A^2 excess 0.02;
- * with this term, 4 % low, which is the COV of the best possible sample of 500 (3.5 % low).
- * Both terms are least at the same specimen (the law's quantiles), so the term guides without
- * changing the goal. */
+ * largest cells of a wide law short; with this term the COV comes within about the COV of the
+ * best possible sample of N (docs/design/imc.md). Both terms are least at the same specimen
+ * (the law's quantiles), so the term guides without changing the goal. */
 static double cov_term_of(const imc_state *s, double sum_sq)
 {
     double n = (double)s->n, var = sum_sq / n - s->mu * s->mu;
@@ -480,7 +451,7 @@ static gp_status state_init(imc_state *S, const gp_imc_params *p, const gp_law *
     S->tscale = S->kt / GP_IMC_PI;
     S->cs[0] = S->ct[0] = (int)n; /* every cell starts in class 0; cell_put moves it */
     for (size_t i = 0; i < n; i++) {
-        /* about 9 us a cell at 10^6 (the AD statistics): seconds in all, so poll the flag */
+        /* seconds in all at 10^6 cells (the AD statistics), so poll the flag */
         if ((i + 1) % 4096 == 0 && cancel_raised(cancel))
             return gp_error_set(err, GP_ERR_CANCELLED, "imc: cancelled while evaluating the cells");
         cell_val c;
@@ -541,9 +512,9 @@ static int cmp_u64(const void *a, const void *b)
 /* Renumbers the seeds along a Hilbert curve over the box (one scale for both axes, so that the
  * curve's cells are square). Why: an IMC step recomputes a random cell and its ~9 neighbours;
  * with the seeds in draw order these are scattered over every per-cell array (cells, neighbour
- * lists, bins, AD values), and at 10^5-10^6 cells each step missed cache many times (a step
- * cost 79k instructions at 100k cells against 65k at 1k, yet ran 3x slower). Along the curve,
- * neighbours have nearby indices, and their data, allocated in index order, lies together.
+ * lists, bins, AD values), and at 10^5-10^6 cells each step would miss cache many times
+ * (docs/design/imc.md). Along the curve, neighbours have nearby indices, and their data,
+ * allocated in index order, lies together.
  * The key is (curve index << 32 | draw index): all keys differ, so the order is unique and
  * the same on every machine (the draw index breaks ties between seeds in one curve cell).
  * Returns -1 when out of memory. */
@@ -688,18 +659,13 @@ static double u01(void *r) { return gsl_rng_uniform((gsl_rng *)r); }
  * moves on by one seed: every seed in turn, once a pass of n steps (exactly when
  * SWEEP_HEADS divides n, else each seed SWEEP_HEADS times in SWEEP_HEADS passes). Why: with the
  * seeds along a Hilbert curve (hilbert_sort), a head's consecutive steps touch neighbouring
- * cells, so the cells a step reads are in the nearest caches from the steps just before, where
- * a random pick at N = 100,000 found them in none (1 thread, bench_imc: 32.0k -> 45.2k
- * steps/s, N = 1,000 unchanged; and the AD error after 10^5 steps at N = 100,000 2074 ->
- * 1449: a sweep leaves no seed untried for a pass, where random picks leave e^-1 of them).
- * Several heads, not one: the steps of one round of lanes (gp_imc.h "Threads") are
- * consecutive, and on one head their cells would be neighbours, their footprints clashing
- * (8 heads: the lanes of up to 4 threads on distinct heads; one head ran 6 % faster). The
- * fidelity table of bench_imc (66 runs at N = 500 and 2,000) as with random picks: 32 of 33
- * AD runs and all 33 E3 runs reach the threshold, in 9.9k and 16.5k steps (geometric means;
- * 10.8k and 18.1k before), the cells' KS/crit 0.160 on average (0.164); to the threshold on
- * the README's 10,000-grain spec fewer steps on 9 of 10 seeds tried, not on all ("Speed and
- * size"). Nor does the sweep leave a trace in space: test_imc "even in space". */
+ * cells, so the cells a step reads are in the nearest caches from the steps just before,
+ * where a random pick at large N finds them in none; and a sweep leaves no seed untried for a
+ * pass, where random picks leave e^-1 of them. Several heads, not one: the steps of one round
+ * of lanes (gp_imc.h "Threads") are consecutive, and on one head their cells would be
+ * neighbours, their footprints clashing (8 heads: the lanes of up to 4 threads on distinct
+ * heads). The sweep reaches the thresholds as random picks do, in fewer steps
+ * (docs/design/imc.md), and leaves no trace in space (test_imc "even in space"). */
 #define SWEEP_HEADS 8
 
 static size_t sweep_seed(long step, size_t n)
@@ -744,10 +710,9 @@ static int propose_anywhere(const gp_voronoi *v, gsl_rng *rng, const double *box
 
 /* The AD moves: the paper's (40 %), a short move towards a point of the seed's own cell
  * (40 %), or a jump anywhere in the container (20 %). The paper's move alone jumps too far to
- * be accepted near convergence (about 1 % of moves at N = 500, 77k steps to reach 0.05 at COV
- * 0.2), short moves fine-tune (12k steps), and jumps take a seed out of a crowd to another
- * region: without them the few largest cells of a wide law are never formed (COV 1.2 at
- * N = 500 stalls 11 % low). */
+ * be accepted near convergence, short moves fine-tune, and jumps take a seed out of a crowd to
+ * another region: without them the few largest cells of a wide law are never formed
+ * (docs/design/imc.md). */
 static int propose_ad(const gp_voronoi *v, gsl_rng *rng, size_t i, step_buf *b, const double *box,
                       gp_vec2 *q)
 {
@@ -799,7 +764,7 @@ static objective evaluate_ad_if(const imc_state *S, const uint32_t *ch, size_t n
  * what a step proposes depends on the tessellation and its number only, not on how many
  * numbers the steps before it drew (a proposal's rejection sampling draws a variable count).
  * That is what lets a lane evaluate step s + 1 before step s is decided: when s is refused
- * (most steps near the end: 99 % at N = 1,000), s + 1 was evaluated on the right
+ * (most steps near the end), s + 1 was evaluated on the right
  * tessellation and stands. Stream 0 of the run's seed places the seeds (MT19937); step s uses
  * (seed, s) through gp_rng_derive_key, of which taus2 keeps 32 bits. */
 static void step_rng_set(gsl_rng *r, uint64_t seed, long step)
@@ -950,11 +915,10 @@ static void round_fn(void *ctx, int tid)
 }
 
 /* Alone or on the team: other work on the machine can keep the helpers from their CPUs, and a
- * round then waits for them (one CPU of two kept busy by another process made two threads
- * 2.7x slower than one at N = 10,000, 1.9x at N = 1,000). So the run measures both: 2,048
- * steps alone, 2,048 on the team, then 65,536 steps on the faster, and again. Under that load
- * two threads then ran 0.94x-1.2x one; on an idle machine the probes cost ~1.5 %. Nothing but
- * the speed depends on this. */
+ * round then waits for them, so that two threads can run slower than one. So the run measures
+ * both: 2,048 steps alone, 2,048 on the team, then 65,536 steps on the faster, and again; on
+ * an idle machine the probes cost little (docs/design/imc.md). Nothing but the speed depends
+ * on this. */
 #define GP_IMC_PROBE_STEPS 2048
 #define GP_IMC_STRETCH_STEPS 65536
 
@@ -1113,10 +1077,8 @@ static int settle_round(run_ctx *C, gp_status *st, gp_error *err)
 /* The next round: how many lanes, and their step numbers. Lanes after an accepted step are
  * wasted, so while many steps are accepted a round has one lane per thread; when few are
  * (below 5 %), GP_IMC_LANES_PER_THREAD per thread, which evens out the threads' loads (a
- * round lasts as long as its slowest thread). N = 1,000, 2 threads, 1 % accepted: 127k steps/s
- * with 1 lane per thread, 139k with 2, 138k with 3; N = 100,000, 33 % accepted: 37.8k, 29.5k,
- * 23.3k (one thread: 31.6k) before lanes after an accepted step were kept, 36.4k with 1 lane a
- * thread and 33.2k with 2 since. Which lanes run changes nothing but the speed. */
+ * round lasts as long as its slowest thread; docs/design/imc.md has the speeds). Which lanes
+ * run changes nothing but the speed. */
 static void number_lanes(run_ctx *C)
 {
     if (C->nt > 1 && C->ro.steps >= C->stretch_end) next_stretch(C);
@@ -1142,7 +1104,7 @@ static gp_status run_loop(run_ctx *C, gp_error *err)
 /* Lanes and threads for a run: up to GP_IMC_LANES_PER_THREAD lanes per thread of
  * params.threads (at most GP_IMC_LANES_MAX), for AD with N > 1; E1-E3 judge every step
  * serially, lanes would not help. Each lane beyond the first holds a whole tessellation (~660
- * bytes a cell: 66 MB at N = 100,000, measured as peak RSS), so the replicas hold at most
+ * bytes a cell), so the replicas hold at most
  * GP_IMC_REPLICA_CELLS cells together: 3 replicas at N = 100,000... 250,000 (2 threads),
  * none at 10^6 (there the steps are a small part of the job). No more threads than lanes. */
 #define GP_IMC_LANES_MAX 16

@@ -14,22 +14,15 @@
  * reported as the excess over its least value for N values, A^2_min(N) (all u_(i) at
  * (2i - 1) / 2N), so that 0 is a perfect match at any N: error = max(excess_size,
  * excess_orient); a move is accepted when the sum of the two does not increase.
- * Why this measure: a histogram of a few classes can be matched exactly by a wrong law (E3 = 0
- * with COV 0.38 for a 0.2 target, 5 classes, N = 500, issue #12), and its integer floor ties the
- * class count to the threshold. A^2 sees every value, has no integer floor, moves with every
- * step, and weighs the tails by 1 / (F (1 - F)), so that the few largest cells that carry a
- * COV cannot drift (a Cramer-von Mises distance weighs them by 1). Figures that decided it
- * (bench_imc, unit square, seed 11; KS as a fraction of its 5 % critical value 1.36/sqrt(N)):
- *     N     COV  a    AD 0.1: KS/crit  COV err  steps     E3 0.002: KS/crit  COV err  steps
- *     500   0.1  1            0.11     -0.0 %   51,909              2.81   +255 %   17,650
- *     500   0.2  0.1          0.23     +0.0 %    3,824              2.16    +92 %    7,318
- *     500   0.8  1            0.19     -1.9 %    2,565              0.77    -16 %   11,836
- *     500   1.2  1            0.23     -4.3 %    3,994              0.97    -25 %   75,273
- *     2000  0.1  0.1          0.11     +0.0 %   90,736              2.72   +184 %  700,791
- *     2000  1.2  0.3          0.21     -2.0 %   13,648              1.13    -19 %   77,911
- * (-3.5 % is the COV of the best sample of 500 from the COV 1.2 law.) A plain A^2 at 0.02
- * left COV 1.2 at N = 500 6-11 % low, hence the COV term; the paper's moves alone needed 77k
- * steps where the mixed moves below need 8k (COV 0.2, N = 500).
+ * Why this measure: a histogram of a few classes can be matched exactly by a wrong law (a far
+ * wider COV than the target's fits 5 classes exactly), and its integer floor ties the class
+ * count to the threshold. A^2 sees every value, has no integer floor, moves with every step,
+ * and weighs the tails by 1 / (F (1 - F)), so that the few largest cells that carry a COV
+ * cannot drift (a Cramer-von Mises distance weighs them by 1). A^2 alone still leaves the
+ * largest cells of a wide law short, hence a COV term in the area excess (gp_imc.c
+ * cov_term_of); and the paper's move alone is rarely accepted near convergence, hence the
+ * mixed moves (gp_imc.c propose_ad). The figures that decided all three, AD against E3:
+ * docs/design/imc.md.
  * Incremental: A^2 is linear in the ranks, so it is kept exactly (integer sums of fixed-point
  * logs) by an order-statistic structure (gp_adstat.h) in O(log N) per changed cell; a
  * rolled-back move restores it bit for bit, and a move is judged by the exact A^2 it would give.
@@ -58,13 +51,14 @@
  * Seed numbering: generated seeds (init uniform or Halton) are renumbered along a Hilbert curve
  * over the container's bounding box before the tessellation is built, so that neighbouring
  * cells have nearby indices and everything stored per cell (cells, neighbour lists, bins, AD
- * values) lies close in memory: a step touches ~9 neighbouring cells, and in draw order these
- * were scattered (3x fewer steps/s at N = 100,000 than at 1,000). Cell i of the result is the
- * i-th seed along the curve; seeds given by the caller (params.seeds) keep their order.
+ * values) lies close in memory: a step touches ~9 neighbouring cells, which in draw order lie
+ * scattered over every per-cell array, so that large runs would wait on the memory
+ * (docs/design/imc.md). Cell i of the result is the i-th seed along the curve; seeds given by
+ * the caller (params.seeds) keep their order.
  *
  * Threads (params.threads, gp_imc.c "lanes"). Each step draws its proposal from a random stream
  * of its own, named by (seed, step number), so what step s + 1 proposes depends only on the
- * tessellation it starts from. Near the end most steps are refused (99 % at N = 1,000), and a
+ * tessellation it starts from. Near the end most steps are refused, and a
  * refused step leaves the tessellation as it was: so T threads evaluate steps s + 1 .. s + k
  * at once, each on its own replica of the tessellation (read-only on the statistics), and the
  * round's steps are then taken in order. An accepted step's move is copied into the other
@@ -74,10 +68,10 @@
  * the same error, so the run is the one-thread run bit for bit. Only AD runs use more than one
  * thread; the replicas hold at most 500,000 cells together (a replica is a whole tessellation,
  * ~660 bytes a cell): one thread from N = 500,000 on; no more threads than CPUs online; and the
- * run times stretches alone and on its threads and keeps the faster (a busy machine). 2
- * threads against one (bench_imc): N = 1,000 ~1.5x, N = 10,000 1.25-1.4x; N = 100,000 in its
- * first 10^5 steps, a third of them accepted, 0.87-0.94x: the settling of a round is serial,
- * so the run goes alone, and the other replicas still take each accepted move.
+ * run times stretches alone and on its threads and keeps the faster (a busy machine). The
+ * settling of a round is serial, so two threads gain most when few steps are accepted (the end
+ * of a run, small N) and little while many are (docs/design/imc.md has the speeds); while the
+ * run goes alone, the other replicas still take each accepted move.
  *
  * Determinism: the same container, N and params (seed included) give the same tessellation bit
  * for bit, whatever params.threads. Thread-safety: one run per call, no shared state; a run
@@ -122,7 +116,8 @@ typedef struct gp_imc_params {
 void gp_imc_params_defaults(gp_imc_params *p);
 
 /* The default threshold of an error kind: 0.002 for E1-E3 (the paper), and for AD the value
- * that bench_imc showed to put the KS distance well inside its 5 % critical value at every N. */
+ * that puts the KS distance well inside its 5 % critical value at every N (gp_imc.c
+ * GP_IMC_AD_THRESHOLD). */
 double gp_imc_default_threshold(int error_kind);
 
 /* The least threshold a run with these params can reach for n cells: the integer-count floor

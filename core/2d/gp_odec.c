@@ -425,9 +425,9 @@ static double radius_bound(const odec_run *R, size_t i)
  * comes first by its bound gets its exact radius and goes back in; one that comes first by its
  * exact radius is the node step 3 takes next (every node still queued has a radius no larger,
  * and ties go by index as there). A node found covered leaves the queue without its exact
- * radius, which is most of them: the exact radii (O(m) each) are taken for about one node in
- * seven (bench_specimen2d phases: 27 of ~180 per grain). The discs and their order are those
- * of computing every radius and sorting.
+ * radius, which is most of them: the exact radii (O(m) each) are taken for a small fraction of
+ * the nodes (docs/design/geometry.md). The discs and their order are those of computing every
+ * radius and sorting.
  * 0, or -1 when out of memory. */
 static int odec_discs(odec_run *R)
 {

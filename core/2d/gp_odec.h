@@ -30,8 +30,8 @@
  * Cost: O(m^2) for m nodes (m ~ 1.1-2 n for a 128-point Fourier contour with default
  * parameters), but lazily: step 3 takes the nodes from a queue of cheap upper bounds of their
  * tangent radii (a subset of the nodes), and a node gets its exact radius only when it comes
- * first uncovered -- 27 of ~180 per grain in bench_specimen2d's specimen; the discs are those
- * of sorting every exact radius.
+ * first uncovered, which few do (docs/design/geometry.md); the discs are those of sorting
+ * every exact radius.
  * Thread safe: no state besides the arguments.
  */
 #ifndef GP_ODEC_H

@@ -1,6 +1,6 @@
-/* gp_outline.h -- the Fourier spectrum of real grain outlines (issue #17): Mollon & Zhao 2012,
- * Sec. 2.2 (Eqs. 5-9) run in the analysis direction, on outlines measured on real grains
- * (traced images, digitised contours), one outline or a set of them.
+/* gp_outline.h -- the Fourier spectrum of real grain outlines (api.md "2D shape"): Mollon &
+ * Zhao 2012, Sec. 2.2 (Eqs. 5-9) run in the analysis direction, on outlines measured on real
+ * grains (traced images, digitised contours), one outline or a set of them.
  *
  * Algorithm, for one outline (a closed polygon, vertices in order, implicitly closed):
  *  1. Clean: non-finite vertices are refused; consecutive repeated points and the closing
@@ -68,10 +68,9 @@
  * Invariants of a result: for analysed outlines D_0 = 1, D_n >= 0, r0 > 0, the pole strictly
  * inside the kernel; info.flags & GP_OUTLINE_REFUSED <=> info.error.code is the refusal.
  * Work: O(V + np log np) per outline (+ O(V log V) when the kernel is needed, + O(np^2) for
- * the descriptors' ODEC), so O(n np log np + total vertices) for a set. Measured (np = 128,
- * 128-vertex outlines, one core): ~0.05 ms per outline without descriptors, ~0.5 ms with
- * them (gp_shape_describe_fourier, the specimen's own cost per grain): 10,000 outlines in
- * about 0.5 s and 5 s.
+ * the descriptors' ODEC), so O(n np log np + total vertices) for a set; the descriptors cost
+ * what the specimen's own grains cost (gp_shape_describe_fourier) and dominate
+ * (docs/design/shape.md).
  * Ownership: a gp_outline (workspace: an FFTW plan for np and scratch growing with the largest
  * outline seen) is the caller's, freed with gp_outline_destroy; a set result owns its arrays,
  * freed with gp_outline_set_result_free. Threads: a gp_outline is used by one thread at a time

@@ -64,7 +64,7 @@ static int vertex_before(const sw_vertex *u, const sw_vertex *v)
 }
 
 /* sorts v[0..n) into the sweep order (a bottom-up merge sort, tmp of n items: qsort's calls
- * through a pointer were a fifth of the whole check) */
+ * through a pointer would be a large share of the whole check; docs/design/geometry.md) */
 static void sort_vertices(sw_vertex *v, sw_vertex *tmp, size_t n)
 {
     sw_vertex *a = v, *b = tmp;

@@ -66,8 +66,9 @@ static void ray_sums(const double *cs, size_t nm, double zr, double zi, double o
  * and odd modes' cosine and sine parts Ce, Se, Co, So give the four rays i, np/2 - i,
  * np/2 + i, np - i as (Ce + Se) + (Co + So), (Ce - Se) - (Co - So), (Ce + Se) - (Co + So)
  * and (Ce - Se) + (Co - So): np/4 sincos and a quarter of the complex products of
- * curve_direct, two rays at a time (issue #16: the regularity's 512 points were 8 % of a
- * specimen). ct, st: np each (the directions); s: np. */
+ * curve_direct, two rays at a time (the regularity's 512 points would otherwise be a visible
+ * share of a specimen's time: docs/design/geometry.md). ct, st: np each (the directions);
+ * s: np. */
 static void curve_quadrant(const double *cs, size_t nm, size_t np, double *ct, double *st,
                            double *s)
 {

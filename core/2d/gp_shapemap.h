@@ -1,5 +1,6 @@
-/* gp_shapemap.h -- from target shape descriptors to a Fourier spectrum (issue #17; Mollon &
- * Zhao 2012, Sec. 2.1 descriptors, Sec. 2.2 Eqs. 10-12 spectra, Sec. 4.3 and Fig. 13).
+/* gp_shapemap.h -- from target shape descriptors to a Fourier spectrum (api.md "2D shape";
+ * Mollon & Zhao 2012, Sec. 2.1 descriptors, Sec. 2.2 Eqs. 10-12 spectra, Sec. 4.3 and
+ * Fig. 13).
  *
  * Problem: the user asks for mean descriptors (any subset of elongation, roundness,
  * circularity, regularity, as gp_shape.h measures them); find D2, D3, D8 (alpha = beta = -2,
@@ -57,7 +58,7 @@
  * fraction of the table's own miss and inside 0.8 of the tolerance -- so that a fresh sample,
  * off by its own noise, stays inside; or max_evals evaluations. The best evaluated spectrum
  * (lowest F on its sample) is returned. With the committed table one evaluation usually
- * suffices. Each evaluation describes ngrains grains (~0.4 ms each on one core at Np = 128).
+ * suffices. Each evaluation describes ngrains grains (docs/design/shape.md has the costs).
  * Deterministic for a given seed.
  *
  * Contour points: the table is measured at GP_SHAPEMAP_TABLE_NP (128) points with Np / 2
@@ -94,7 +95,8 @@ enum {
 #define GP_SHAPEMAP_BIT(k) (1u << (k))
 #define GP_SHAPEMAP_ALL 0xFu
 
-/* Tolerances of issue #17: a target is met when the mean is within these. */
+/* Tolerances of the target descriptors (api.md "2D shape"): a target is met when the mean is
+ * within these. */
 #define GP_SHAPEMAP_TOL_ELONGATION 0.02
 #define GP_SHAPEMAP_TOL_ROUNDNESS 0.05
 #define GP_SHAPEMAP_TOL_CIRCULARITY 0.02
@@ -154,9 +156,8 @@ void gp_shapemap_params_defaults(gp_shapemap_params *p);
  * returns when it refuses; otherwise GP_OK with the best spectrum found and that sample's
  * means and sds. out->missed != 0 after GP_OK means the refinement ended (max_evals) with
  * those descriptors still outside their tolerance on the sample: a valid spectrum that says
- * so (the caller warns). Bounded cost: at most max_evals * ngrains grain descriptions (6 * 256
- * * 0.4 ms ~ 0.6 s at Np = 128 on one core; usually one evaluation, 0.1 s). params NULL =
- * defaults. */
+ * so (the caller warns). Bounded cost: at most max_evals * ngrains grain descriptions, usually
+ * ngrains (docs/design/shape.md). params NULL = defaults. */
 gp_status gp_shapemap_fit(const gp_shapemap_target *t, const gp_shapemap_params *params,
                           gp_shapemap_result *out, gp_error *err);
 

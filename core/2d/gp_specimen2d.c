@@ -7,7 +7,7 @@
  * Cells are filled by a pool of threads that take cells from a shared counter and write
  * results by cell index, so the specimen is the same bits whatever the thread count.
  *
- * Shape (issue #17; gp_specimen2d_shape.c): the mean spectrum and the per-mode spread are
+ * Shape (gp_specimen2d_shape.c): the mean spectrum and the per-mode spread are
  * settled first (phase "shape": the descriptor fit or the outlines' analysis); with target
  * descriptors the spectrum is then calibrated on filled grains (phase "calibration", below
  * build_grains) before the fill proper.
@@ -1081,13 +1081,12 @@ static void job_free(fill_job *job, size_t n)
  * Example 1 comes out at 0.635 for 0.65, and it advises asking for a little more). So the
  * shortfall is handed to the cells that did reach their target: they are refilled, all to one
  * higher fraction chosen so that the total makes up the difference, at most REFILL_PASSES
- * times. A refill goes on from the cell's grain (gp_fill_cell_from), ~15-60 evaluations a cell
- * instead of ~500 for a fresh search; a cell that cannot reach the fraction so leaves its share
- * to the next pass, whose fraction is higher. Measured (bench_specimen2d fill): Example 1
- * 0.6135 after the first fill, 0.649999 after 3 refills (the goal is 1e-6 below 0.65), 1.5x
- * the first fill's time (2x with fresh searches, which stopped at 0.6500 after 2); 10,000
- * grains 0.6303, then 0.649999 after 4 refills, 1.4x (1.8x). Cells keep the larger of their
- * grains, so a refill never loses area. */
+ * times. A refill goes on from the cell's grain (gp_fill_cell_from), a small fraction of the
+ * evaluations of a fresh search; a cell that cannot reach the fraction so leaves its share to
+ * the next pass, whose fraction is higher. The refills reach the goal (1e-6 below the asked
+ * fraction) in a few passes for about half the first fill's time again
+ * (docs/design/specimen2d.md). Cells keep the larger of their grains, so a refill never loses
+ * area. */
 #define REFILL_PASSES 4
 
 static gp_status refill(build_ctx *b, fill_job *job, gp_error *err)
@@ -1127,12 +1126,11 @@ static gp_status refill(build_ctx *b, fill_job *job, gp_error *err)
 
 /* ---------------------------------------------------------------- descriptors calibration */
 
-/* Target descriptors (issue #17): gp_shapemap_fit finds a spectrum whose random-phase grains
- * have the asked means, but the specimen's grains have their phases 2..7 chosen by the cell
- * filling and, with a spread, amplitudes that vary -- neither of which the fit models.
- * Measured without calibration (300 grains, the nine targets of test_shapemap.c): elongation
- * -0.011 .. +0.008 off the fit's own sample, roundness +-0.011, circularity +-0.006,
- * regularity -0.03 .. +0.04. So the spectrum is calibrated on the specimen's own cells: a
+/* Target descriptors: gp_shapemap_fit finds a spectrum whose random-phase grains have the
+ * asked means, but the specimen's grains have their phases 2..7 chosen by the cell filling
+ * and, with a spread, amplitudes that vary -- neither of which the fit models, and either of
+ * which moves the means by about a tolerance (docs/design/specimen2d.md). So the spectrum is
+ * calibrated on the specimen's own cells: a
  * subset of them (every cell up to CAL_MAX_CELLS, else that many spread over the indices) is
  * filled and described with the current spectrum; while a given mean is further than
  * CAL_DONE of its tolerance from its target, one defect-correction step of the table
@@ -1140,8 +1138,8 @@ static gp_status refill(build_ctx *b, fill_job *job, gp_error *err)
  * CAL_ROUNDS times; the spectrum of the best measured round is used. The cells keep their
  * phases and amplitude streams from round to round (common random numbers), so the measured
  * means move smoothly with the spectrum. Cost: one or two fills and descriptions of the
- * subset (0.8 s each at 300 grains of 128 points). */
-#define CAL_MAX_CELLS 500
+ * subset. */
+#define CAL_MAX_CELLS GP_SPECIMEN2D_CALIBRATION_CELLS
 #define CAL_ROUNDS 2
 #define CAL_DONE 0.25
 
@@ -1284,8 +1282,8 @@ static int cmp_double_asc(const void *a, const void *b)
  * (cap sorted here, then overwritten with the matched areas: the k-th smallest is
  * min(cap_(k), q[k])): the larger of the KS distance to the law by number and the KS distance
  * by mass (area-weighted) to the ideal sample q. By number alone a few largest grains left
- * short cost a few N-ths; by mass they are the sieve's passing at its top (a sieve law came out
- * 3.3 points off at 3 mm when the cells were chosen by number only). */
+ * short cost a few N-ths; by mass they are the sieve's passing at its top, which cells chosen
+ * by number only miss by points (docs/design/specimen2d.md). */
 static double matched_miss(double *cap, const double *q, size_t n, const gp_law *law)
 {
     qsort(cap, n, sizeof *cap, cmp_double_asc);
@@ -1606,7 +1604,8 @@ static void warn_shape(build_ctx *b)
              GP_GRAINSHAPE_TRIES);
 }
 
-/* Every target not reached, with how close it came (issue #12: an honest end). */
+/* Every target not reached, with how close it came: a run that stops short is a valid
+ * specimen that says so. */
 static void collect_warnings(build_ctx *b)
 {
     gp_specimen2d *out = b->out;

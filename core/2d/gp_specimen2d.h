@@ -16,8 +16,8 @@
  *   2. pass A fills every cell up to solid_fraction x 1.2 (GRAIN_LAW_HEADROOM), giving each
  *      cell the largest grain it can hold up to that;
  *   3. cells sized for their grains: small cells hold less of themselves than large ones
- *      (fewer sides), so with step 1's cells the smallest grains fall short, a KS distance of
- *      ~0.02 at any N (1.5 and 4.3 times the critical value at 10,000 and 100,000 grains).
+ *      (fewer sides), so with step 1's cells the smallest grains fall short, by a KS distance
+ *      that does not shrink with N while its critical value does (docs/design/specimen2d.md).
  *      When the grains step 4 would make from pass A miss the law by more than half the
  *      critical value (by number, or by mass), the cell law is drawn together
  *      (gp_law_powered: lam A^kappa, the same mean) by the kappa that pass A's own cells
@@ -33,15 +33,16 @@
  * The number of grains of a sieve law follows from the container: N = round(solid_fraction x
  * area / mean grain area of the law) (gp_spec2d_cell_count).
  *
- * Shape (issue #17; api.md "2D shape"). The grains' mean spectrum comes from the spec's shape
+ * Shape (api.md "2D shape"). The grains' mean spectrum comes from the spec's shape
  * form: D2/D3/D8 with alpha, beta (Eqs. 10-12), a spectrum as given, target mean descriptors
  * (gp_shapemap_fit, then calibrated on the specimen's own filled grains: gp_specimen2d.c,
  * "descriptors calibration"), or outlines (gp_outline_set_analyze: their mean spectrum at
  * contour_points rays and contour_points / 2 modes, D_1 kept). With a spread, or with outlines
  * whose own per-mode cov is the default spread, every grain draws its own amplitudes around the
  * mean (gp_grainshape.h: lognormal per mode, stream 2^62 + i, redrawn while not star-shaped)
- * and is filled and described with them. No spread (or 0) is the paper's setting, bit for bit
- * what the specimen was before. The result's stats.shape is out->shape (gp_shape_used).
+ * and is filled and described with them. No spread (or 0) is the paper's setting: every grain
+ * has the mean spectrum, and nothing is drawn for it. The result's stats.shape is out->shape
+ * (gp_shape_used).
  *
  * Fit and warnings. Every result carries stats.fit (gp_fit.h), measured on the cells and
  * grains themselves, and a list of warnings: each target not reached (IMC threshold, a KS
@@ -202,7 +203,7 @@ typedef struct gp_cell2d {
     double orientation_deg;
 } gp_cell2d;
 
-/* The shape the grains were given (issue #17), for the result: stats.shape and
+/* The shape the grains were given, for the result: stats.shape and
  * stats.descriptors.<name>.target. Grain g's own amplitudes are drawn around `spectrum` with
  * the per-mode coefficients of variation `cov` (gp_grainshape.h). */
 typedef struct gp_shape_used {
@@ -277,6 +278,10 @@ typedef struct gp_specimen2d {
      * and the descriptors' calibration, which the others then leave out */
     double t_tessellation, t_imc, t_fill, t_odec, t_descriptors, t_shape, t_total;
 } gp_specimen2d;
+
+/* The descriptors' calibration fills and describes at most this many of the cells, once or
+ * twice (a caller's cost estimate needs it). */
+#define GP_SPECIMEN2D_CALIBRATION_CELLS 500
 
 /* Builds the specimen. Returns GP_OK, or an error with a message (GP_ERR_CANCELLED when the
  * progress callback or *cancel asked to stop). On success *out owns everything and is freed

@@ -1,6 +1,6 @@
-/* gp_specimen2d_shape.c -- the shape of a specimen's grains (issue #17): the mean spectrum of
- * each shape form, the per-mode spread, and the table step of the descriptors' calibration.
- * See gp_specimen2d_internal.h; gp_specimen2d.h says what the result reports. */
+/* gp_specimen2d_shape.c -- the shape of a specimen's grains (api.md "2D shape"): the mean
+ * spectrum of each shape form, the per-mode spread, and the table step of the descriptors'
+ * calibration. See gp_specimen2d_internal.h; gp_specimen2d.h says what the result reports. */
 #include "gp_specimen2d_internal.h"
 
 #include <math.h>

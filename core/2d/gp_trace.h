@@ -1,4 +1,4 @@
-/* gp_trace.h -- grain outlines from a binary image (issue #17): the "image treatment, contour
+/* gp_trace.h -- grain outlines from a binary image: the "image treatment, contour
  * discretization" step of Mollon & Zhao 2012, Sec. 2.2, that feeds gp_outline.
  *
  * Input: a w x h image of bytes, row-major, row 0 at the TOP (as PGM and most formats store

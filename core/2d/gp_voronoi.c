@@ -21,10 +21,11 @@
  *   polygon C reaches a bin holding general edges is intersected with the container by a
  *   hand-written convex-polygon-with-region clip (general_clip, in phases: the ring edges'
  *   entry and exit events on C, paired and sorted along C, walked into loops, holes keyholed,
- *   loops stored): ring chains inside C, joined along C's boundary, one loop per part. Vertex classification and crossings are computed
- *   from one snapped set of signed distances, so they are consistent by construction; touching
- *   contacts (a zero-length chain) are dropped; anything still inconsistent is reported as
- *   GP_ERR_INTERNAL, never guessed. GEOS was not needed: C is convex, which makes this simple.
+ *   loops stored): ring chains inside C, joined along C's boundary, one loop per part. Vertex
+ *   classification and crossings are computed from one snapped set of signed distances, so
+ *   they are consistent by construction; touching contacts (a zero-length chain) are dropped;
+ *   anything still inconsistent is reported as GP_ERR_INTERNAL, never guessed. No general
+ *   polygon library (GEOS) is needed: C is convex, which makes this simple.
  *
  * - Moves ("Moves" below): moving seed i changes only i and the cells that are its neighbours
  *   before or after the move, nb_old(i) U nb_new(i) (about 9 cells, independent of N). The
@@ -32,7 +33,8 @@
  *   Voronoi cell within the box B, clipped by the outer ring when that is convex, so they are
  *   the Delaunay neighbours within a convex domain D (B, or the convex container), and in
  *   non-convex containers too. A move takes each changed cell's candidates from these lists, not
- *   from the grid (the grid's ring search was 77 % of an IMC step): see "Moves".
+ *   from the grid, whose ring search would cost most of an IMC step (docs/design/imc.md): see
+ *   "Moves".
  *
  * - Each cell owns a heap buffer (grown, never shrunk). A move computes the new cells into spare
  *   buffers from a pool and swaps pointers; rollback swaps them back (bit-exact, O(1) per cell),
@@ -83,6 +85,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "gp_grid.h"
 
 #define GP_VOR_SEEDS_PER_BIN 2.0
 #define GP_VOR_PI 3.14159265358979323846
@@ -256,15 +260,11 @@ static void bin_remove(vbin *b, int32_t i)
 
 static inline int32_t bin_x(const gp_voronoi *v, double x)
 {
-    double f = x * v->ihx;
-    int32_t b = f < 0 ? 0 : (f >= v->nbx ? v->nbx - 1 : (int32_t)f);
-    return b;
+    return (int32_t)gp_grid_cell(x * v->ihx, (size_t)v->nbx);
 }
 static inline int32_t bin_y(const gp_voronoi *v, double y)
 {
-    double f = y * v->ihy;
-    int32_t b = f < 0 ? 0 : (f >= v->nby ? v->nby - 1 : (int32_t)f);
-    return b;
+    return (int32_t)gp_grid_cell(y * v->ihy, (size_t)v->nby);
 }
 
 /* the bin of local point p */
@@ -1108,24 +1108,33 @@ static gp_status cell_start(cell_run *R, gp_voronoi *v, uint32_t i, int full)
     return GP_OK;
 }
 
-/* Bin b (nearest point md2 from the seed): clips by the convex outer ring's edges in it (their
- * half-planes contain the container, so a convex container costs nothing extra), and appends
- * its seeds closer than 2 Rmax to the candidates v->cand_d / cand_j [*nc ..). */
+/* Clips the cell by the convex outer ring's edges in bin b that have not clipped it yet (their
+ * half-planes contain the container, so a convex container costs nothing extra). */
+static gp_status clip_convex_edges_in_bin(cell_run *R, int32_t b)
+{
+    gp_voronoi *v = R->v;
+    for (uint32_t q = v->ce_off[b]; q < v->ce_off[b + 1]; q++) {
+        uint32_t e = v->ce[q];
+        if (v->estamp[e] == R->es) continue;
+        v->estamp[e] = R->es;
+        gp_vec2 a = v->rv[e], c = v->rv[v->enext[e]];
+        gp_vec2 nrm = {c.y - a.y, a.x - c.x};
+        gp_status st = clip_step(v, &R->m, &R->ina, a, nrm, R->epsr * (fabs(nrm.x) + fabs(nrm.y)),
+                                 -(int32_t)e - 2, R->s, &R->rmax2);
+        if (st != GP_OK) return st;
+    }
+    return GP_OK;
+}
+
+/* Bin b (nearest point md2 from the seed): clips by the convex outer ring's edges in it, and
+ * appends its seeds closer than 2 Rmax to the candidates v->cand_d / cand_j [*nc ..). */
 static gp_status cell_bin(cell_run *R, int32_t b, double md2, int32_t *nc)
 {
     gp_voronoi *v = R->v;
     const gp_vec2 s = R->s;
     if (v->outer_convex && md2 <= R->rmax2) {
-        for (uint32_t q = v->ce_off[b]; q < v->ce_off[b + 1]; q++) {
-            uint32_t e = v->ce[q];
-            if (v->estamp[e] == R->es) continue;
-            v->estamp[e] = R->es;
-            gp_vec2 a = v->rv[e], c = v->rv[v->enext[e]];
-            gp_vec2 nrm = {c.y - a.y, a.x - c.x};
-            gp_status st = clip_step(v, &R->m, &R->ina, a, nrm, R->epsr * (fabs(nrm.x) + fabs(nrm.y)),
-                                     -(int32_t)e - 2, s, &R->rmax2);
-            if (st != GP_OK) return st;
-        }
+        gp_status st = clip_convex_edges_in_bin(R, b);
+        if (st != GP_OK) return st;
     }
     vbin *bn = &v->bins[b];
     const int32_t *it = bin_items(bn);
@@ -1582,17 +1591,8 @@ static gp_status clip_convex_edges_near(cell_run *R)
     poly_bins(v, R->ina ? v->sa : v->sb, (size_t)R->m, r);
     for (int32_t yy = r[2]; yy <= r[3]; yy++)
         for (int32_t xx = r[0]; xx <= r[1]; xx++) {
-            int32_t b = yy * v->nbx + xx;
-            for (uint32_t q = v->ce_off[b]; q < v->ce_off[b + 1]; q++) {
-                uint32_t e = v->ce[q];
-                if (v->estamp[e] == R->es) continue;
-                v->estamp[e] = R->es;
-                gp_vec2 a = v->rv[e], c = v->rv[v->enext[e]];
-                gp_vec2 nrm = {c.y - a.y, a.x - c.x};
-                gp_status st = clip_step(v, &R->m, &R->ina, a, nrm, R->epsr * (fabs(nrm.x) + fabs(nrm.y)),
-                                         -(int32_t)e - 2, R->s, &R->rmax2);
-                if (st != GP_OK) return st;
-            }
+            gp_status st = clip_convex_edges_in_bin(R, yy * v->nbx + xx);
+            if (st != GP_OK) return st;
         }
     return GP_OK;
 }
@@ -1786,6 +1786,12 @@ static int dcmp(const void *a, const void *b)
 
 static int cancel_raised(const volatile int *cancel);
 
+/* The bins: about GP_VOR_SEEDS_PER_BIN seeds each, so their side h follows from the container's
+ * area (not its bounding box: a thin or holed container keeps that occupancy), rounded up to a
+ * whole number of bins per axis (a bin at most h wide) and widened by 1.25 while there are more
+ * than 4N + 64 bins. Not gp_grid_size (gp_grid.h), which sizes a grid by a search's reach: a
+ * cell's search walks rings of bins outwards until they are 2 Rmax away, so a bin needs no
+ * least width, only its occupancy. */
 static gp_status build_grid(gp_voronoi *v, const volatile int *cancel)
 {
     double area = v->carea;
@@ -2330,7 +2336,7 @@ static int cell_copy(vcell *dst, const vcell *src)
  * moves per cell every cell would live in buffers last used by some random cell far away, and
  * the memory order the caller set up by numbering the seeds along a space-filling curve
  * (gp_imc.c) would be lost; a copy of ~9 cells of ~300 bytes costs far less than the cache
- * misses. When a copy cannot grow a buffer, that cell keeps its spare (as before). */
+ * misses. When a copy cannot grow a buffer, that cell keeps its spare (a pointer swap). */
 void gp_voronoi_commit(gp_voronoi *v)
 {
     if (!v || !v->pending) return;

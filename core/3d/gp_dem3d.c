@@ -1,6 +1,6 @@
 /* gp_dem3d.c -- see gp_dem3d.h.
  *
- * Two details the header does not spell out:
+ * Details the header does not spell out:
  *  - free flight: density scaling raises a small sphere's inertia so that its contacts keep
  *    the time step; gravity acting on the true mass then accelerates it by only g (m / m_i),
  *    down to g / 100 for a grain a tenth of the scaling radius, and the fines of a wide sieve
@@ -11,8 +11,8 @@
  *    would. The switch happens at a gap, not at contact, because one free step under g moves
  *    a small sphere about as far as its static overlap (g dt^2 ~ m g / k): switching at
  *    contact makes a resting sphere bounce for ever. Static states are unchanged (no force
- *    differs), and so is everything near contact. With the relaxation's damping of 0.7, the
- *    fines of a size ratio of 20 come to rest in about half the steps.
+ *    differs), and so is everything near contact; the fines of a wide sieve come to rest much
+ *    sooner (docs/design/dem3d.md).
  *  - the candidate list holds the pairs with a gap below skin + free_gap, so a sphere sees
  *    every surface within free_gap until the two spheres that moved (or grew) most have
  *    together moved the skin: one fine falling through the pores at ~1 m/s may go nearly the
@@ -21,12 +21,11 @@
  *  - S_c, the kinetic energy and vmax are read only after a run, so only a run's last step
  *    sums them (a square root per sphere saved on every other step); the walls' forces and
  *    stiffnesses, which the servo needs, are summed on every step.
- *  - speed (issue #16): the pair kernel and the sphere step run on vectors of four doubles
- *    (GCC's generic vectors; an AVX2 clone picked at load time on x86-64, two SSE2 halves
+ *  - vectors: the pair kernel and the sphere step run on vectors of four doubles (GCC's
+ *    generic vectors; an AVX2 clone picked at load time on x86-64, two SSE2 halves
  *    elsewhere), branch-free where a branch would be a coin toss; every lane does the IEEE
- *    operations of the scalar code in its order, so the bits are those of the scalar code
- *    (the sample's spheres and contacts hash the same as before this layout) and the same
- *    on any machine (-ffp-contract=off: no FMA).
+ *    operations of the scalar form in its order, so the bits are those of one sphere or pair
+ *    at a time, and the same on any machine (-ffp-contract=off: no FMA).
  */
 #include "gp_dem3d.h"
 
@@ -35,6 +34,8 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "gp_grid.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -525,23 +526,8 @@ static gp_status level_grids(gp_dem3d *d, level_grid lv[NLEVEL], double reach, g
         if (!G->n)
             continue;
         G->cs = 2 * G->rmax + reach;
-        for (int a = 0; a < 3; a++) {
-            double e = ext_hi[a] - ext_lo[a];
-            double ga = floor(e / G->cs);
-            if (ga < 1) ga = 1;
-            if (ga > 2048) ga = 2048;
-            G->g[a] = (size_t)ga;
-        }
-        while (G->g[0] * G->g[1] * G->g[2] > 2 * G->n + 64) {
-            int a = G->g[0] >= G->g[1] && G->g[0] >= G->g[2] ? 0 : (G->g[1] >= G->g[2] ? 1 : 2);
-            G->g[a] = (G->g[a] + 1) / 2;
-        }
-        for (int a = 0; a < 3; a++) {
-            double e = ext_hi[a] - ext_lo[a];
-            G->lo[a] = ext_lo[a];
-            G->inv[a] = e > 0 ? (double)G->g[a] / e : 0;
-        }
-        size_t nc = G->g[0] * G->g[1] * G->g[2];
+        memcpy(G->lo, ext_lo, sizeof G->lo);
+        size_t nc = gp_grid_size(ext_lo, ext_hi, G->cs, 2048, 2 * G->n + 64, G->g, G->inv);
         if (grow_size_t(&d->lv_start[L], &d->lv_start_cap[L], nc + 1)
             || grow_size_t(&d->lv_list[L], &d->lv_list_cap[L], G->n))
             return gp_error_set(err, GP_ERR_NOMEM, "dem3d: out of memory (cells)");
@@ -552,12 +538,8 @@ static gp_status level_grids(gp_dem3d *d, level_grid lv[NLEVEL], double reach, g
     for (size_t i = 0; i < n; i++) {
         level_grid *G = lv + lev[i];
         size_t c[3];
-        for (int a = 0; a < 3; a++) {
-            long k = (long)((d->x[3 * i + a] - G->lo[a]) * G->inv[a]);
-            if (k < 0) k = 0;
-            if (k >= (long)G->g[a]) k = (long)G->g[a] - 1;
-            c[a] = (size_t)k;
-        }
+        for (int a = 0; a < 3; a++)
+            c[a] = gp_grid_cell((d->x[3 * i + a] - G->lo[a]) * G->inv[a], G->g[a]);
         cellbuf[i] = (c[2] * G->g[1] + c[1]) * G->g[0] + c[0];
         G->start[cellbuf[i] + 1]++;
     }

@@ -63,9 +63,9 @@
  * weights: omega_max^2 = lam_max(M^-1/2 K M^-1/2) <= max_i [sum_c beta k_n (1/m_i +
  * 1/sqrt(m_i m_j)) + 2 E R_i n_w / m_i], n_w the most walls touched on one axis (the walls'
  * block is diagonal). k_n is taken at the full radii (never smaller than at the current ones).
- * On packings of this DEM the bound is 1.5-1.6 x the true omega_max: 1.52-1.59 on 50-150
- * spheres (test_dem3d, GSL's eigensolver on the full 6N x 6N K and M), 1.6 on the paper's
- * relaxed sample (Lanczos; a direction-aware 6 x 6 block bound would gain only 10 %).
+ * On packings of this DEM the bound is 1.5-1.6 x the true omega_max (test_dem3d checks it
+ * against the eigenvalues; docs/design/dem3d.md), close enough that a tighter, direction-aware
+ * bound would not pay.
  * The integrator: leapfrog (v += a dt, then x += v dt; the spring sees the motion of the step)
  * is stable for omega dt < 2. Local damping multiplies a force component by 1 + c where it
  * brakes (f v < 0); in leapfrog's fastest mode (the sign flips every step) every component

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gp_grid.h"
+
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
@@ -35,23 +37,9 @@ gp_status gp_dem3d_find_pairs(const double *xyzr, size_t n, double gap, size_t *
         }
         if (xyzr[4 * i + 3] > rmax) rmax = xyzr[4 * i + 3];
     }
-    double cs = 2 * rmax + (gap > 0 ? gap : 0);
     size_t g[3];
     double inv[3];
-    for (int a = 0; a < 3; a++) {
-        double e = hi[a] - lo[a];
-        double ga = cs > 0 ? floor(e / cs) : 1;
-        if (ga < 1) ga = 1;
-        if (ga > 4096) ga = 4096;
-        g[a] = (size_t)ga;
-    }
-    while (g[0] * g[1] * g[2] > 2 * n + 64) {
-        int a = g[0] >= g[1] && g[0] >= g[2] ? 0 : (g[1] >= g[2] ? 1 : 2);
-        g[a] = (g[a] + 1) / 2;
-    }
-    for (int a = 0; a < 3; a++)
-        inv[a] = hi[a] > lo[a] ? (double)g[a] / (hi[a] - lo[a]) : 0;
-    size_t nc = g[0] * g[1] * g[2];
+    size_t nc = gp_grid_size(lo, hi, 2 * rmax + (gap > 0 ? gap : 0), 4096, 2 * n + 64, g, inv);
     size_t *start = calloc(nc + 1, sizeof *start), *cell = malloc(n * sizeof *cell),
            *list = malloc(n * sizeof *list), *fill = malloc(nc * sizeof *fill);
     size_t cap = 8 * n + 64, np = 0;
@@ -62,12 +50,8 @@ gp_status gp_dem3d_find_pairs(const double *xyzr, size_t n, double gap, size_t *
     }
     for (size_t i = 0; i < n; i++) {
         size_t c[3];
-        for (int a = 0; a < 3; a++) {
-            long k = (long)((xyzr[4 * i + a] - lo[a]) * inv[a]);
-            if (k < 0) k = 0;
-            if (k >= (long)g[a]) k = (long)g[a] - 1;
-            c[a] = (size_t)k;
-        }
+        for (int a = 0; a < 3; a++)
+            c[a] = gp_grid_cell((xyzr[4 * i + a] - lo[a]) * inv[a], g[a]);
         cell[i] = (c[2] * g[1] + c[1]) * g[0] + c[0];
         start[cell[i] + 1]++;
     }

@@ -53,8 +53,7 @@
 #define STABILITY GP_SPEC3D_STABILITY /* Eq. 7: 0.01 % */
 #define GROW_FROM 0.6            /* initial radius scale of the placement */
 /* durations, in units of sqrt(d50 / g) (see where tu is computed; the paper's sieve has ~860
- * steps per unit at the relaxation's dt, ~735 at the deposition's and compaction's, and these
- * are its former step counts at ~860) */
+ * steps per unit at the relaxation's dt, ~735 at the deposition's and compaction's) */
 #define GROW_T 1.75              /* growth of the radii */
 #define SETTLE_T 1.2             /* deposition ends after this ... */
 #define SETTLE_SC 5e-2           /* ... or when S_c is below this */
@@ -66,23 +65,18 @@
 #define CHUNK 100
 /* Relaxation looks at S_c (Eq. 7, measured on a run's last step) every CHUNK steps and stops
  * at the first look <= 1e-4: the paper's condition, checked once (as YADE's scripts check
- * it). S_c is noisy there (rattlers settling). Measured on the paper's sample, seeds 0-9,
- * looking every 10 steps over the 1,000 steps after that stop: S_c is above 1e-4 at 46-82 %
- * of the looks, at most 3.3e-4 to 8.1e-4 (26-73 % and 2.6e-4 to 5.8e-4 with one time step
- * for all phases, before f116b41); holding it at every look for 100 steps would take 310 to
- * 1,790 more steps. A finer look stops earlier, on a dip of that noise: looking every 10
- * steps saved ~300 steps but left S_c above 1e-4 at 55-85 % of the later looks, so the look
- * stays at CHUNK. */
+ * it). S_c is noisy there (rattlers settling): after that stop it is back above 1e-4 at most
+ * later looks, and holding it for 100 steps would cost hundreds to thousands of steps more. A
+ * finer look stops earlier, on a dip of that noise, and leaves the packing no more stable, so
+ * the look stays at CHUNK (docs/design/specimen3d.md). */
 #define STALL_FRACTION 0.1
 #define LADDER_FRACTION 0.2      /* least progress per window, of the height still to go */
 #define LADDER_MIN_LEFT 0.004    /* ... counted as at least this fraction of b_z; also the
                                     least gap of the approach's speed limit (APPROACH_T). The
-                                    last stretch of the paper's sample creeps at this floor
-                                    (0.002: ~1 unit for its last 1 mm); 0.004 saves ~300 steps
-                                    of compaction on seeds 0-9, and relaxation then takes no
-                                    longer; 0.006-0.008 save ~150 more in compaction but
-                                    relaxation takes 200-300 more (the packing arrives faster
-                                    than it settles) */
+                                    last stretch of compaction creeps at this floor: lower, it
+                                    creeps longer; higher, relaxation takes longer than
+                                    compaction saves (the packing arrives faster than it
+                                    settles; docs/design/specimen3d.md) */
 #define LADDER_FACTOR 0.5        /* friction step of the ladder */
 #define LADDER_MIN_DEG 0.5       /* below this the ladder goes to zero friction */
 #define MAX_SCALED_RATIO 3.5     /* density scaling radius >= rmax / this */
@@ -93,26 +87,19 @@
                                     damping c = 0.7. The DEM checks every step against a proven
                                     bound on omega_max (shear and rotation included) and the
                                     limit omega dt < 2 / sqrt(1 + c) of leapfrog with local
-                                    damping c (gp_dem3d.h); at 0.43 relaxation already needs a
-                                    cut on some seeds */
+                                    damping c (gp_dem3d.h); a little higher, relaxation needs
+                                    cuts on some seeds (docs/design/specimen3d.md) */
 #define DT_DAMPING_EXP 0.45      /* the other phases (c = the material's 0.2) step
                                     ((1 + 0.7) / (1 + c))^0.45 = 1.17 x longer
                                     (params.dt_damping_exp): for the same contacts they use
                                     (1.2 / 1.7)^0.05 = 0.98 of the relaxation's fraction of its
-                                    own limit. On the paper's sample (seeds 0-9) the steps use
-                                    at most 0.80-0.89 of the limit in deposition, 0.88-0.94 in
-                                    compaction and 0.89-0.95 in relaxation, never cut (with one
-                                    step for all: 0.90-0.94, in relaxation); 0.96 in the
-                                    compaction of test_cancel_phases' 12 mm sample (0.96 in its
-                                    relaxation with one step). 0.5 (the same fraction, 1.19 x)
-                                    saves as many steps, but the small spec of the integration
-                                    tests (55 spheres at porosity 0.5, which jam without
-                                    friction at 0.50-0.54 by the seed: ~45 % reach 0.5, with
-                                    one step or with this one) then jammed at 0.5057 at its
-                                    default seed 0 */
+                                    own limit, so that no phase needs a cut. 0.5 (the same
+                                    fraction, 1.19 x) saves as many steps, but a small loose
+                                    spec of the integration tests then jams short of its
+                                    porosity (docs/design/specimen3d.md) */
 #define COMPACTION_STRESS 1.0    /* top-wall stress, times the geostatic stress at the bottom */
-/* local damping during relaxation (the static state does not depend on it; Sc <= 1e-4 comes
- * ~2x sooner than at 0.2) */
+/* local damping during relaxation (the static state does not depend on it; S_c <= 1e-4 comes
+ * far sooner than at the material's 0.2: docs/design/specimen3d.md) */
 #define RELAX_DAMPING GP_SPEC3D_RELAX_DAMPING
 
 /* the phase fractions of the progress reports (gp_progress.h) */
@@ -289,7 +276,7 @@ static int place(const double *diam, size_t n, double lam, const double L[3], gp
  * One pass feeds every measure: contact counts (always reported), fabric and stress (when
  * asked), and the contact list (only with GP_OUT3_CONTACTS). A tiled packing's contacts come
  * in chunks from gp_flip_contacts_each and are never all held at once unless the list is
- * asked for (it was ~2 GB for 7.5 million spheres); an untiled or relaxed packing's array goes
+ * asked for (~2 GB for 7.5 million spheres); an untiled or relaxed packing's array goes
  * through the same code. The sums run in the contacts' order whatever the chunks, so the
  * numbers do not depend on how the contacts arrive, nor on GP_OUT3_CONTACTS. */
 #define MEASURE_CHUNK 4096 /* contacts per chunk (288 KB); the cancel flag is read per chunk */
@@ -685,8 +672,8 @@ static gp_status start_dem(build_run *R)
      * median diameter by weight: the grains that carry the load), the time a grain takes to
      * fall its own size. In steps this unit is ~860 for the paper's sieve and ~2300 for a size
      * ratio of 20 (at the relaxation's dt; 1.17 x fewer at the deposition's, tu), where dt
-     * follows the small grains: counted in steps, the windows that judge progress were too
-     * short there, and the deposit never had the time to settle. */
+     * follows the small grains: counted in steps, the windows that judge progress would be too
+     * short there, and the deposit would never have the time to settle. */
     double d50 = diam[n - 1];
     double tot = 0, acc = 0;
     for (size_t i = 0; i < n; i++)
