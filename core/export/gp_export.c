@@ -318,13 +318,13 @@ static int read_f64s(gp_export *e, uint64_t off, double *out, int n)
 
 int gp_xr_sphere(gp_export *e, uint64_t i, double q[4])
 {
-    if (i >= e->nitems) return gp_error_set(&e->err, GP_ERR_INTERNAL, "sphere %llu", (unsigned long long)i), -1;
+    if (i >= e->info.nitems) return gp_error_set(&e->err, GP_ERR_INTERNAL, "sphere %llu", (unsigned long long)i), -1;
     return read_f64s(e, e->off_items + 32 * i, q, 4);
 }
 
-int gp_xr_grain(gp_export *e, uint64_t g, gp_xgrain *out)
+int gp_xr_grain(gp_export *e, uint64_t g, gp_export_grain *out)
 {
-    if (g >= e->nitems) return gp_error_set(&e->err, GP_ERR_INTERNAL, "grain %llu", (unsigned long long)g), -1;
+    if (g >= e->info.nitems) return gp_error_set(&e->err, GP_ERR_INTERNAL, "grain %llu", (unsigned long long)g), -1;
     const unsigned char *p = cache_get(e, e->off_items + (uint64_t)GP_PACK_GRAIN * g, GP_PACK_GRAIN);
     if (!p) return -1;
     memcpy(&out->point_first, p, 8);
@@ -338,8 +338,9 @@ int gp_xr_grain(gp_export *e, uint64_t g, gp_xgrain *out)
     memcpy(&out->circularity, p + 64, 8);
     memcpy(&out->regularity, p + 72, 8);
     /* a corrupt record must not send the readers past their arrays */
-    if (out->point_first > e->npoints || out->point_count > e->npoints - out->point_first ||
-        out->disc_first > e->ndiscs || out->disc_count > e->ndiscs - out->disc_first) {
+    const gp_export_info *h = &e->info;
+    if (out->point_first > h->npoints || out->point_count > h->npoints - out->point_first ||
+        out->disc_first > h->ndiscs || out->disc_count > h->ndiscs - out->disc_first) {
         gp_error_set(&e->err, GP_ERR_INVALID, "pack grain %llu points outside its arrays",
                      (unsigned long long)g);
         return -1;
@@ -349,13 +350,13 @@ int gp_xr_grain(gp_export *e, uint64_t g, gp_xgrain *out)
 
 int gp_xr_point(gp_export *e, uint64_t k, double p[2])
 {
-    if (k >= e->npoints) return gp_error_set(&e->err, GP_ERR_INTERNAL, "point %llu", (unsigned long long)k), -1;
+    if (k >= e->info.npoints) return gp_error_set(&e->err, GP_ERR_INTERNAL, "point %llu", (unsigned long long)k), -1;
     return read_f64s(e, e->off_points + 16 * k, p, 2);
 }
 
 int gp_xr_disc(gp_export *e, uint64_t k, double d[3])
 {
-    if (k >= e->ndiscs) return gp_error_set(&e->err, GP_ERR_INTERNAL, "disc %llu", (unsigned long long)k), -1;
+    if (k >= e->info.ndiscs) return gp_error_set(&e->err, GP_ERR_INTERNAL, "disc %llu", (unsigned long long)k), -1;
     return read_f64s(e, e->off_discs + 24 * k, d, 3);
 }
 
@@ -418,19 +419,19 @@ int gp_xw_lines(gp_export *e, const gp_xlines *f)
         e->section = 1;
         e->index = e->sub = 0;
         if (f->header(e)) return -1;
-        if (e->nitems == 0) return 1;
-        return e->dim == 2 ? next_grain(e, f) : 0;
+        if (e->info.nitems == 0) return 1;
+        return e->info.dim == 2 ? next_grain(e, f) : 0;
     }
-    if (e->dim == 3) {
+    if (e->info.dim == 3) {
         double q[4];
         if (gp_xr_sphere(e, e->index, q) || f->sphere(e, q)) return -1;
-        return ++e->index >= e->nitems;
+        return ++e->index >= e->info.nitems;
     }
     double d[3];
     if (gp_xr_disc(e, e->grain.disc_first + e->sub, d) || f->disc(e, d)) return -1;
     if (++e->sub < e->grain.disc_count) return 0;
     e->sub = 0;
-    if (++e->index >= e->nitems) return 1;
+    if (++e->index >= e->info.nitems) return 1;
     return next_grain(e, f);
 }
 
@@ -439,7 +440,7 @@ int gp_xw_lines(gp_export *e, const gp_xlines *f)
 /* The DEM block after the spheres into e->dem; -1 when its magic is not there. */
 static int read_dem(gp_export *e)
 {
-    const unsigned char *p = cache_get(e, GP_PACK_HEADER + 32 * e->nitems, GP_PACK_DEM);
+    const unsigned char *p = cache_get(e, GP_PACK_HEADER + 32 * e->info.nitems, GP_PACK_DEM);
     if (!p || memcmp(p, GP_PACK_DEM_MAGIC, 8)) return -1;
     double v[13];
     memcpy(v, p + 8, sizeof v);
@@ -464,24 +465,20 @@ static int dem_usable(const gp_xdem *d)
            d->rmax < INFINITY && d->tiling[0] >= 1 && d->tiling[1] >= 1 && d->tiling[2] >= 1;
 }
 
-gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_export **out,
-                         gp_error *err)
+/* Opens the pack behind src and checks its header, sizes and DEM block: the part of an export
+ * that every format and the record reader share. */
+static gp_status pack_open(const gp_export_source *src, gp_export **out, gp_error *err)
 {
     *out = NULL;
-    if ((unsigned)f >= GP_EXPORT_NFORMATS)
-        return gp_error_set(err, GP_ERR_INVALID, "unknown export format %d", (int)f);
     if (!src || !src->read) return gp_error_set(err, GP_ERR_INVALID, "no source");
     if (src->size < GP_PACK_HEADER)
         return gp_error_set(err, GP_ERR_INVALID, "not an export pack (%llu bytes)",
                             (unsigned long long)src->size);
     gp_export *e = calloc(1, sizeof *e);
     if (!e) return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
-    e->format = f;
     e->src = *src;
     e->cache = malloc(CACHE_BYTES);
-    e->cap = 4096;
-    e->buf = malloc(e->cap);
-    if (!e->cache || !e->buf) {
+    if (!e->cache) {
         gp_export_destroy(e);
         return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
     }
@@ -499,37 +496,57 @@ gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_exp
     else if (h.version != GP_PACK_VERSION) why = "unknown version";
     else if (h.dim != 2 && h.dim != 3) why = "bad dimension";
     if (!why) {
-        e->dim = (int)h.dim;
-        e->flags = h.flags;
-        e->nitems = h.nitems;
-        e->npoints = h.npoints;
-        e->ndiscs = h.ndiscs;
-        e->density = h.density;
-        memcpy(e->lo, h.lo, sizeof e->lo);
-        memcpy(e->hi, h.hi, sizeof e->hi);
-        e->max_extent = h.max_extent;
+        e->info.dim = (int)h.dim;
+        e->info.flags = h.flags;
+        e->info.nitems = h.nitems;
+        e->info.npoints = h.npoints;
+        e->info.ndiscs = h.ndiscs;
+        e->info.density = h.density;
+        memcpy(e->info.lo, h.lo, sizeof e->info.lo);
+        memcpy(e->info.hi, h.hi, sizeof e->info.hi);
+        e->info.max_extent = h.max_extent;
         e->off_items = GP_PACK_HEADER;
         /* sizes are checked in floating point first so that a corrupt count cannot wrap */
         double need;
-        if (e->dim == 3) {
-            need = GP_PACK_HEADER + 32.0 * (double)e->nitems;
-            if (e->flags & GP_EXPORT_HAS_DEM) need += GP_PACK_DEM;
+        if (e->info.dim == 3) {
+            need = GP_PACK_HEADER + 32.0 * (double)e->info.nitems;
+            if (e->info.flags & GP_EXPORT_HAS_DEM) need += GP_PACK_DEM;
         } else {
-            need = GP_PACK_HEADER + (double)GP_PACK_GRAIN * (double)e->nitems +
-                   16.0 * (double)e->npoints + 24.0 * (double)e->ndiscs;
-            e->off_points = GP_PACK_HEADER + (uint64_t)GP_PACK_GRAIN * e->nitems;
-            e->off_discs = e->off_points + 16 * e->npoints;
+            need = GP_PACK_HEADER + (double)GP_PACK_GRAIN * (double)e->info.nitems +
+                   16.0 * (double)e->info.npoints + 24.0 * (double)e->info.ndiscs;
+            e->off_points = GP_PACK_HEADER + (uint64_t)GP_PACK_GRAIN * e->info.nitems;
+            e->off_discs = e->off_points + 16 * e->info.npoints;
         }
         if (need != (double)src->size) why = "its size does not match its counts";
     }
-    if (!why && e->dim == 3 && (e->flags & GP_EXPORT_HAS_DEM) && read_dem(e))
+    if (!why && e->info.dim == 3 && (e->info.flags & GP_EXPORT_HAS_DEM) && read_dem(e))
         why = "bad DEM block";
     if (why) {
         gp_export_destroy(e);
         return gp_error_set(err, GP_ERR_INVALID, "not an export pack: %s", why);
     }
-    if (!gp_export_format_supports(f, e->dim)) {
-        int dim = e->dim;
+    *out = e;
+    return GP_OK;
+}
+
+gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_export **out,
+                         gp_error *err)
+{
+    *out = NULL;
+    if ((unsigned)f >= GP_EXPORT_NFORMATS)
+        return gp_error_set(err, GP_ERR_INVALID, "unknown export format %d", (int)f);
+    gp_export *e;
+    gp_status st = pack_open(src, &e, err);
+    if (st) return st;
+    e->format = f;
+    e->cap = 4096;
+    e->buf = malloc(e->cap);
+    if (!e->buf) {
+        gp_export_destroy(e);
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    }
+    if (!gp_export_format_supports(f, e->info.dim)) {
+        int dim = e->info.dim;
         gp_export_destroy(e);
         return gp_error_set(err, GP_ERR_INVALID, "format %s does not exist in %dD (valid: %s)",
                             gp_export_format_name(f), dim, gp_export_format_list(dim));
@@ -538,7 +555,9 @@ gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_exp
     case GP_EXPORT_LAMMPS:
     case GP_EXPORT_LIGGGHTS: e->step = gp_export_step_lammps; break;
     case GP_EXPORT_YADE: e->step = gp_export_step_yade; break;
-    case GP_EXPORT_VTK: e->step = e->dim == 3 ? gp_export_step_vtk3d : gp_export_step_vtk2d; break;
+    case GP_EXPORT_VTK:
+        e->step = e->info.dim == 3 ? gp_export_step_vtk3d : gp_export_step_vtk2d;
+        break;
     case GP_EXPORT_LAMMPS_RELAX: e->step = gp_export_step_lammps_relax; break;
     default: e->step = gp_export_step_csv; break;
     }
@@ -591,4 +610,78 @@ void gp_export_destroy(gp_export *e)
     free(e->cache);
     free(e->buf);
     free(e);
+}
+
+/* ------------------------------------------------------------------ record reader */
+
+struct gp_export_reader {
+    gp_export *e; /* opened by pack_open: the header and the read cache, no format */
+};
+
+gp_status gp_export_reader_open(const gp_export_source *src, gp_export_reader **out,
+                                gp_error *err)
+{
+    *out = NULL;
+    gp_export_reader *r = calloc(1, sizeof *r);
+    if (!r) return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    gp_status st = pack_open(src, &r->e, err);
+    if (st) {
+        free(r);
+        return st;
+    }
+    *out = r;
+    return GP_OK;
+}
+
+const gp_export_info *gp_export_reader_info(const gp_export_reader *r) { return &r->e->info; }
+
+/* The index check of a public read: a record of the pack's kind (dim), index below count. */
+static gp_status reader_check(const gp_export_reader *r, int dim, const char *what, uint64_t k,
+                              uint64_t count, gp_error *err)
+{
+    if (r->e->info.dim != dim)
+        return gp_error_set(err, GP_ERR_INVALID, "a %dD pack has no %s records", r->e->info.dim,
+                            what);
+    if (k >= count)
+        return gp_error_set(err, GP_ERR_INVALID, "%s %llu of %llu", what, (unsigned long long)k,
+                            (unsigned long long)count);
+    return GP_OK;
+}
+
+/* The outcome of a record read: the reader's error, passed to the caller's. */
+static gp_status reader_result(const gp_export_reader *r, int failed, gp_error *err)
+{
+    return failed ? gp_error_set(err, r->e->err.code, "%s", r->e->err.message) : GP_OK;
+}
+
+gp_status gp_export_reader_sphere(gp_export_reader *r, uint64_t i, double q[4], gp_error *err)
+{
+    gp_status st = reader_check(r, 3, "sphere", i, r->e->info.nitems, err);
+    return st ? st : reader_result(r, gp_xr_sphere(r->e, i, q), err);
+}
+
+gp_status gp_export_reader_grain(gp_export_reader *r, uint64_t g, gp_export_grain *out,
+                                 gp_error *err)
+{
+    gp_status st = reader_check(r, 2, "grain", g, r->e->info.nitems, err);
+    return st ? st : reader_result(r, gp_xr_grain(r->e, g, out), err);
+}
+
+gp_status gp_export_reader_point(gp_export_reader *r, uint64_t k, double p[2], gp_error *err)
+{
+    gp_status st = reader_check(r, 2, "point", k, r->e->info.npoints, err);
+    return st ? st : reader_result(r, gp_xr_point(r->e, k, p), err);
+}
+
+gp_status gp_export_reader_disc(gp_export_reader *r, uint64_t k, double d[3], gp_error *err)
+{
+    gp_status st = reader_check(r, 2, "disc", k, r->e->info.ndiscs, err);
+    return st ? st : reader_result(r, gp_xr_disc(r->e, k, d), err);
+}
+
+void gp_export_reader_destroy(gp_export_reader *r)
+{
+    if (!r) return;
+    gp_export_destroy(r->e);
+    free(r);
 }

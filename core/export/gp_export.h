@@ -9,7 +9,8 @@
  *  2. gp_export_open() reads a pack through a byte-range reader (a memory buffer, an SQLite
  *     incremental blob, a file...) and gp_export_read() hands the file out in pieces of any
  *     size. Working memory is O(1) in the specimen size: one staging buffer of one record (a
- *     line) and a 64 KiB read cache.
+ *     line) and a 64 KiB read cache. A gp_export_reader (below) reads the pack's records
+ *     themselves, for a caller that draws or measures the specimen rather than writing a file.
  *
  * The format families live in gp_export_lammps.c (lammps, liggghts), gp_export_lammps_relax.c
  * (lammps-relax), gp_export_yade.c, gp_export_vtk.c and gp_export_csv.c, behind one small
@@ -137,5 +138,57 @@ gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_exp
 gp_status gp_export_read(gp_export *e, char *buf, size_t cap, size_t *n, gp_error *err);
 
 void gp_export_destroy(gp_export *e);
+
+/* ---- reading a pack's records ----
+ *
+ * For a caller that wants the specimen rather than a file (the service draws its SVG views from
+ * the pack): a reader opens a pack with the checks of gp_export_open (magic, byte order,
+ * version, sizes, DEM block) and hands out its records by index, in any order, through the same
+ * 64 KiB read cache. Reads near the previous one come from the cache, so a caller that walks two
+ * arrays together (each grain's record and its contour points) keeps a reader for each.
+ * A read returns GP_OK, or GP_ERR_INVALID for a record the pack does not have (a sphere of a 2D
+ * pack, an index past its count), a failed source read, or a grain record whose points or discs
+ * lie outside their arrays; the reader stays usable. Ownership and threads as for a gp_export:
+ * the source must outlive the reader; one thread at a time per reader, any number of readers
+ * (of the same pack too) at once. */
+
+typedef struct gp_export_reader gp_export_reader;
+
+/* A pack's header (layout above). */
+typedef struct gp_export_info {
+    int dim;            /* 2 or 3 */
+    unsigned flags;     /* GP_EXPORT_HAS_DESCRIPTORS, GP_EXPORT_HAS_DEM */
+    uint64_t nitems;    /* 3D: spheres; 2D: grains */
+    uint64_t npoints;   /* 2D: contour points of all grains */
+    uint64_t ndiscs;    /* 2D: ODEC discs of all grains */
+    double density;     /* kg/m^3 */
+    double lo[3], hi[3];/* the box (2D: the container's bounding box, z 0) */
+    double max_extent;  /* 2D: the largest grain's bounding-box diagonal */
+} gp_export_info;
+
+/* One 2D grain record. Its contour (the result's, point for point) is points point_first ..
+ * point_first + point_count - 1, its ODEC discs are discs disc_first .. disc_first +
+ * disc_count - 1; both ranges lie inside the pack's arrays. Values are the result's raw
+ * doubles: the four descriptors are NaN in a pack without GP_EXPORT_HAS_DESCRIPTORS, and any
+ * value may be non-finite where the result's is (the JSON result writes those as null). */
+typedef struct gp_export_grain {
+    uint64_t point_first, point_count, disc_first, disc_count;
+    double area, orientation_deg, elongation, roundness, circularity, regularity;
+} gp_export_grain;
+
+/* Opens a reader of the pack behind src (GP_ERR_INVALID when it is not one, GP_ERR_NOMEM). */
+gp_status gp_export_reader_open(const gp_export_source *src, gp_export_reader **out,
+                                gp_error *err);
+/* The pack's header; valid until gp_export_reader_destroy. */
+const gp_export_info *gp_export_reader_info(const gp_export_reader *r);
+/* 3D: sphere i as x, y, z, r (m). */
+gp_status gp_export_reader_sphere(gp_export_reader *r, uint64_t i, double q[4], gp_error *err);
+/* 2D: grain g's record. */
+gp_status gp_export_reader_grain(gp_export_reader *r, uint64_t g, gp_export_grain *out,
+                                 gp_error *err);
+/* 2D: contour point k (of all grains' points) as x, y; ODEC disc k as x, y, r. */
+gp_status gp_export_reader_point(gp_export_reader *r, uint64_t k, double p[2], gp_error *err);
+gp_status gp_export_reader_disc(gp_export_reader *r, uint64_t k, double d[3], gp_error *err);
+void gp_export_reader_destroy(gp_export_reader *r);
 
 #endif /* GP_EXPORT_H */

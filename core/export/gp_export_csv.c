@@ -7,7 +7,7 @@
 
 static int csv_header(gp_export *e)
 {
-    return gp_xw_printf(e, e->dim == 3 ? "x,y,z,r\n" : "grain,x,y,r\n");
+    return gp_xw_printf(e, e->info.dim == 3 ? "x,y,z,r\n" : "grain,x,y,r\n");
 }
 
 static int csv_sphere(gp_export *e, const double q[4])

@@ -19,12 +19,6 @@
 #define GP_PACK_DEM 128u  /* bytes of the 3D DEM block (GP_EXPORT_HAS_DEM) */
 #define GP_PACK_DEM_MAGIC "GPEXDEM3"
 
-/* One 2D grain record of the pack. */
-typedef struct gp_xgrain {
-    uint64_t point_first, point_count, disc_first, disc_count;
-    double area, orientation_deg, elongation, roundness, circularity, regularity;
-} gp_xgrain;
-
 /* The 3D DEM block of a pack (gp_export.h has its layout); present = 0 without one. */
 typedef struct gp_xdem {
     int present;
@@ -36,13 +30,7 @@ typedef struct gp_xdem {
 struct gp_export {
     gp_export_format format;
     gp_export_source src;
-    /* header */
-    int dim;
-    unsigned flags;
-    uint64_t nitems, npoints, ndiscs;
-    double density;
-    double lo[3], hi[3];
-    double max_extent;    /* 2D: largest grain bounding-box diagonal */
+    gp_export_info info;  /* the header */
     gp_xdem dem;          /* 3D: the DEM block, if the pack has one */
     uint64_t off_items, off_points, off_discs; /* byte offsets of the arrays */
     /* read cache */
@@ -56,7 +44,7 @@ struct gp_export {
     int (*step)(gp_export *e);
     int section;
     uint64_t index, sub;
-    gp_xgrain grain;      /* the grain at e->index (2D), loaded by the family */
+    gp_export_grain grain; /* the grain at e->index (2D), loaded by the family */
     double aux;           /* per-grain scratch (e.g. LAMMPS 2D density scale) */
     uint64_t file_bytes;  /* lammps-relax: size of the data file in the tar */
     int ntypes;           /* lammps-relax: size classes (atom types) */
@@ -73,7 +61,7 @@ int gp_xw_bytes(gp_export *e, const void *p, size_t n);
 
 /* Record readers (0 on success, -1 with e->err set). */
 int gp_xr_sphere(gp_export *e, uint64_t i, double q[4]);
-int gp_xr_grain(gp_export *e, uint64_t g, gp_xgrain *out);
+int gp_xr_grain(gp_export *e, uint64_t g, gp_export_grain *out);
 int gp_xr_point(gp_export *e, uint64_t k, double p[2]);
 int gp_xr_disc(gp_export *e, uint64_t k, double d[3]);
 

@@ -31,8 +31,8 @@ static int write_box(gp_export *e, uint64_t natoms, double zlo, double zhi, cons
                         "\n"
                         "Atoms # %s\n"
                         "\n",
-                        (unsigned long long)natoms, e->lo[0], e->hi[0], e->lo[1], e->hi[1], zlo,
-                        zhi, style);
+                        (unsigned long long)natoms, e->info.lo[0], e->info.hi[0], e->info.lo[1],
+                        e->info.hi[1], zlo, zhi, style);
 }
 
 static int header_3d(gp_export *e)
@@ -42,15 +42,15 @@ static int header_3d(gp_export *e)
                      "%s data file from grainpack (spheres-3d): %llu spheres, SI units\n"
                      "# read with: units si / atom_style sphere / %sread_data FILE\n"
                      "# atom line: id type diameter(m) density(kg/m^3) x y z (m)\n",
-                     lig ? "LIGGGHTS" : "LAMMPS", (unsigned long long)e->nitems,
+                     lig ? "LIGGGHTS" : "LAMMPS", (unsigned long long)e->info.nitems,
                      lig ? "atom_modify map array sort 0 0 / boundary f f f / " : ""))
         return -1;
-    return write_box(e, e->nitems, e->lo[2], e->hi[2], "sphere");
+    return write_box(e, e->info.nitems, e->info.lo[2], e->info.hi[2], "sphere");
 }
 
 static int header_2d(gp_export *e)
 {
-    double half = 0.5 * fmax(e->hi[0] - e->lo[0], e->hi[1] - e->lo[1]);
+    double half = 0.5 * fmax(e->info.hi[0] - e->info.lo[0], e->info.hi[1] - e->info.lo[1]);
     if (gp_xw_printf(
             e,
             "LAMMPS data file from grainpack (fourier-voronoi-2d): %llu grains as rigid bodies "
@@ -67,22 +67,23 @@ static int header_2d(gp_export *e)
             "#   comm_modify vel yes cutoff %.6g\n"
             "#   fix grains all rigid/small molecule\n"
             "#   fix plane all enforce2d\n",
-            (unsigned long long)e->nitems, (unsigned long long)e->ndiscs, e->density,
-            1.5 * e->max_extent))
+            (unsigned long long)e->info.nitems, (unsigned long long)e->info.ndiscs, e->info.density,
+            1.5 * e->info.max_extent))
         return -1;
-    return write_box(e, e->ndiscs, -half, half, "hybrid");
+    return write_box(e, e->info.ndiscs, -half, half, "hybrid");
 }
 
 static int lammps_header(gp_export *e)
 {
-    return e->dim == 3 ? header_3d(e) : header_2d(e);
+    return e->info.dim == 3 ? header_3d(e) : header_2d(e);
 }
 
 /* 3D atom line: id type diameter density x y z */
 static int lammps_sphere(gp_export *e, const double q[4])
 {
     return gp_xw_printf(e, "%llu 1 %.17g %.17g %.17g %.17g %.17g\n",
-                        (unsigned long long)e->index + 1, 2.0 * q[3], e->density, q[0], q[1], q[2]);
+                        (unsigned long long)e->index + 1, 2.0 * q[3], e->info.density, q[0], q[1],
+                        q[2]);
 }
 
 /* Loads grain e->index into e->grain and its disc density scale into e->aux. */
@@ -103,7 +104,7 @@ static int load_grain(gp_export *e)
 static int lammps_disc(gp_export *e, const double d[3])
 {
     /* mass = (4/3) pi r^3 rho' = rho * scale * pi r^2, see the file comment */
-    double rho = e->density * e->aux * 0.75 / d[2];
+    double rho = e->info.density * e->aux * 0.75 / d[2];
     return gp_xw_printf(e, "%llu 1 %.17g %.17g 0 %.17g %.17g %llu\n",
                         (unsigned long long)(e->grain.disc_first + e->sub + 1), d[0], d[1],
                         2.0 * d[2], rho, (unsigned long long)e->index + 1);

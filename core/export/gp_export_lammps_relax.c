@@ -113,15 +113,16 @@ static int data_head(gp_export *e)
                         "\n"
                         "Atoms # sphere\n"
                         "\n",
-                        (unsigned long long)e->nitems, (unsigned long long)e->nitems, e->ntypes,
-                        e->lo[0], e->hi[0], e->lo[1], e->hi[1], e->lo[2], e->hi[2]);
+                        (unsigned long long)e->info.nitems, (unsigned long long)e->info.nitems, e->ntypes,
+                        e->info.lo[0], e->info.hi[0], e->info.lo[1], e->info.hi[1], e->info.lo[2],
+                        e->info.hi[2]);
 }
 
 /* the atom line of sphere i, q = x, y, z, r (the true density: relax.in scales the inertia) */
 static int data_atom(gp_export *e, uint64_t i, const double q[4])
 {
     return gp_xw_printf(e, "%llu %d %.17g %.17g %.17g %.17g %.17g\n", (unsigned long long)i + 1,
-                        size_class(e, q[3]), 2.0 * q[3], e->density, q[0], q[1], q[2]);
+                        size_class(e, q[3]), 2.0 * q[3], e->info.density, q[0], q[1], q[2]);
 }
 
 /* The data file's size: its header and every atom line formatted once into the (empty)
@@ -132,7 +133,7 @@ static int data_size(gp_export *e, uint64_t *bytes)
     if (data_head(e)) return -1;
     n += e->len;
     e->len = 0;
-    for (uint64_t i = 0; i < e->nitems; i++) {
+    for (uint64_t i = 0; i < e->info.nitems; i++) {
         double q[4];
         if (gp_xr_sphere(e, i, q) || data_atom(e, i, q)) return -1;
         n += e->len;
@@ -187,8 +188,8 @@ static int script_head(gp_export *e)
         "# - porosity = 1 - (sphere volumes clipped to the box) / box volume; coordination number =\n"
         "#   (2 sphere-sphere contacts + wall contacts) / spheres, rattlers included (as grainpack).\n"
         "\n",
-        d->stability, (unsigned long long)e->nitems, e->lo[0], e->hi[0], e->lo[1], e->hi[1],
-        e->lo[2], e->hi[2], d->tiling[0], d->tiling[1], d->tiling[2], d->porosity,
+        d->stability, (unsigned long long)e->info.nitems, e->info.lo[0], e->info.hi[0], e->info.lo[1],
+        e->info.hi[1], e->info.lo[2], e->info.hi[2], d->tiling[0], d->tiling[1], d->tiling[2], d->porosity,
         d->coordination, MAX_STEPS, EVERY, d->young, e->ntypes, e->type_ratio, 100 * err,
         d->poisson, d->friction_deg, d->gravity, d->relax_damping, d->damping, d->scaled_radius,
         d->dt);
@@ -238,8 +239,8 @@ static int script_model(gp_export *e)
 static int script_forces(gp_export *e)
 {
     const gp_xdem *d = &e->dem;
-    double rho43 = 4.0 / 3.0 * M_PI * e->density, rs = d->scaled_radius;
-    const double *L = e->hi;
+    double rho43 = 4.0 / 3.0 * M_PI * e->info.density, rs = d->scaled_radius;
+    const double *L = e->info.hi;
     if (gp_xw_printf(e,
                      "# radii, and the inertia of density scaling (r_s = %.17g m)\n"
                      "compute         r all property/atom radius\n"
@@ -259,20 +260,20 @@ static int script_forces(gp_export *e)
                          "variable        h%cl atom 0.5*(c_r-(%c-%.17g)+abs(c_r-(%c-%.17g)))\n"
                          "variable        h%ch atom 0.5*(c_r-(%.17g-%c)+abs(c_r-(%.17g-%c)))\n"
                          "variable        fw%c atom %.17g*c_r*(v_h%cl-v_h%ch)\n",
-                         ax[a], ax[a], e->lo[a], ax[a], e->lo[a], ax[a], L[a], ax[a], L[a], ax[a],
-                         ax[a], 2 * d->young, ax[a], ax[a]))
+                         ax[a], ax[a], e->info.lo[a], ax[a], e->info.lo[a], ax[a], L[a], ax[a], L[a],
+                         ax[a], ax[a], 2 * d->young, ax[a], ax[a]))
             return -1;
     /* only the spheres within rmax of a face can touch one: the others skip the variables */
     double rm = d->rmax;
     int thin = 0;
-    for (int a = 0; a < 3; a++) thin |= L[a] - e->lo[a] < 4 * rm;
+    for (int a = 0; a < 3; a++) thin |= L[a] - e->info.lo[a] < 4 * rm;
     if (thin ? gp_xw_printf(e, "group           nearwall union all\n")
              : gp_xw_printf(e,
                             "region          core block %.17g %.17g %.17g %.17g %.17g %.17g side "
                             "out units box\n"
                             "group           nearwall dynamic all region core every 1\n",
-                            e->lo[0] + rm, L[0] - rm, e->lo[1] + rm, L[1] - rm, e->lo[2] + rm,
-                            L[2] - rm))
+                            e->info.lo[0] + rm, L[0] - rm, e->info.lo[1] + rm, L[1] - rm,
+                            e->info.lo[2] + rm, L[2] - rm))
         return -1;
     double c = d->relax_damping;
     return gp_xw_printf(
@@ -295,7 +296,8 @@ static int script_forces(gp_export *e)
 /* S_c, the coordination number and the porosity, each measured as grainpack measures it */
 static int script_measures(gp_export *e)
 {
-    double V = (e->hi[0] - e->lo[0]) * (e->hi[1] - e->lo[1]) * (e->hi[2] - e->lo[2]);
+    const double *lo = e->info.lo, *hi = e->info.hi;
+    double V = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
     return gp_xw_printf(
         e,
         "# S_c (Eq. 7): sum |F| / (2 sum of pair f_n + sum of wall f_n)\n"
@@ -403,13 +405,13 @@ int gp_export_step_lammps_relax(gp_export *e)
         e->section = SEC_DATA_HEAD;
         return write_script(e) ? -1 : 0;
     case SEC_DATA_HEAD:
-        e->section = e->nitems ? SEC_ATOMS : SEC_END;
+        e->section = e->info.nitems ? SEC_ATOMS : SEC_END;
         e->index = 0;
         return write_data_head(e) ? -1 : 0;
     case SEC_ATOMS: {
         double q[4];
         if (gp_xr_sphere(e, e->index, q) || data_atom(e, e->index, q)) return -1;
-        if (++e->index >= e->nitems) e->section = SEC_END;
+        if (++e->index >= e->info.nitems) e->section = SEC_END;
         return 0;
     }
     default: /* the data file's padding, then the end of the archive: two zero blocks */

@@ -21,7 +21,7 @@ enum { V3_HEAD, V3_POINTS, V3_VERTS_HEAD, V3_VERTS, V3_DATA_HEAD, V3_RADIUS };
 int gp_export_step_vtk3d(gp_export *e)
 {
     double q[4];
-    unsigned long long n = (unsigned long long)e->nitems;
+    unsigned long long n = (unsigned long long)e->info.nitems;
     switch (e->section) {
     case V3_HEAD:
         if (gp_xw_printf(e,
@@ -33,7 +33,8 @@ int gp_export_step_vtk3d(gp_export *e)
                          "box_lo 3 1 double\n%.17g %.17g %.17g\n"
                          "box_hi 3 1 double\n%.17g %.17g %.17g\n"
                          "POINTS %llu double\n",
-                         n, e->lo[0], e->lo[1], e->lo[2], e->hi[0], e->hi[1], e->hi[2], n))
+                         n, e->info.lo[0], e->info.lo[1], e->info.lo[2], e->info.hi[0], e->info.hi[1],
+                         e->info.hi[2], n))
             return -1;
         e->section = n ? V3_POINTS : V3_VERTS_HEAD;
         e->index = 0;
@@ -41,7 +42,7 @@ int gp_export_step_vtk3d(gp_export *e)
     case V3_POINTS:
         if (gp_xr_sphere(e, e->index, q) || gp_xw_printf(e, "%.17g %.17g %.17g\n", q[0], q[1], q[2]))
             return -1;
-        if (++e->index >= e->nitems) e->section = V3_VERTS_HEAD;
+        if (++e->index >= e->info.nitems) e->section = V3_VERTS_HEAD;
         return 0;
     case V3_VERTS_HEAD:
         if (gp_xw_printf(e, "VERTICES %llu %llu\n", n, 2 * n)) return -1;
@@ -50,7 +51,7 @@ int gp_export_step_vtk3d(gp_export *e)
         return 0;
     case V3_VERTS:
         if (gp_xw_printf(e, "1 %llu\n", (unsigned long long)e->index)) return -1;
-        if (++e->index >= e->nitems) e->section = V3_DATA_HEAD;
+        if (++e->index >= e->info.nitems) e->section = V3_DATA_HEAD;
         return 0;
     case V3_DATA_HEAD:
         if (gp_xw_printf(e, "POINT_DATA %llu\nSCALARS radius double 1\nLOOKUP_TABLE default\n", n))
@@ -60,7 +61,7 @@ int gp_export_step_vtk3d(gp_export *e)
         return n == 0;
     default:
         if (gp_xr_sphere(e, e->index, q) || gp_xw_printf(e, "%.17g\n", q[3])) return -1;
-        return ++e->index >= e->nitems;
+        return ++e->index >= e->info.nitems;
     }
 }
 
@@ -89,10 +90,10 @@ static const char *const cell_arrays[] = {"grain_id",   "area",      "orientatio
 
 static int n_cell_arrays(const gp_export *e)
 {
-    return (e->flags & GP_EXPORT_HAS_DESCRIPTORS) ? 7 : 3;
+    return (e->info.flags & GP_EXPORT_HAS_DESCRIPTORS) ? 7 : 3;
 }
 
-static double grain_value(const gp_xgrain *g, int a)
+static double grain_value(const gp_export_grain *g, int a)
 {
     switch (a) {
     case 1: return g->area;
@@ -105,7 +106,7 @@ static double grain_value(const gp_xgrain *g, int a)
 }
 
 /* One value of array a for grain g, repeated `times` times (one line each). */
-static int write_values(gp_export *e, int a, uint64_t g, const gp_xgrain *gr, uint64_t times)
+static int write_values(gp_export *e, int a, uint64_t g, const gp_export_grain *gr, uint64_t times)
 {
     for (uint64_t k = 0; k < times; k++) {
         int rc = a == 0 ? gp_xw_printf(e, "%llu\n", (unsigned long long)g)
@@ -117,8 +118,9 @@ static int write_values(gp_export *e, int a, uint64_t g, const gp_xgrain *gr, ui
 
 int gp_export_step_vtk2d(gp_export *e)
 {
-    unsigned long long np = (unsigned long long)(e->npoints + e->ndiscs);
-    unsigned long long nd = (unsigned long long)e->ndiscs, ng = (unsigned long long)e->nitems;
+    unsigned long long np = (unsigned long long)(e->info.npoints + e->info.ndiscs);
+    unsigned long long nd = (unsigned long long)e->info.ndiscs;
+    unsigned long long ng = (unsigned long long)e->info.nitems;
     double p[3];
     int a = (int)e->aux;
     switch (e->section) {
@@ -133,20 +135,20 @@ int gp_export_step_vtk2d(gp_export *e)
                          ng, nd, np))
             return -1;
         e->index = 0;
-        e->section = e->npoints ? V2_CONTOUR : e->ndiscs ? V2_DISCS : V2_VERTS_HEAD;
+        e->section = e->info.npoints ? V2_CONTOUR : e->info.ndiscs ? V2_DISCS : V2_VERTS_HEAD;
         return 0;
     case V2_CONTOUR:
         if (gp_xr_point(e, e->index, p) || gp_xw_printf(e, "%.17g %.17g 0\n", p[0], p[1]))
             return -1;
-        if (++e->index >= e->npoints) {
+        if (++e->index >= e->info.npoints) {
             e->index = 0;
-            e->section = e->ndiscs ? V2_DISCS : V2_VERTS_HEAD;
+            e->section = e->info.ndiscs ? V2_DISCS : V2_VERTS_HEAD;
         }
         return 0;
     case V2_DISCS:
         if (gp_xr_disc(e, e->index, p) || gp_xw_printf(e, "%.17g %.17g 0\n", p[0], p[1]))
             return -1;
-        if (++e->index >= e->ndiscs) e->section = V2_VERTS_HEAD;
+        if (++e->index >= e->info.ndiscs) e->section = V2_VERTS_HEAD;
         return 0;
     case V2_VERTS_HEAD:
         if (gp_xw_printf(e, "VERTICES %llu %llu\n", nd, 2 * nd)) return -1;
@@ -154,24 +156,25 @@ int gp_export_step_vtk2d(gp_export *e)
         e->section = nd ? V2_VERTS : V2_POLYS_HEAD;
         return 0;
     case V2_VERTS:
-        if (gp_xw_printf(e, "1 %llu\n", (unsigned long long)(e->npoints + e->index))) return -1;
-        if (++e->index >= e->ndiscs) e->section = V2_POLYS_HEAD;
+        if (gp_xw_printf(e, "1 %llu\n", (unsigned long long)(e->info.npoints + e->index)))
+            return -1;
+        if (++e->index >= e->info.ndiscs) e->section = V2_POLYS_HEAD;
         return 0;
     case V2_POLYS_HEAD:
         if (gp_xw_printf(e, "POLYGONS %llu %llu\n", ng,
-                         ng + (unsigned long long)e->npoints))
+                         ng + (unsigned long long)e->info.npoints))
             return -1;
         e->index = 0;
         e->section = ng ? V2_POLYS : V2_CELL_HEAD;
         return 0;
     case V2_POLYS: {
-        gp_xgrain g;
+        gp_export_grain g;
         if (gp_xr_grain(e, e->index, &g)) return -1;
         if (gp_xw_printf(e, "%llu", (unsigned long long)g.point_count)) return -1;
         for (uint64_t k = 0; k < g.point_count; k++)
             if (gp_xw_printf(e, " %llu", (unsigned long long)(g.point_first + k))) return -1;
         if (gp_xw_printf(e, "\n")) return -1;
-        if (++e->index >= e->nitems) e->section = V2_CELL_HEAD;
+        if (++e->index >= e->info.nitems) e->section = V2_CELL_HEAD;
         return 0;
     }
     case V2_CELL_HEAD:
@@ -193,11 +196,11 @@ int gp_export_step_vtk2d(gp_export *e)
         return 0;
     case V2_ARRAY_DISCS:
     case V2_ARRAY_POLYS: {
-        gp_xgrain g;
+        gp_export_grain g;
         if (gp_xr_grain(e, e->index, &g)) return -1;
         int discs = e->section == V2_ARRAY_DISCS;
         if (write_values(e, a, e->index, &g, discs ? g.disc_count : 1)) return -1;
-        if (++e->index >= e->nitems) {
+        if (++e->index >= e->info.nitems) {
             e->index = 0;
             if (discs) {
                 e->section = V2_ARRAY_POLYS;
@@ -212,20 +215,20 @@ int gp_export_step_vtk2d(gp_export *e)
         if (gp_xw_printf(e, "POINT_DATA %llu\nSCALARS radius double 1\nLOOKUP_TABLE default\n", np))
             return -1;
         e->index = 0;
-        if (e->npoints) e->section = V2_RADIUS_CONTOUR;
-        else if (e->ndiscs) e->section = V2_RADIUS_DISCS;
+        if (e->info.npoints) e->section = V2_RADIUS_CONTOUR;
+        else if (e->info.ndiscs) e->section = V2_RADIUS_DISCS;
         else return 1;
         return 0;
     case V2_RADIUS_CONTOUR:
         if (gp_xw_printf(e, "0\n")) return -1;
-        if (++e->index >= e->npoints) {
+        if (++e->index >= e->info.npoints) {
             e->index = 0;
-            if (!e->ndiscs) return 1;
+            if (!e->info.ndiscs) return 1;
             e->section = V2_RADIUS_DISCS;
         }
         return 0;
     default:
         if (gp_xr_disc(e, e->index, p) || gp_xw_printf(e, "%.17g\n", p[2])) return -1;
-        return ++e->index >= e->ndiscs;
+        return ++e->index >= e->info.ndiscs;
     }
 }

@@ -8,14 +8,14 @@
 
 static int yade_header(gp_export *e)
 {
-    if (e->dim == 3)
+    if (e->info.dim == 3)
         return gp_xw_printf(e, "# grainpack spheres-3d, %llu spheres, SI (m); "
                                "yade: ymport.text(FILE)\n# x y z r\n",
-                            (unsigned long long)e->nitems);
+                            (unsigned long long)e->info.nitems);
     return gp_xw_printf(e, "# grainpack fourier-voronoi-2d, %llu grains, %llu discs, "
                            "SI (m); yade: ymport.textClumps(FILE)\n"
                            "# x y z r clumpId\n",
-                        (unsigned long long)e->nitems, (unsigned long long)e->ndiscs);
+                        (unsigned long long)e->info.nitems, (unsigned long long)e->info.ndiscs);
 }
 
 static int yade_sphere(gp_export *e, const double q[4])

@@ -38,7 +38,7 @@ struct gp_svg_items {
     size_t idx;
     js_scan *js; /* scan */
     uint64_t off;
-    gp_export *e, *ep; /* pack: its grain or sphere records, its contour points (a reader of
+    gp_export_reader *e, *ep; /* pack: its grain or sphere records, its contour points (a reader of
                         * its own, so that both are read in order, each through its cache) */
     uint64_t k;
 };

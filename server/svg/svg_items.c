@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gp_export_internal.h" /* the pack's record readers (gp_xr_grain, gp_xr_point, ...) */
 #include "svg/svg_internal.h"
 
 const char *const svg_items_part_name[3] = {"grains", "cells", "spheres"};
@@ -112,8 +111,8 @@ void gp_svg_items_close(gp_svg_items *it)
 {
     if (it) {
         json_scan_close(it->js);
-        gp_export_destroy(it->e);
-        gp_export_destroy(it->ep);
+        gp_export_reader_destroy(it->e);
+        gp_export_reader_destroy(it->ep);
         svg_items_free(&it->cur);
     }
     free(it);
@@ -414,21 +413,21 @@ static int pack_rewind(gp_svg_items *it)
 
 static int pack_next(gp_svg_items *it)
 {
-    gp_export *e = it->e;
+    gp_export_reader *e = it->e;
     svg_item *c = &it->cur;
-    if (it->k >= e->nitems) return 0;
+    if (it->k >= gp_export_reader_info(e)->nitems) return 0;
     uint64_t k = it->k++;
     item_clear(c);
     if (it->part == GP_SVG_SPHERES) {
-        if (gp_xr_sphere(e, k, c->q)) return -1;
+        if (gp_export_reader_sphere(e, k, c->q, NULL)) return -1;
         return 1;
     }
-    gp_xgrain g;
-    if (gp_xr_grain(e, k, &g)) return -1;
+    gp_export_grain g;
+    if (gp_export_reader_grain(e, k, &g, NULL)) return -1;
     if (!it->light) {
         if (pts_room(c, (size_t)g.point_count)) return -1;
         for (uint64_t i = 0; i < g.point_count; i++)
-            if (gp_xr_point(it->ep, g.point_first + i, c->xy + 2 * i)) return -1;
+            if (gp_export_reader_point(it->ep, g.point_first + i, c->xy + 2 * i, NULL)) return -1;
         c->npts = (size_t)g.point_count;
     }
     c->area = g.area;
@@ -453,10 +452,9 @@ gp_svg_items *gp_svg_items_pack(const gp_export_source *pack, gp_svg_part part)
     gp_svg_items *it = items_new(part);
     if (!it) return NULL;
     gp_error err;
-    /* any format opens the pack and checks its header; only the record readers are used */
-    if (gp_export_open(GP_EXPORT_CSV, pack, &it->e, &err) ||
-        it->e->dim != (part == GP_SVG_SPHERES ? 3 : 2) ||
-        (part == GP_SVG_GRAINS && gp_export_open(GP_EXPORT_CSV, pack, &it->ep, &err))) {
+    if (gp_export_reader_open(pack, &it->e, &err) ||
+        gp_export_reader_info(it->e)->dim != (part == GP_SVG_SPHERES ? 3 : 2) ||
+        (part == GP_SVG_GRAINS && gp_export_reader_open(pack, &it->ep, &err))) {
         gp_svg_items_close(it);
         return NULL;
     }

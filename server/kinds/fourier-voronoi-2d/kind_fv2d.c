@@ -542,7 +542,6 @@ static json_t *brief(const json_t *spec, const json_t *stats)
  *   (fill, then describe) with its own fraction: the plan has the first round's two passes
  *   and the second round as one entry weighted by how often it runs (its describe pass is a
  *   repass of that entry, progress.c). */
-#define CAL_CELLS_MAX 500      /* the core's CAL_MAX_CELLS */
 #define CAL_ROUND2_SHARE 0.6
 /* - shape.outlines, phase "shape": gp_outline_set_analyze, ~0.37 ms an outline at Np 128
  *   and ~1.7 ms at 512 (100-1,000 outlines of 64-1,000 vertices: the vertices barely count) */
@@ -590,7 +589,7 @@ static int plan(const void *spec_, const json_t *spec_json, gpd_phase *out, int 
     ph[k++] = (gpd_phase){"imc", moves * COST_IMC_S *
                                      (1 + COST_IMC_DECADE * log10(fmax(n, 1000) / 1000)), 0};
     if (grains && form == GP_SHAPE_FORM_DESCRIPTORS) {
-        double m = fmin(n, CAL_CELLS_MAX) * scale;
+        double m = fmin(n, GP_SPECIMEN2D_CALIBRATION_CELLS) * scale;
         ph[k++] = (gpd_phase){"calibration", COST_FILL_S * m, 1};
         ph[k++] = (gpd_phase){"calibration", COST_DESC_S * m, 1};
         ph[k++] = (gpd_phase){"calibration", CAL_ROUND2_SHARE * (COST_FILL_S + COST_DESC_S) * m,
