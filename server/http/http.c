@@ -24,6 +24,7 @@
 #include "jobs/metrics.h"
 #include "http/offload.h"
 #include "http/page.h"
+#include "http/routes.h"
 #include "kinds/fourier-voronoi-2d/shapes.h"
 #include "store/store.h"
 #include "svg/svg_job.h"
@@ -56,9 +57,17 @@ typedef struct req {
      * the handler; its response is kept here until the connection is resumed */
     int offloaded;
     struct MHD_Connection *conn;
-    enum MHD_Result (*handler)(struct MHD_Connection *, struct req *);
+    enum MHD_Result (*handler)(struct MHD_Connection *, struct req *, const char *);
     struct MHD_Response *resp;
+    /* the route of the path (routes.h; NULL: none) and its {id}, matched when the request
+     * arrives: the router answers by it, the metrics count by it */
+    const gpd_route *route;
+    char id[GPD_ROUTE_PARAM_MAX];
 } req;
+
+/* a handler of the route table (routes.h: gpd_handler): id is the route's {id}, "" for a route
+ * without one */
+typedef enum MHD_Result (*handler_fn)(struct MHD_Connection *c, req *r, const char *id);
 
 /* *con_cls before the access handler has run: the length of the request target (on_uri) */
 #define URI_LEN_TAGGED(p) (((uintptr_t)(p)) & 1u)
@@ -201,8 +210,6 @@ static const char *qarg(struct MHD_Connection *c, const char *name)
     return MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, name);
 }
 
-static int is_get(const char *m) { return !strcmp(m, "GET") || !strcmp(m, "HEAD"); }
-
 static int valid_status(const char *s)
 {
     static const char *all[] = {"queued", "running", "succeeded", "failed", "cancelled"};
@@ -213,8 +220,9 @@ static int valid_status(const char *s)
 
 /* ------------------------------------------------------------------ handlers */
 
-static enum MHD_Result h_health(struct MHD_Connection *c, req *r)
+static enum MHD_Result h_health(struct MHD_Connection *c, req *r, const char *id)
 {
+    (void)id;
     long q = 0, run = 0, su = 0, f = 0, ca = 0;
     store_rc rc = store_counts(&q, &run, &su, &f, &ca);
     json_t *j = json_object();
@@ -244,8 +252,9 @@ static enum MHD_Result h_health(struct MHD_Connection *c, req *r)
     return send_json(c, r, rc == STORE_OK ? 200 : 503, j);
 }
 
-static enum MHD_Result h_schema(struct MHD_Connection *c, req *r)
+static enum MHD_Result h_schema(struct MHD_Connection *c, req *r, const char *id)
 {
+    (void)id;
     const char *kind = qarg(c, "kind");
     const char *doc = kind ? gp_schema_text(kind) : gp_schema_document();
     if (!doc) {
@@ -259,17 +268,19 @@ static enum MHD_Result h_schema(struct MHD_Connection *c, req *r)
 }
 
 /* GET /metrics: the Prometheus text exposition (metrics.h) */
-static enum MHD_Result h_metrics(struct MHD_Connection *c, req *r)
+static enum MHD_Result h_metrics(struct MHD_Connection *c, req *r, const char *id)
 {
+    (void)id;
     size_t len = 0;
-    char *text = metrics_render(&len);
+    char *text = metrics_render(workers_total(), workers_busy(), &len);
     if (!text) return send_error(c, r, 500, "internal", NULL, "out of memory");
     return send_buf(c, r, 200, "text/plain; version=0.0.4; charset=utf-8", text, len,
                     MHD_RESPMEM_MUST_FREE, NULL);
 }
 
-static enum MHD_Result h_dashboard(struct MHD_Connection *c, req *r)
+static enum MHD_Result h_dashboard(struct MHD_Connection *c, req *r, const char *id)
 {
+    (void)id;
     const char *html = gpd_page_html();
     if (!html) return send_error(c, r, 500, "internal", NULL, "out of memory");
     return send_buf(c, r, 200, "text/html; charset=utf-8", (char *)html, strlen(html),
@@ -332,8 +343,9 @@ static json_t *effective_spec(struct MHD_Connection *c, req *r, const gpd_kind *
     return eff;
 }
 
-static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
+static enum MHD_Result h_submit(struct MHD_Connection *c, req *r, const char *no_id)
 {
+    (void)no_id; /* the route has none: id is the new job's */
     if (r->len == 0)
         return send_error(c, r, 400, "invalid_json", NULL,
                           "the request body is empty; expected a JSON spec object");
@@ -373,15 +385,17 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r)
 }
 
 /* POST /v1/shapes/analyze: outlines or an image -> their spectrum, at once (shapes.h) */
-static enum MHD_Result h_shapes(struct MHD_Connection *c, req *r)
+static enum MHD_Result h_shapes(struct MHD_Connection *c, req *r, const char *id)
 {
+    (void)id;
     int status = 500;
     json_t *j = gpd_shapes_analyze(r->body, r->len, &status);
     return send_json(c, r, (unsigned)status, j);
 }
 
-static enum MHD_Result h_list(struct MHD_Connection *c, req *r)
+static enum MHD_Result h_list(struct MHD_Connection *c, req *r, const char *id)
 {
+    (void)id;
     const char *status = qarg(c, "status");
     const char *lim = qarg(c, "limit");
     const char *after = qarg(c, "after");
@@ -745,6 +759,29 @@ static enum MHD_Result h_export(struct MHD_Connection *c, req *r, const char *id
                        free_export, disp);
 }
 
+/* GET /v1/jobs/{id}/svg and /export: by the job's kind */
+static enum MHD_Result h_job_svg(struct MHD_Connection *c, req *r, const char *id)
+{
+    return with_kind(c, r, id, h_svg);
+}
+
+static enum MHD_Result h_job_export(struct MHD_Connection *c, req *r, const char *id)
+{
+    return with_kind(c, r, id, h_export);
+}
+
+/* the functions of the route table's handlers (routes.h); gpd_http_start checks that every
+ * handler the table names has one */
+static const handler_fn handlers[GPD_H_COUNT] = {
+    [GPD_H_DASHBOARD] = h_dashboard, [GPD_H_METRICS] = h_metrics,
+    [GPD_H_HEALTH] = h_health,       [GPD_H_SCHEMA] = h_schema,
+    [GPD_H_SHAPES] = h_shapes,       [GPD_H_LIST] = h_list,
+    [GPD_H_SUBMIT] = h_submit,       [GPD_H_JOB] = h_job,
+    [GPD_H_CANCEL] = h_cancel,       [GPD_H_RESULT] = h_result,
+    [GPD_H_SVG] = h_job_svg,         [GPD_H_EXPORT] = h_job_export,
+    [GPD_H_SPEC] = h_spec,           [GPD_H_SUMMARY] = h_summary,
+};
+
 /* a CORS preflight of an accepted origin: 204 with what it may send */
 static enum MHD_Result preflight(struct MHD_Connection *c, req *r)
 {
@@ -807,15 +844,14 @@ static enum MHD_Result method_not_allowed(struct MHD_Connection *c, req *r, cons
 static void run_offloaded(void *arg)
 {
     req *r = arg;
-    if (r->handler(r->conn, r) != MHD_YES && !r->resp) r->status = -1; /* close it */
+    if (r->handler(r->conn, r, r->id) != MHD_YES && !r->resp) r->status = -1; /* close it */
     MHD_resume_connection(r->conn);
 }
 
 /* Answers r by h off the HTTP threads (offload.h): the connection is suspended until the
  * response is ready, and on_request queues it. Where the pool does not take it (shutting
  * down), h runs here. */
-static enum MHD_Result offload(struct MHD_Connection *c, req *r,
-                               enum MHD_Result (*h)(struct MHD_Connection *, req *))
+static enum MHD_Result offload(struct MHD_Connection *c, req *r, handler_fn h)
 {
     r->conn = c;
     r->handler = h;
@@ -824,13 +860,17 @@ static enum MHD_Result offload(struct MHD_Connection *c, req *r,
     if (gpd_offload_submit(run_offloaded, r) == 0) return MHD_YES;
     MHD_resume_connection(c);
     r->offloaded = 0;
-    return h(c, r);
+    return h(c, r, r->id);
 }
 
+/* Answers r by the route table (routes.h): 404 for a path no route matches, 405 with the
+ * route's Allow for a method it does not answer, 404 for an {id} that cannot be a job id, else
+ * the method's handler, offloaded or here. */
 static enum MHD_Result route(struct MHD_Connection *c, req *r, const char *url,
                              const char *method)
 {
-    /* canonical path: drop one trailing slash (but keep "/") */
+    /* canonical path, for the messages: drop one trailing slash (but keep "/"), as the
+     * matcher does */
     char path[512];
     size_t ul = strlen(url);
     if (ul >= sizeof path)
@@ -838,67 +878,16 @@ static enum MHD_Result route(struct MHD_Connection *c, req *r, const char *url,
     memcpy(path, url, ul + 1);
     if (ul > 1 && path[ul - 1] == '/') path[--ul] = '\0';
 
-    if (!strcmp(path, "/")) {
-        if (!is_get(method)) return method_not_allowed(c, r, method, path, "GET, HEAD");
-        return h_dashboard(c, r);
-    }
-    if (!strcmp(path, "/metrics")) {
-        if (!is_get(method)) return method_not_allowed(c, r, method, path, "GET, HEAD");
-        return h_metrics(c, r);
-    }
-    if (!strcmp(path, "/v1/health")) {
-        if (!is_get(method)) return method_not_allowed(c, r, method, path, "GET, HEAD");
-        return h_health(c, r);
-    }
-    if (!strcmp(path, "/v1/schema")) {
-        if (!is_get(method)) return method_not_allowed(c, r, method, path, "GET, HEAD");
-        return h_schema(c, r);
-    }
-    if (!strcmp(path, "/v1/jobs")) {
-        /* parsing and validating a body costs CPU in proportion to it: off the HTTP threads */
-        if (!strcmp(method, "POST")) return offload(c, r, h_submit);
-        if (is_get(method)) return h_list(c, r);
-        return method_not_allowed(c, r, method, path, "GET, HEAD, POST");
-    }
-    if (!strcmp(path, "/v1/shapes/analyze")) {
-        /* the analysis costs CPU in proportion to the body: off the HTTP threads */
-        if (!strcmp(method, "POST")) return offload(c, r, h_shapes);
-        return method_not_allowed(c, r, method, path, "POST");
-    }
-    if (!strncmp(path, "/v1/jobs/", 9)) {
-        char id[80];
-        const char *p = path + 9;
-        const char *slash = strchr(p, '/');
-        size_t il = slash ? (size_t)(slash - p) : strlen(p);
-        if (il == 0 || il >= sizeof id)
-            return send_error(c, r, 404, "not_found", NULL, "no such resource: %.128s", path);
-        memcpy(id, p, il);
-        id[il] = '\0';
-        const char *sub = slash ? slash + 1 : NULL;
-        if (!sub) {
-            if (!strcmp(method, "DELETE")) {
-                if (!gpd_id_is_plausible(id)) return not_found(c, r, id);
-                return h_cancel(c, r, id);
-            }
-            if (!is_get(method))
-                return method_not_allowed(c, r, method, path, "GET, HEAD, DELETE");
-            if (!gpd_id_is_plausible(id)) return not_found(c, r, id);
-            return h_job(c, r, id);
-        }
-        enum MHD_Result (*h)(struct MHD_Connection *, req *, const char *) = NULL;
-        kind_handler hk = NULL;
-        if (!strcmp(sub, "result")) h = h_result;
-        else if (!strcmp(sub, "svg")) hk = h_svg;
-        else if (!strcmp(sub, "export")) hk = h_export;
-        else if (!strcmp(sub, "spec")) h = h_spec;
-        else if (!strcmp(sub, "summary")) h = h_summary;
-        if (!h && !hk)
-            return send_error(c, r, 404, "not_found", NULL, "no such resource: %.128s", path);
-        if (!is_get(method)) return method_not_allowed(c, r, method, path, "GET, HEAD");
-        if (!gpd_id_is_plausible(id)) return not_found(c, r, id);
-        return h ? h(c, r, id) : with_kind(c, r, id, hk);
-    }
-    return send_error(c, r, 404, "not_found", NULL, "no such resource: %.128s", path);
+    const gpd_route *rt = r->route;
+    if (!rt) return send_error(c, r, 404, "not_found", NULL, "no such resource: %.128s", path);
+    int m = gpd_route_method_of(method);
+    if (!gpd_route_answers(rt, m))
+        return method_not_allowed(c, r, method, path, gpd_route_allow(rt));
+    const gpd_route_op *op = &rt->op[m];
+    handler_fn h = handlers[op->handler];
+    if (!h) return send_error(c, r, 500, "internal", NULL, "no handler for %s %s", method, path);
+    if (r->id[0] && !gpd_id_is_plausible(r->id)) return not_found(c, r, r->id);
+    return op->offload ? offload(c, r, h) : h(c, r, r->id);
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const char *url,
@@ -916,6 +905,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         r->url_len = url_len;
         snprintf(r->method, sizeof r->method, "%s", method);
         snprintf(r->url, sizeof r->url, "%s", url);
+        r->route = gpd_route_match(url, r->id, sizeof r->id);
         *con_cls = r;
         /* 414, 403 forbidden_host / forbidden_origin, CORS preflight: before anything else,
          * so that a refused request creates or reads nothing */
@@ -1008,8 +998,8 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
                 1e3 * (gpd_monotonic_s() - r->t0),
                 toe == MHD_REQUEST_TERMINATED_COMPLETED_OK ? "" : " (aborted)");
     }
-    /* by route pattern; a path cut to the buffer is not one of them */
-    metrics_http_request(strlen(r->url) < sizeof r->url - 1 ? r->url : "", r->status);
+    /* by the route matched when the request arrived (refused ones too) */
+    metrics_http_request(r->route, r->status);
     if (r->resp) MHD_destroy_response(r->resp);
     free(r->body);
     free(r);
@@ -1106,8 +1096,27 @@ bad:
     return -1;
 }
 
+/* Whether every handler the route table names has its function here (a route added to the
+ * table without one would answer 500). */
+static int handlers_complete(void)
+{
+    size_t n = 0;
+    const gpd_route *rt = gpd_routes(&n);
+    int ok = 1;
+    for (size_t i = 0; i < n; i++)
+        for (int m = 0; m < GPD_ROUTE_NMETHODS; m++) {
+            gpd_handler h = rt[i].op[m].handler;
+            if (h == GPD_H_NONE || (h > GPD_H_NONE && h < GPD_H_COUNT && handlers[h])) continue;
+            gpd_log(GPD_LOG_ERROR, "route %s %s has no handler in http.c",
+                    gpd_route_method_name(m), rt[i].pattern);
+            ok = 0;
+        }
+    return ok;
+}
+
 int gpd_http_start(const gpd_http_config *cfg)
 {
+    if (!handlers_complete()) return -1;
     max_body = cfg->max_body;
     if (cfg->max_result_mb > 0) max_result_mb = cfg->max_result_mb;
     max_queued = cfg->max_queued;

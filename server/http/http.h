@@ -1,26 +1,15 @@
 /* http.h -- the HTTP front of grainpackd (libmicrohttpd): routing, bodies, errors.
  *
- * Routes (shared/spec/api.md; extensions marked +):
- *   GET  /                         dashboard (text/html)
- *   GET  /v1/health                liveness, queue depth, workers
- *   GET  /v1/schema[?kind=K]       the JSON Schema (+ ?kind= one kind's schema)
- *   POST /v1/jobs                  201 job object (+ full job object, not only id/status), Location
- *                                  (503 queue_full with Retry-After past --max-queued)
- *   GET  /v1/jobs?status=&limit=&after=   newest first, keyset cursor "next"
- *   GET  /v1/jobs/{id}             job object
- *   DELETE /v1/jobs/{id}           cancel (200 job object; 409 already_finished)
- *   DELETE /v1/jobs/{id}?purge=1   remove a finished job, result, pack and summary (204;
- *                                  409 not_finished while queued or running)
- *   GET  /metrics                  Prometheus text format 0.0.4 (metrics.h)
- *   GET  /v1/jobs/{id}/result      result JSON (409 not_ready)
- *   GET  /v1/jobs/{id}/svg?view=V  image/svg+xml (409 not_ready)
- *   GET  /v1/jobs/{id}/export?format=F   an export file of the job (api.md formats)
- *   GET  /v1/jobs/{id}/spec        + the effective spec (defaults filled in)
+ * Routes: one table, routes.c (routes.h), walked by the router and read by the metrics; each
+ * route and method is described in docs/api.md under "### METHOD /path" (the contract is
+ * shared/spec/api.md; tests/server/test_routes.c checks every route has its heading). A path
+ * no route matches is 404 not_found, a method its route does not answer 405
+ * method_not_allowed with an Allow header, an {id} that cannot be a job id 404 not_found.
  * HEAD is accepted wherever GET is. Every 4xx/5xx body is
  *   {"error": {"code": "...", "message": "...", "pointer": "/json/pointer"}}
  * (pointer only where a field of the spec or a query parameter is at fault).
  *
- * Before routing (api.md, "Limits and origin"):
+ * Before routing (docs/api.md, "Limits" and "Origin, Host and security headers"):
  *   414 uri_too_long      the request target (path and query) is over GPD_MAX_URL bytes
  *   403 forbidden_host    the Host header names a host this daemon does not answer to
  *                         (DNS rebinding): accepted are localhost, 127.0.0.1, [::1], the

@@ -8,9 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "http/routes.h"
 #include "store/store.h"
 #include "util/util.h"
-#include "jobs/workers.h"
 
 /* the kinds and phases the static tables have room for (a kind past them is not counted) */
 #define MAX_KINDS 8
@@ -18,51 +18,20 @@
 
 /* ------------------------------------------------------------------ HTTP requests */
 
-static const char *const routes[] = {"/",
-                                     "/metrics",
-                                     "/v1/health",
-                                     "/v1/schema",
-                                     "/v1/shapes/analyze",
-                                     "/v1/jobs",
-                                     "/v1/jobs/:id",
-                                     "/v1/jobs/:id/result",
-                                     "/v1/jobs/:id/svg",
-                                     "/v1/jobs/:id/export",
-                                     "/v1/jobs/:id/spec",
-                                     "/v1/jobs/:id/summary",
-                                     "other"};
-#define NROUTES (sizeof routes / sizeof *routes)
-#define ROUTE_JOB 6   /* "/v1/jobs/:id", the subresources follow it */
-#define ROUTE_OTHER (NROUTES - 1)
+/* by route of the table (routes.h), the last row for requests no route matched ("other") */
+#define ROUTE_OTHER GPD_ROUTES_MAX
 #define STATUS_LO 100 /* statuses 100..599 are counted */
 #define NSTATUS 500
 
-static uint64_t http_count[NROUTES][NSTATUS]; /* atomic */
+static uint64_t http_count[GPD_ROUTES_MAX + 1][NSTATUS]; /* atomic */
 
-/* the route pattern of a path as http.c routes it (one trailing slash dropped) */
-static size_t route_of(const char *path)
+void metrics_http_request(const gpd_route *route, int status)
 {
-    size_t n = strlen(path);
-    if (n > 1 && path[n - 1] == '/') n--;
-    for (size_t i = 0; i < ROUTE_JOB; i++)
-        if (strlen(routes[i]) == n && !strncmp(routes[i], path, n)) return i;
-    if (n <= 9 || strncmp(path, "/v1/jobs/", 9)) return ROUTE_OTHER;
-    const char *id = path + 9, *end = path + n;
-    const char *slash = memchr(id, '/', (size_t)(end - id));
-    if (!slash) return ROUTE_JOB;
-    if (slash == id) return ROUTE_OTHER;
-    const char *sub = slash + 1;
-    size_t sl = (size_t)(end - sub);
-    static const char *const subs[] = {"result", "svg", "export", "spec", "summary"};
-    for (size_t i = 0; i < sizeof subs / sizeof *subs; i++)
-        if (strlen(subs[i]) == sl && !strncmp(subs[i], sub, sl)) return ROUTE_JOB + 1 + i;
-    return ROUTE_OTHER;
-}
-
-void metrics_http_request(const char *path, int status)
-{
-    if (!path || status < STATUS_LO || status >= STATUS_LO + NSTATUS) return;
-    __atomic_add_fetch(&http_count[route_of(path)][status - STATUS_LO], 1, __ATOMIC_RELAXED);
+    if (status < STATUS_LO || status >= STATUS_LO + NSTATUS) return;
+    size_t n = 0;
+    const gpd_route *table = gpd_routes(&n);
+    size_t i = route && route >= table && route < table + n ? (size_t)(route - table) : ROUTE_OTHER;
+    __atomic_add_fetch(&http_count[i][status - STATUS_LO], 1, __ATOMIC_RELAXED);
 }
 
 /* ------------------------------------------------------------------ jobs */
@@ -250,26 +219,31 @@ static void render_http(gpd_buf *b)
 {
     head(b, "grainpack_http_requests_total", "counter",
          "HTTP responses by route pattern and status code.");
-    for (size_t r = 0; r < NROUTES; r++)
+    size_t nroutes = 0;
+    const gpd_route *table = gpd_routes(&nroutes);
+    for (size_t r = 0; r <= nroutes; r++) {
+        size_t row = r < nroutes ? r : ROUTE_OTHER;
+        const char *label = r < nroutes ? table[r].label : GPD_ROUTE_OTHER_LABEL;
         for (int s = 0; s < NSTATUS; s++) {
-            uint64_t n = __atomic_load_n(&http_count[r][s], __ATOMIC_RELAXED);
+            uint64_t n = __atomic_load_n(&http_count[row][s], __ATOMIC_RELAXED);
             if (n)
                 gpd_buf_printf(b,
                                "grainpack_http_requests_total{route=\"%s\",status=\"%d\"} %llu\n",
-                               routes[r], s + STATUS_LO, (unsigned long long)n);
+                               label, s + STATUS_LO, (unsigned long long)n);
         }
+    }
 }
 
-char *metrics_render(size_t *len)
+char *metrics_render(int workers, int busy, size_t *len)
 {
     gpd_buf b = {0};
     gpd_buf_reserve(&b, 16384);
     render_jobs(&b);
     render_finished(&b);
     head(&b, "grainpack_workers", "gauge", "Worker threads that run jobs.");
-    gpd_buf_printf(&b, "grainpack_workers %d\n", workers_total());
+    gpd_buf_printf(&b, "grainpack_workers %d\n", workers);
     head(&b, "grainpack_workers_busy", "gauge", "Worker threads running a job now.");
-    gpd_buf_printf(&b, "grainpack_workers_busy %d\n", workers_busy());
+    gpd_buf_printf(&b, "grainpack_workers_busy %d\n", busy);
     render_histograms(&b);
     render_http(&b);
     long long bytes = 0;

@@ -1,8 +1,8 @@
 /* metrics.h -- GET /metrics: the daemon's figures in the Prometheus text exposition format
  * 0.0.4 (Content-Type "text/plain; version=0.0.4; charset=utf-8").
  *
- * The names are part of the contract (api.md "Operations"; tests/integration/test_operations.py
- * reads them):
+ * The names are part of the contract (api.md "Operations"; docs/api.md "GET /metrics";
+ * tests/integration/test_operations.py reads them):
  *   grainpack_jobs{kind,status}                     gauge: jobs in the store (one GROUP BY over
  *                                                   an index, at each scrape); every kind of the
  *                                                   table and every status, 0 included
@@ -13,12 +13,11 @@
  *   grainpack_job_duration_seconds{kind,phase}      histogram (_bucket{le}, _sum, _count) of the
  *                                                   "timings" of each succeeded job's result, one
  *                                                   series a phase of its kind (kind.h: phases)
- *   grainpack_http_requests_total{route,status}     counter: responses by route pattern ("/",
- *                                                   "/metrics", "/v1/health", "/v1/schema",
- *                                                   "/v1/jobs", "/v1/jobs/:id",
- *                                                   "/v1/jobs/:id/result|svg|export|spec", or
- *                                                   "other") and HTTP status, counted when the
- *                                                   request completes. The job id is ":id", not
+ *   grainpack_http_requests_total{route,status}     counter: responses by route and HTTP
+ *                                                   status, counted when the request completes.
+ *                                                   route is the label of the route table's row
+ *                                                   (http/routes.h; "/", "/v1/jobs/:id/result",
+ *                                                   ...) or "other". The job id is ":id", not
  *                                                   "{id}": a "}" inside a label value is valid
  *                                                   Prometheus text but trips simple line parsers
  *                                                   (the integration test's among them)
@@ -29,6 +28,10 @@
  * whose buckets, sum and count must agree, and the mean run time behind Retry-After, are under
  * one mutex, held for an observation (once a job) or a copy (once a scrape). A scrape costs one
  * SQL query, one PRAGMA pair and a stat(): cheap enough every second under load.
+ *
+ * Dependencies: the workers report finished jobs here (metrics_job_*); the metrics read
+ * nothing of the workers (their figures are passed to metrics_render by the caller, http.c),
+ * so that jobs/workers -> jobs/metrics is one way.
  */
 #ifndef GPD_METRICS_H
 #define GPD_METRICS_H
@@ -37,10 +40,12 @@
 
 #include <jansson.h>
 
+#include "http/routes.h"
 #include "kinds/kind.h"
 
-/* A response of status to a request for path (the URL path, without the query). */
-void metrics_http_request(const char *path, int status);
+/* A response of status to a request whose path matched route (gpd_route_match; NULL: none,
+ * counted as "other"). */
+void metrics_http_request(const gpd_route *route, int status);
 
 /* A job of kind (its name) finished with status "succeeded", "failed" or "cancelled" after
  * running run_s seconds (< 0: it never ran, e.g. cancelled while queued). */
@@ -55,7 +60,8 @@ void metrics_job_timings(const gpd_kind *k, const json_t *timings);
  * any job has finished). */
 int metrics_retry_after(int workers);
 
-/* The exposition text (malloc'ed, *len bytes), or NULL on out of memory. */
-char *metrics_render(size_t *len);
+/* The exposition text (malloc'ed, *len bytes), or NULL on out of memory; workers and busy
+ * are the pool's figures (workers_total(), workers_busy() of jobs/workers.h). */
+char *metrics_render(int workers, int busy, size_t *len);
 
 #endif /* GPD_METRICS_H */
