@@ -12,8 +12,8 @@
 extern const unsigned char gp_schema_text_combined[];
 
 /* the kinds, in the order of gp_spec_kinds() and of the combined document */
-static const gp_spec_kind *const g_kinds[] = {&gp_spec_kind_2d, &gp_spec_kind_3d};
-#define NKINDS (sizeof g_kinds / sizeof *g_kinds)
+#define g_kinds gp_spec_kind_table
+#define NKINDS GP_SPEC_NKINDS
 
 static const char *g_names[NKINDS + 1];
 static json_t *g_schema[NKINDS];

@@ -3,7 +3,8 @@
  * defaults; values out of range or malformed refused with a message naming the flag and what
  * it takes; the list option (--allow-origin) handed over value by value; the actions, unknown
  * options and stray arguments; --help and the Markdown table made from the table; and
- * docs/operations.md naming every flag and every environment variable of the table. */
+ * docs/operations.md naming every flag and every environment variable of the table, its options
+ * table being the Markdown one, verbatim. */
 #include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -421,6 +422,12 @@ static void test_docs(void)
             fprintf(stderr, "docs/operations.md: no %s\n", T[i].env);
         if (T[i].env) CHECK(mentions(doc, T[i].env));
     }
+    /* the docs' table is the one the daemon prints, verbatim */
+    char *md = printed(gpd_options_markdown);
+    CHECK(md && strstr(doc, md) != NULL);
+    if (md && !strstr(doc, md))
+        fprintf(stderr, "docs/operations.md: its options table is not `grainpackd --help-markdown`\n");
+    free(md);
     free(doc);
 }
 

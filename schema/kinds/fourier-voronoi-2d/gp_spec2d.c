@@ -15,6 +15,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+extern const gp_spec_kind gp_spec_kind_fourier_voronoi_2d; /* this kind, defined at the end */
+
 extern const unsigned char gp_schema_text_fourier_voronoi_2d[];
 
 /* the names of the enums, at the index of their value */
@@ -339,7 +341,7 @@ int gp_spec2d_read(const json_t *full, gp_spec2d *out, gp_spec_problem *p)
 {
     gp_spec_problem local;
     p = gp_spec_begin(p, &local);
-    if (gp_spec_read_begin(&gp_spec_kind_2d, full, out, sizeof *out, p)) return -1;
+    if (gp_spec_read_begin(&gp_spec_kind_fourier_voronoi_2d, full, out, sizeof *out, p)) return -1;
     gp_spec_reader r = {0};
     const json_t *size = gp_rd_member(&r, full, "/size", JSON_OBJECT, 0);
     const json_t *ori = gp_rd_member(&r, full, "/orientation", JSON_OBJECT, 0);
@@ -560,7 +562,7 @@ static int check_shape_2d(const gp_spec2d *s, gp_spec_problem *p)
 /* the schema's particles maximum: the bound of a derived cell count too */
 static double max_particles(void)
 {
-    const json_t *props = json_object_get(gp_spec_schema(&gp_spec_kind_2d), "properties");
+    const json_t *props = json_object_get(gp_spec_schema(&gp_spec_kind_fourier_voronoi_2d), "properties");
     double m = 1e6;
     gp_schema_number(json_object_get(props, "particles"), "maximum", &m);
     return m;
@@ -833,7 +835,7 @@ static int spec_bounds_2d(const json_t *full, gp_spec_bounds_t *b, gp_spec_probl
     return rc;
 }
 
-const gp_spec_kind gp_spec_kind_2d = {
+const gp_spec_kind gp_spec_kind_fourier_voronoi_2d = {
     .name = "fourier-voronoi-2d",
     .schema_text = gp_schema_text_fourier_voronoi_2d,
     .explain = explain_2d,

@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+extern const gp_spec_kind gp_spec_kind_spheres_3d; /* this kind, defined at the end */
+
 extern const unsigned char gp_schema_text_spheres_3d[];
 
 /* the names of the outputs, at the index of their bit (GP_OUT3_*) */
@@ -30,7 +32,7 @@ int gp_spec3d_read(const json_t *full, gp_spec3d *out, gp_spec_problem *p)
 {
     gp_spec_problem local;
     p = gp_spec_begin(p, &local);
-    if (gp_spec_read_begin(&gp_spec_kind_3d, full, out, sizeof *out, p)) return -1;
+    if (gp_spec_read_begin(&gp_spec_kind_spheres_3d, full, out, sizeof *out, p)) return -1;
     gp_spec_reader r = {0};
     out->seed = (uint64_t)gp_rd_num(&r, full, "/seed", 0, GP_RD_COUNT);
     const json_t *box = gp_rd_array(&r, full, "/box", 3, 3, 0);
@@ -221,7 +223,7 @@ static int spec_bounds_3d(const json_t *full, gp_spec_bounds_t *b, gp_spec_probl
 }
 
 /* no rules on the spec as posted, no defaults that depend on other fields */
-const gp_spec_kind gp_spec_kind_3d = {
+const gp_spec_kind gp_spec_kind_spheres_3d = {
     .name = "spheres-3d",
     .schema_text = gp_schema_text_spheres_3d,
     .check = check_3d,
