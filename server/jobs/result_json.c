@@ -665,15 +665,8 @@ void gpd_jw_items(gpd_jw *w, size_t n, gpd_jw_item_fn item, const void *user, in
     int nt = threads < 1 ? 1 : threads;
     if ((size_t)nt > nblocks) nt = (int)nblocks;
     if (nt > 1 && w->state == GPD_JW_OK) {
-        items_run R;
-        memset(&R, 0, sizeof R);
-        R.w = w;
-        R.n = n;
-        R.block = block;
-        R.nblocks = nblocks;
-        R.nt = nt;
-        R.item = item;
-        R.user = user;
+        items_run R = {.w = w, .n = n, .block = block, .nblocks = nblocks, .nt = nt,
+                       .item = item, .user = user};
         if (items_threaded(&R) == 0) return;
     }
     for (size_t i = 0; i < n && w->state == GPD_JW_OK; i++) item(w, i, user);

@@ -244,6 +244,12 @@ static json_t *shape_outlines(const gp_shape_used *u)
     return o;
 }
 
+/* o's members names[0 .. n) set to the numbers v[0 .. n), in that order */
+static void set_reals(json_t *o, const char *const *names, const double *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++) json_object_set_new(o, names[i], gpd_jreal(v[i]));
+}
+
 /* stats.shape (see the top of the file) */
 static json_t *shape_json(const gp_specimen2d *s, const gp_spec2d *spec)
 {
@@ -252,12 +258,8 @@ static json_t *shape_json(const gp_specimen2d *s, const gp_spec2d *spec)
     if (!o) return NULL;
     json_object_set_new(o, "form", json_string(shape_form_name(u->form)));
     json_object_set_new(o, "spectrum", gpd_jreals(u->spectrum, u->nmodes));
-    json_object_set_new(o, "D2", gpd_jreal(u->D2));
-    json_object_set_new(o, "D3", gpd_jreal(u->D3));
-    json_object_set_new(o, "D8", gpd_jreal(u->D8));
-    json_object_set_new(o, "alpha", gpd_jreal(u->alpha));
-    json_object_set_new(o, "beta", gpd_jreal(u->beta));
-    json_object_set_new(o, "spread", gpd_jreal(u->spread));
+    static const char *const names[] = {"D2", "D3", "D8", "alpha", "beta", "spread"};
+    set_reals(o, names, (double[]){u->D2, u->D3, u->D8, u->alpha, u->beta, u->spread}, 6);
     json_object_set_new(o, "spread_source",
                         json_string(u->spread_from_outlines                  ? "outlines"
                                     : spec->spread_given || spec->spread > 0 ? "spec"
@@ -428,12 +430,12 @@ static json_t *head_2d(const gp_specimen2d *s, const gp_spec2d *spec, const json
     /* "shape" (first, as it ran first) only when a shape phase ran */
     json_t *tm = json_object();
     if (shape_computed(s->shape.form)) json_object_set_new(tm, "shape", gpd_jreal(s->t_shape));
-    json_object_set_new(tm, "tessellation", gpd_jreal(s->t_tessellation));
-    json_object_set_new(tm, "imc", gpd_jreal(s->t_imc));
-    json_object_set_new(tm, "fill", gpd_jreal(s->t_fill));
-    json_object_set_new(tm, "odec", gpd_jreal(s->t_odec));
-    json_object_set_new(tm, "descriptors", gpd_jreal(s->t_descriptors));
-    json_object_set_new(tm, "total", gpd_jreal(s->t_total));
+    static const char *const phases[] = {"tessellation", "imc", "fill", "odec", "descriptors",
+                                         "total"};
+    set_reals(tm, phases,
+              (double[]){s->t_tessellation, s->t_imc, s->t_fill, s->t_odec, s->t_descriptors,
+                         s->t_total},
+              6);
     json_object_set_new(r, "timings", tm);
     return r;
 }
