@@ -10,8 +10,8 @@
    and schema/: the code says what it does; its history belongs to git and docs/design/.
 3. Every global symbol that the server library defines starts with gp_, gpd_ or the name of
    its own module (its object file's name).
-4. A kind's name, as a string ("fourier-voronoi-2d", "spheres-3d"), appears in server/ and
-   schema/ only inside that kind's own folders (kinds/<kind>/).
+4. A kind's name (a folder of schema/kinds/), as a string, appears in server/ and schema/ only
+   inside that kind's own folders (kinds/<kind>/).
 Prints each violation and "N passed, N failed" at the end; exits 1 when any check failed.
 """
 import os
@@ -147,10 +147,15 @@ def check_symbols():
     check(not bad, "%d global names after no module" % len(bad))
 
 
-KIND_NAME = re.compile(r'"(fourier-voronoi-2d|spheres-3d)"')
+def kind_names():
+    """the kinds, by their folders in schema/kinds/"""
+    return sorted(os.listdir(os.path.join(ROOT, "schema", "kinds")))
 
 
 def check_kind_names():
+    kinds = kind_names()
+    check(len(kinds) >= 2, "the kinds' folders were found (%s)" % kinds)
+    KIND_NAME = re.compile('"(%s)"' % "|".join(map(re.escape, kinds)))
     bad = []
     for top in ("server", "schema"):
         for d, _, files in os.walk(os.path.join(ROOT, top)):
