@@ -149,6 +149,10 @@ struct gp_dem3d {
     long dt_cuts;
     double wall[6];            /* positions: lo x, hi x, lo y, hi y, lo z, hi z */
     double servo_f[6], servo_v[6], servo_lim[6];
+    double servo_s[6];         /* > 0: a stress servo (its force: this times the face area) */
+    int servo_stress;          /* some wall has servo_s > 0 */
+    double wall_v[6];          /* a prescribed wall velocity (m/s, along +axis) ... */
+    int wall_vmode[6];         /* ... when this is set */
     double servo_dt;           /* SERVO_GAIN per step of this dt (0: per step, whatever dt) */
     double wall_f[6], wall_k[6];
     size_t wall_n;
@@ -452,11 +456,51 @@ void gp_dem3d_set_radius_scale(gp_dem3d *d, double s)
         d->rscale_ref = s;
 }
 
+/* whether some wall is a stress servo (the step then computes the faces' areas) */
+static void servo_modes(gp_dem3d *d)
+{
+    d->servo_stress = 0;
+    for (int w = 0; w < 6; w++)
+        d->servo_stress |= d->servo_s[w] > 0;
+}
+
 void gp_dem3d_set_servo(gp_dem3d *d, int w, double force, double vmax)
 {
     d->servo_f[w] = force > 0 ? force : 0;
     d->servo_v[w] = vmax;
+    d->servo_s[w] = 0;
+    d->wall_vmode[w] = 0;
+    d->wall_v[w] = 0;
+    servo_modes(d);
 }
+
+void gp_dem3d_set_servo_stress(gp_dem3d *d, int w, double stress, double vmax)
+{
+    d->servo_s[w] = stress > 0 ? stress : 0;
+    d->servo_f[w] = 0;
+    d->servo_v[w] = vmax;
+    d->wall_vmode[w] = 0;
+    d->wall_v[w] = 0;
+    servo_modes(d);
+}
+
+void gp_dem3d_set_wall_velocity(gp_dem3d *d, int w, double v)
+{
+    d->servo_f[w] = 0;
+    d->servo_s[w] = 0;
+    d->wall_vmode[w] = 1;
+    d->wall_v[w] = v;
+    servo_modes(d);
+}
+
+/* the area of wall w's face: the spans of the other two axes */
+static double face_area(const double *W, int w)
+{
+    int a = w / 2, b = (a + 1) % 3, c = (a + 2) % 3;
+    return (W[2 * b + 1] - W[2 * b]) * (W[2 * c + 1] - W[2 * c]);
+}
+
+double gp_dem3d_face_area(const gp_dem3d *d, int w) { return face_area(d->wall, w); }
 
 void gp_dem3d_set_servo_dt(gp_dem3d *d, double dt_ref) { d->servo_dt = dt_ref > 0 ? dt_ref : 0; }
 
@@ -1363,15 +1407,25 @@ gp_status gp_dem3d_run(gp_dem3d *d, long nsteps, gp_error *err)
             return gp_error_set(err, GP_ERR_DEGENERATE,
                                 "dem3d: a sphere left the box or diverged at step %ld (time step too "
                                 "large for the loading?)", d->steps);
-        /* servo walls (Eq. 10) */
+        /* servo walls (Eq. 10); a stress servo's force from the faces as the step found
+         * them (before any wall moves); walls with a prescribed velocity */
+        double area[6] = {0};
+        if (d->servo_stress)
+            for (int w = 0; w < 6; w++)
+                area[w] = face_area(d->wall, w);
         for (int w = 0; w < 6; w++) {
-            if (d->servo_f[w] <= 0)
+            if (d->wall_vmode[w]) {
+                d->wall[w] += d->wall_v[w] * d->dt;
+                continue;
+            }
+            double target = d->servo_s[w] > 0 ? d->servo_s[w] * area[w] : d->servo_f[w];
+            if (target <= 0)
                 continue;
             double lim = d->servo_v[w] * d->dt;
             /* a rate in time (servo_dt): a longer step moves the wall further, so that the
              * protocol's windows, which are in time, see the same wall whatever dt */
             double gain = d->servo_dt > 0 ? SERVO_GAIN * d->dt / d->servo_dt : SERVO_GAIN;
-            double mv = wk[w] > 0 ? gain * (d->servo_f[w] - wf[w]) / wk[w] : lim;
+            double mv = wk[w] > 0 ? gain * (target - wf[w]) / wk[w] : lim;
             if (mv > lim) mv = lim;
             if (mv < -lim) mv = -lim;
             d->wall[w] += (w & 1) ? -mv : mv;

@@ -136,7 +136,8 @@ void gp_dem3d_set_radius_scale(gp_dem3d *d, double s);
 double gp_dem3d_wall(const gp_dem3d *d, int w);
 /* Servo wall (Eq. 10): each step the wall moves inward by gain * (F - F_c) / k_wall (gain: see
  * gp_dem3d_set_servo_dt), F_c and k_wall the sum of the forces and normal stiffnesses of its
- * contacts, at most vmax * dt (and by vmax * dt when it has no contact). force <= 0 turns the servo off (the wall stays). */
+ * contacts, at most vmax * dt (and by vmax * dt when it has no contact). force <= 0 turns the servo off (the wall stays).
+ * Replaces a stress servo or a velocity on w. */
 void gp_dem3d_set_servo(gp_dem3d *d, int w, double force, double vmax);
 /* The servo as a rate in time: a step of dt moves a wall by gain = SERVO_GAIN dt / dt_ref of
  * Eq. 10's displacement (SERVO_GAIN = 0.25), the same wall motion per unit time whatever the
@@ -144,6 +145,17 @@ void gp_dem3d_set_servo(gp_dem3d *d, int w, double force, double vmax);
 void gp_dem3d_set_servo_dt(gp_dem3d *d, double dt_ref);
 /* The servo never moves wall w inward past position (NAN = no limit). */
 void gp_dem3d_set_servo_limit(gp_dem3d *d, int w, double position);
+/* A servo wall aiming at a stress (Pa): each step its target force is stress times the
+ * current area of its face (the spans of the other two axes, as the walls stood when the
+ * step began), the rest as gp_dem3d_set_servo (Eq. 10, gain, vmax, limit); stress <= 0 turns
+ * the servo off (the wall stays). Replaces a force servo or a velocity on w. */
+void gp_dem3d_set_servo_stress(gp_dem3d *d, int w, double stress, double vmax);
+/* Wall w moves at v (m/s, along +axis: v < 0 moves wall 5 down) on every step: position +=
+ * v dt after the step. Replaces a servo on w; gp_dem3d_set_servo and _servo_stress turn the
+ * velocity off again (v = 0: the wall stays). */
+void gp_dem3d_set_wall_velocity(gp_dem3d *d, int w, double v);
+/* The current area of wall w's face (m^2): the spans of the other two axes. */
+double gp_dem3d_face_area(const gp_dem3d *d, int w);
 
 /* Advances nsteps. Fails (GP_ERR_DEGENERATE) if a sphere leaves the box or a value is not
  * finite, and with GP_ERR_CANCELLED before a step when the cancel flag is up. */

@@ -83,20 +83,18 @@
 #define POROSITY_SLACK 0.003     /* the wall may end this far from the target porosity (the
                                     tolerance is 0.005): above, where the packing jams without
                                     friction; below, following a packing that settles away */
-#define DT_SAFETY 0.4            /* of sqrt(m / 2 E R), m density-scaled, at the relaxation's
-                                    damping c = 0.7. The DEM checks every step against a proven
-                                    bound on omega_max (shear and rotation included) and the
-                                    limit omega dt < 2 / sqrt(1 + c) of leapfrog with local
-                                    damping c (gp_dem3d.h); a little higher, relaxation needs
-                                    cuts on some seeds (docs/design/specimen3d.md) */
-#define DT_DAMPING_EXP 0.45      /* the other phases (c = the material's 0.2) step
-                                    ((1 + 0.7) / (1 + c))^0.45 = 1.17 x longer
-                                    (params.dt_damping_exp): for the same contacts they use
-                                    (1.2 / 1.7)^0.05 = 0.98 of the relaxation's fraction of its
-                                    own limit, so that no phase needs a cut. 0.5 (the same
-                                    fraction, 1.19 x) saves as many steps, but a small loose
-                                    spec of the integration tests then jams short of its
-                                    porosity (docs/design/specimen3d.md) */
+/* DT_SAFETY (0.4): of sqrt(m / 2 E R), m density-scaled, at the relaxation's damping c = 0.7.
+ * The DEM checks every step against a proven bound on omega_max (shear and rotation included)
+ * and the limit omega dt < 2 / sqrt(1 + c) of leapfrog with local damping c (gp_dem3d.h); a
+ * little higher, relaxation needs cuts on some seeds (docs/design/specimen3d.md).
+ * DT_DAMPING_EXP (0.45): the other phases (c = the material's 0.2) step
+ * ((1 + 0.7) / (1 + c))^0.45 = 1.17 x longer (params.dt_damping_exp): for the same contacts
+ * they use (1.2 / 1.7)^0.05 = 0.98 of the relaxation's fraction of its own limit, so that no
+ * phase needs a cut. 0.5 (the same fraction, 1.19 x) saves as many steps, but a small loose
+ * spec of the integration tests then jams short of its porosity (docs/design/specimen3d.md).
+ * Both are public (gp_specimen3d.h): a triaxial test of the specimen steps by the same rule. */
+#define DT_SAFETY GP_SPEC3D_DT_SAFETY
+#define DT_DAMPING_EXP GP_SPEC3D_DT_DAMPING_EXP
 #define COMPACTION_STRESS 1.0    /* top-wall stress, times the geostatic stress at the bottom */
 /* local damping during relaxation (the static state does not depend on it; S_c <= 1e-4 comes
  * far sooner than at the material's 0.2: docs/design/specimen3d.md) */
@@ -180,6 +178,7 @@ void gp_specimen3d_destroy(gp_specimen3d *s)
     if (!s)
         return;
     free(s->spheres);
+    free(s->sample_spheres);
     free(s->contacts);
     free(s->stats.psd.diameter);
     free(s->stats.psd.target_weight);
@@ -941,6 +940,9 @@ static gp_status collect_sample(build_run *R)
     S->stop_reason = R->reason;
     gp_dem3d_spheres(dem, R->xyzr);
     res->sample_box[2] = gp_dem3d_wall(dem, 5);
+    if (!(res->sample_spheres = malloc(4 * R->n * sizeof *res->sample_spheres)))
+        return gp_error_set(R->err, GP_ERR_NOMEM, "out of memory");
+    memcpy(res->sample_spheres, R->xyzr, 4 * R->n * sizeof *R->xyzr);
     gp_status st = gp_dem3d_contacts(dem, &R->con, &R->ncon, R->err);
     if (st)
         return st;

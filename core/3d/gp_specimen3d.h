@@ -33,6 +33,12 @@
 #define GP_SPEC3D_GRAVITY 9.81
 #define GP_SPEC3D_STABILITY 1e-4
 #define GP_SPEC3D_RELAX_DAMPING 0.7
+/* The DEM's time step rule of the protocol (gp_dem3d_params; gp_specimen3d.c says why): the
+ * step is GP_SPEC3D_DT_SAFETY sqrt(m / 2 E R) at the relaxation's damping, and follows the
+ * damping c as (1 + c)^-GP_SPEC3D_DT_DAMPING_EXP (dt_damping_exp). A triaxial test of the
+ * specimen (gp_triax.h) steps by the same rule. */
+#define GP_SPEC3D_DT_SAFETY 0.4
+#define GP_SPEC3D_DT_DAMPING_EXP 0.45
 
 /* outputs (bit flags); porosity, coordination number, PSD and timings are always reported */
 enum {
@@ -136,6 +142,9 @@ typedef struct gp_specimen3d {
     size_t count;                /* number of spheres in the final packing (even without output) */
     double box[3];               /* the final (tiled) box, m */
     double sample_box[3];        /* the sample box, m */
+    double *sample_spheres;      /* stats.sample_particles * 4: x, y, z, r (m) of the sample S0
+                                    as its DEM left it, before any tiling (in [0, sample_box]);
+                                    always filled, whatever the outputs */
     gp_contact3d *contacts;      /* with GP_OUT3_CONTACTS (the type: gp_dem3d.h) */
     size_t ncontacts;
     gp_stats3d stats;
