@@ -36,6 +36,7 @@
 #include <jansson.h>
 
 #include "gp_spec.h"
+#include "kinds/triaxial-3d/gp_spec_triax.h"
 
 /* the daemon's default --max-body: larger bodies never reach the validator */
 #define GP_FUZZ_SPEC_MAX_INPUT (1u << 20)
@@ -144,7 +145,10 @@ static const char *gp_fuzz_check_bounds(const json_t *full)
 }
 #endif
 
-/* parses spec as kind k (0 = 2D, 1 = 3D); 0 or -1 as the parser said; *broken set when the
+/* the kinds' parsers, by index: 0 the 2D kind, 1 the 3D kind, 2 the triaxial test */
+#define GP_FUZZ_NKINDS 3
+
+/* parses spec as kind k (< GP_FUZZ_NKINDS); 0 or -1 as the parser said; *broken set when the
  * parsed struct is inconsistent */
 static int gp_fuzz_parse(const json_t *spec, int k, gp_spec_problem *p, const char **broken)
 {
@@ -154,13 +158,29 @@ static int gp_fuzz_parse(const json_t *spec, int k, gp_spec_problem *p, const ch
         rc = gp_spec2d_read(spec, &s, p);
         if (rc == 0 && !*broken) *broken = gp_fuzz_check_2d(&s);
         gp_spec2d_free(&s);
-    } else {
+    } else if (k == 1) {
         gp_spec3d s;
         rc = gp_spec3d_read(spec, &s, p);
         if (rc == 0 && !*broken) *broken = gp_fuzz_check_3d(&s);
         gp_spec3d_free(&s);
+    } else {
+        gp_spec_triax s;
+        rc = gp_spec_triax_read(spec, &s, p);
+        if (rc == 0 && !*broken) *broken = gp_fuzz_check_3d(&s.specimen);
+        gp_spec_triax_free(&s);
     }
     return rc;
+}
+
+/* the parser of a spec's kind (the 2D kind's for anything that names no other) */
+static int gp_fuzz_kind_index(const json_t *spec)
+{
+    const char *kind = json_string_value(json_object_get(spec, "kind"));
+    static const char *const parsers[GP_FUZZ_NKINDS] = {"fourier-voronoi-2d", "spheres-3d",
+                                                        "triaxial-3d"};
+    for (int k = 0; kind && k < GP_FUZZ_NKINDS; k++)
+        if (!strcmp(kind, parsers[k])) return k;
+    return 0;
 }
 
 /* Runs the calls on one input. Returns NULL when every contract holds, else a one-line
@@ -190,22 +210,23 @@ static const char *gp_fuzz_spec_one(const uint8_t *data, size_t size, gp_fuzz_sp
 
     /* both parsers on the input as posted: no contract on the verdict (they take effective
      * specs), but a refusal is a well-formed problem, and nothing leaks or crashes */
-    for (int as = 0; as < 2 && !broken; as++) {
+    for (int as = 0; as < GP_FUZZ_NKINDS && !broken; as++) {
         const char *unchecked = NULL; /* the struct of a spec as posted may be anything */
         if (gp_fuzz_parse(spec, as, &pp, &unchecked) != 0) broken = gp_fuzz_problem_broken(&pp);
     }
 
-    /* the kind's parser (2D for anything that is not the 3D kind) */
-    const char *kind = json_string_value(json_object_get(spec, "kind"));
-    int k = kind && !strcmp(kind, "spheres-3d") ? 1 : 0;
+    int k = gp_fuzz_kind_index(spec);
     if (valid && full) {
         if (gp_fuzz_parse(full, k, &pp, &broken) != 0 && !broken)
             broken = "the parser refuses a valid spec's effective spec";
-        /* the other kind's parser refuses it at /kind */
-        if (gp_fuzz_parse(full, !k, &pp, &broken) == 0 && !broken)
-            broken = "a spec parses as both kinds";
-        else if (!broken && strcmp(pp.pointer, "/kind"))
-            broken = "the other kind's parser does not refuse at /kind";
+        /* every other kind's parser refuses it at /kind */
+        for (int other = 0; other < GP_FUZZ_NKINDS && !broken; other++) {
+            if (other == k) continue;
+            if (gp_fuzz_parse(full, other, &pp, &broken) == 0 && !broken)
+                broken = "a spec parses as two kinds";
+            else if (!broken && strcmp(pp.pointer, "/kind"))
+                broken = "another kind's parser does not refuse at /kind";
+        }
         /* the effective spec is its own effective spec */
         json_t *again = gp_spec_with_defaults(full, &pd);
         if (!again && !broken) broken = "the effective spec of a valid spec is not valid";

@@ -299,8 +299,25 @@ static enum MHD_Result send_problem(struct MHD_Connection *c, req *r, const gp_s
                       p->message[0] ? p->message : dflt_msg);
 }
 
+/* gpd_job_lookup (kind.h) on the store: another job's kind, status and effective spec */
+static int lookup_job(const char *id, char kind[64], char status[16], json_t **spec)
+{
+    char *k = NULL, *text = NULL;
+    *spec = NULL;
+    if (!gpd_id_is_plausible(id)) return 1;
+    store_rc rc = store_get_text(id, "kind", &k, status);
+    if (rc == STORE_OK) rc = store_get_text(id, "spec", &text, status);
+    snprintf(kind, 64, "%s", k ? k : "");
+    *spec = text ? json_loads(text, 0, NULL) : NULL;
+    free(k);
+    free(text);
+    if (rc == STORE_NOT_FOUND) return 1;
+    return rc == STORE_OK && *spec ? 0 : -1;
+}
+
 /* The body as a spec with its defaults filled in, of a kind this daemon runs, within the
- * result bound; NULL when it has been answered (400, 422, 500). */
+ * result bound; NULL when it has been answered (400, 422, 500). A reference of the spec to
+ * another job is resolved first, by the kind (gpd_kind.resolve). */
 static json_t *effective_spec(struct MHD_Connection *c, req *r, const gpd_kind **kind,
                               enum MHD_Result *ret)
 {
@@ -320,6 +337,12 @@ static json_t *effective_spec(struct MHD_Connection *c, req *r, const gpd_kind *
     }
     gp_spec_problem prob;
     memset(&prob, 0, sizeof prob);
+    const gpd_kind *posted = gpd_kind_find(json_string_value(json_object_get(spec, "kind")));
+    if (posted && posted->resolve && posted->resolve(spec, lookup_job, &prob)) {
+        json_decref(spec);
+        *ret = send_problem(c, r, &prob, "invalid_spec", "invalid spec");
+        return NULL;
+    }
     json_t *eff = gp_spec_with_defaults(spec, &prob);
     json_decref(spec);
     if (!eff) {
@@ -734,18 +757,54 @@ static int export_open(struct MHD_Connection *c, req *r, const char *id, const g
     return -1;
 }
 
+/* An export the kind writes itself (kind.h: gpd_kind_export), from the job's summary */
+static enum MHD_Result kind_export(struct MHD_Connection *c, req *r, const char *id,
+                                   const gpd_kind_export *e)
+{
+    char *text = NULL, st[16];
+    size_t len = 0;
+    store_rc rc = store_get_summary(id, &text, &len, NULL, st);
+    if (rc == STORE_NOT_FOUND) return not_found(c, r, id);
+    if (rc != STORE_OK) return send_store_error(c, r);
+    json_t *sum = text ? json_loadb(text, len, 0, NULL) : NULL;
+    free(text);
+    if (!sum) return send_error(c, r, 500, "internal", NULL, "the stored summary is not JSON");
+    gpd_err err = {0, ""};
+    char *file = e->write(sum, &len, &err);
+    json_decref(sum);
+    if (!file)
+        return send_error(c, r, err.status == 409 ? 409 : 500,
+                          err.status == 409 ? "missing_output" : "internal",
+                          err.status == 409 ? "/outputs" : NULL, "%s", err.msg);
+    struct MHD_Response *resp = MHD_create_response_from_buffer(len, file, MHD_RESPMEM_MUST_FREE);
+    if (!resp) {
+        free(file);
+        return MHD_NO;
+    }
+    char disp[160];
+    snprintf(disp, sizeof disp, "attachment; filename=\"%s-%s.%s\"", id, e->format,
+             e->extension);
+    std_headers(resp, r, e->mime);
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_DISPOSITION, disp);
+    return queue_response(c, r, 200, resp);
+}
+
 static enum MHD_Result h_export(struct MHD_Connection *c, req *r, const char *id,
                                const gpd_kind *k, const char *st)
 {
     enum MHD_Result ret = MHD_NO;
     const char *format = qarg(c, "format");
-    int f = gp_export_format_parse(format);
-    if (f < 0 || !gp_export_format_supports(f, k->export_dim))
+    const gpd_kind_export *own = gpd_kind_export_find(k, format);
+    int f = own ? -1 : gp_export_format_parse(format);
+    if (!own && (f < 0 || !gp_export_format_supports(f, k->export_dim))) {
+        char formats[256];
+        gpd_kind_export_list(k, formats, sizeof formats);
         return send_error(c, r, 400, "invalid_parameter", NULL,
-                          "format: expected one of %s%s%.64s%s",
-                          gp_export_format_list(k->export_dim), format ? "; got \"" : "",
-                          format ? format : "", format ? "\"" : "");
+                          "format: expected one of %s%s%.64s%s", formats,
+                          format ? "; got \"" : "", format ? format : "", format ? "\"" : "");
+    }
     if (strcmp(st, "succeeded")) return not_ready(c, r, id, st);
+    if (own) return kind_export(c, r, id, own);
     export_dl *d = calloc(1, sizeof *d);
     if (!d) return send_error(c, r, 500, "internal", NULL, "out of memory");
     if (export_open(c, r, id, k, f, d, &ret)) {

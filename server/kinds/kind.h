@@ -24,6 +24,7 @@
 #include "jobs/progress.h"
 #include "jobs/result_json.h"
 #include "svg/svg_view.h"
+#include "util/util.h"
 
 /* A view of the SVG renderer: ?view=name draws it. */
 typedef struct gpd_view {
@@ -32,10 +33,34 @@ typedef struct gpd_view {
     gp_svg_view_fn open;
 } gpd_view;
 
+/* What the submit path lets a kind read of another job (gpd_kind.resolve): 0 with the job's
+ * kind and status and (*spec, a new reference) its effective spec; 1 when there is no job of
+ * that id; -1 when the store failed. */
+typedef int (*gpd_job_lookup)(const char *id, char kind[64], char status[16], json_t **spec);
+
+/* An export a kind writes itself, from its stored result's summary (store_get_summary), rather
+ * than from an export pack (core/export): what does not fit a pack, such as curves. */
+typedef struct gpd_kind_export {
+    const char *format;    /* ?format= */
+    const char *extension; /* of the file name, without the dot */
+    const char *mime;
+    /* the file (malloc'ed, *len bytes) of a succeeded job's summary; NULL with err (409 when
+     * the result lacks what it needs, naming the output to ask for; 500) */
+    char *(*write)(const json_t *summary, size_t *len, gpd_err *err);
+} gpd_kind_export;
+
 typedef struct gpd_kind {
     const char *name;
     /* a spec of this kind (JSON): the dashboard's example */
     const char *example;
+
+    /* ---- POST /v1/jobs: the body as posted, before it is validated (NULL: nothing) ---- */
+    /* Replaces, in place, what spec refers to in another job by what the worker needs of it,
+     * read now (lookup) so that a bad reference is refused at submit and the job never reads
+     * the other one (which may be purged meanwhile): 0, or -1 with *p (invalid_spec at the
+     * reference; "internal" when the store failed). The spec is not validated yet: the hook
+     * leaves what it does not understand to the schema. */
+    int (*resolve)(json_t *spec, gpd_job_lookup lookup, gp_spec_problem *p);
 
     /* ---- POST /v1/jobs: a valid effective spec (gp_spec_with_defaults) ---- */
     /* Its estimated result against max_bytes: 0, or -1 with *p (422 too_large, or from the
@@ -91,8 +116,12 @@ typedef struct gpd_kind {
     const gpd_view *views;
     /* 1 when a result without a "kind" member is of this kind (NULL: never) */
     int (*owns_result)(const json_t *result);
-    /* the dimension of its packs: its export formats (gp_export_format_supports) */
+    /* the dimension of its packs: its export formats (gp_export_format_supports); 0: no packs,
+     * no formats of core/export */
     int export_dim;
+    /* the exports it writes itself (ending with a NULL format; NULL: none), listed before and
+     * served instead of core/export's formats of the same name */
+    const gpd_kind_export *exports;
     /* a job without a pack: "job ... has no <pack_what> to export ... with <pack_output> in
      * outputs" */
     const char *pack_what, *pack_output;
@@ -137,6 +166,11 @@ const gpd_kind *gpd_kind_at(size_t i);
 int gpd_kind_index(const gpd_kind *k);
 /* k's view of that name, or NULL. */
 const gpd_view *gpd_kind_view(const gpd_kind *k, const char *name);
+
+/* k's own export of that format (gpd_kind.exports), or NULL. */
+const gpd_kind_export *gpd_kind_export_find(const gpd_kind *k, const char *format);
+/* The names of k's export formats, its own then core/export's, ", "-separated, into buf. */
+void gpd_kind_export_list(const gpd_kind *k, char *buf, size_t n);
 
 /* The names of k's views, ", "-separated ("packing, cells, ..."), into buf. */
 void gpd_kind_view_list(const gpd_kind *k, char *buf, size_t n);

@@ -10,7 +10,8 @@
  * is the kind a result without "kind" falls back to. */
 #define GPD_KINDS(X)          \
     X(gpd_kind_fv2d)          \
-    X(gpd_kind_spheres3d)
+    X(gpd_kind_spheres3d)     \
+    X(gpd_kind_triax)
 
 #define DECLARE(k) extern const gpd_kind k;
 GPD_KINDS(DECLARE)
@@ -58,6 +59,32 @@ static void join(char *buf, size_t n, int first, const char *sep, const char *qu
 {
     size_t at = strlen(buf);
     if (at < n) snprintf(buf + at, n - at, "%s%s%s%s", first ? "" : sep, quote, word, quote);
+}
+
+const gpd_kind_export *gpd_kind_export_find(const gpd_kind *k, const char *format)
+{
+    for (const gpd_kind_export *e = k->exports; format && e && e->format; e++)
+        if (!strcmp(e->format, format)) return e;
+    return NULL;
+}
+
+void gpd_kind_export_list(const gpd_kind *k, char *buf, size_t n)
+{
+    if (n) buf[0] = '\0';
+    int first = 1;
+    for (const gpd_kind_export *e = k->exports; e && e->format; e++, first = 0)
+        join(buf, n, first, ", ", "", e->format);
+    if (k->export_dim != 2 && k->export_dim != 3) return;
+    /* core/export's formats, but those the kind writes itself */
+    const char *p = gp_export_format_list(k->export_dim);
+    while (*p) {
+        size_t w = strcspn(p, ", ");
+        char f[32];
+        snprintf(f, sizeof f, "%.*s", (int)w, p);
+        if (w && !gpd_kind_export_find(k, f)) join(buf, n, first, ", ", "", f), first = 0;
+        p += w;
+        p += strspn(p, ", ");
+    }
 }
 
 void gpd_kind_view_list(const gpd_kind *k, char *buf, size_t n)
@@ -115,8 +142,10 @@ static json_t *kind_json(const gpd_kind *k)
     for (const gpd_view *v = k->views; views && v->name; v++)
         json_array_append_new(views, json_pack("{s:s, s:o}", "name", v->name, "options",
                                                words(v->options)));
+    char exports[256];
+    gpd_kind_export_list(k, exports, sizeof exports);
     return json_pack("{s:o, s:o, s:o}", "example", json_loads(k->example, 0, NULL), "views",
-                     views, "exports", words(gp_export_format_list(k->export_dim)));
+                     views, "exports", words(exports));
 }
 
 json_t *gpd_kinds_json(void)

@@ -22,5 +22,13 @@ int svg_views3d_section(gp_svg *g, const gp_svg_input *in, const gp_svg_options 
                      gpd_err *err);
 int svg_views3d_psd(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                  gpd_err *err);
+/* The section of any result of spheres (its "spheres", "box" [bx, by, bz] from 0 or else their
+ * bounds, "tiling"), with two subtitle lines of sub's (l1, l2 of n bytes each, from the result,
+ * the cut's z and that cut's porosity, NaN when unknown); sub NULL: the spheres-3d kind's
+ * (porosity and grading from its stats) */
+typedef void (*svg_views3d_subtitle_fn)(const json_t *res, double z, double cut_porosity,
+                                        char *l1, char *l2, size_t n);
+int svg_views3d_section_with(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
+                             int width, svg_views3d_subtitle_fn sub, gpd_err *err);
 
 #endif /* GPD_SVG_VIEWS_H */

@@ -1,6 +1,7 @@
 /* svg_views3d.c -- the SVG views of the 3D kind (kind_spheres3d.c): a section of the packing at
- * a height z (the spheres it cuts, coloured by diameter, read one at a time in passes) and the
- * grain-size distribution (stats.psd: target and achieved, by weight and by number). */
+ * a height z (the spheres it cuts, coloured by diameter, read one at a time in passes; shared
+ * with the other sphere kinds through svg_views3d_section_with) and the grain-size distribution
+ * (stats.psd: target and achieved, by weight and by number). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -172,9 +173,9 @@ static void section_subtitle(const json_t *res, const sphere_scan *sc, double ar
 }
 
 /* the head (title, subtitle, axes, the box) and the tail (a colour bar of the diameters) of
- * the section */
+ * the section; its subtitle by sub (NULL: section_subtitle) */
 static void section_frame(gp_svg *g, const json_t *res, bounds b, int width,
-                          const sphere_scan *sc, double hz, int nz)
+                          const sphere_scan *sc, double hz, int nz, svg_views3d_subtitle_fn sub)
 {
     int height;
     frame f = svg_plot_map_frame(b, width, &height);
@@ -184,8 +185,11 @@ static void section_frame(gp_svg *g, const json_t *res, bounds b, int width,
     char title[200], l1[320], l2[200];
     snprintf(title, sizeof title, "Section at z = %.4g m: %zu of %zu spheres cut", g->z, sc->ncut,
              sc->n);
-    section_subtitle(res, sc, (b.xmax - b.xmin) * (b.ymax - b.ymin), g->z, hz, nz, l1, l2,
-                     sizeof l1);
+    double area = (b.xmax - b.xmin) * (b.ymax - b.ymin);
+    if (sub)
+        sub(res, g->z, area > 0 ? 1 - sc->cut_area / area : NAN, l1, l2, sizeof l2);
+    else
+        section_subtitle(res, sc, area, g->z, hz, nz, l1, l2, sizeof l1);
     svg_plot_doc_begin(s, width, height, title);
     svg_plot_text_at(s, width / 2.0, 42, "middle", "class=\"subtitle\"", l1);
     svg_plot_text_at(s, width / 2.0, 58, "middle", "class=\"subtitle\" fill=\"#444444\"", l2);
@@ -206,8 +210,8 @@ static void section_frame(gp_svg *g, const json_t *res, bounds b, int width,
 /* The section at z (opt->z, else default_z): pass 1 diameter range, bounds (when the result
  * has no box), count and the spheres cut (once z is known); the head; step_section draws the
  * cut spheres, then the tail. */
-int svg_views3d_section(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
-                     gpd_err *err)
+int svg_views3d_section_with(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt,
+                             int width, svg_views3d_subtitle_fn sub, gpd_err *err)
 {
     if (svg_open_part(g, in, GP_SVG_SPHERES, "section", err)) return -1;
     double box[3] = {NAN, NAN, NAN}, lo[3] = {0, 0, 0};
@@ -237,8 +241,14 @@ int svg_views3d_section(gp_svg *g, const gp_svg_input *in, const gp_svg_options 
     g->dmax = sc.dmax;
     g->logscale = sc.dmax > 4 * sc.dmin;
     bounds b = {lo[0], lo[0] + box[0], lo[1], lo[1] + box[1]};
-    section_frame(g, in->summary, b, width, &sc, box[2], nz);
+    section_frame(g, in->summary, b, width, &sc, box[2], nz, sub);
     return svg_start_steps(g, step_section, err);
+}
+
+int svg_views3d_section(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
+                     gpd_err *err)
+{
+    return svg_views3d_section_with(g, in, opt, width, NULL, err);
 }
 
 /* the sieve curves of stats.psd: percent passing against the sieve diameter (log scale) */
