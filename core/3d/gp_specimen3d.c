@@ -28,7 +28,10 @@
  *  phase 2, tiling: gp_flip.
  * Code: gp_specimen3d_build() runs one function per phase over one build_run (read_spec,
  * draw_sample, place_sample, start_dem, deposit, compact, relax, collect_sample, tile_sample,
- * measure_final); the measures of the final packing are one pass over its contacts (measure).
+ * measure_final, measure_transfer); the measures of the final packing are one pass over its
+ * contacts (measure); a tiled specimen's sample and final packing are then measured side by
+ * side by gp_transfer (measure_transfer), which reads the spheres and contacts and changes
+ * nothing else.
  */
 #include "gp_specimen3d.h"
 
@@ -38,6 +41,7 @@
 #include "gp_flip.h"
 #include "gp_rng.h"
 #include "gp_sieve.h"
+#include "gp_transfer.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -106,6 +110,14 @@
                                     at a constant speed, is quicker on this scale) */
 #define TILE_FLIP_PF 0.4         /* tiling: the flip done ... */
 #define TILE_MEASURE_PF 0.6      /* ... and the tiled relaxation, before the measures */
+#define TILE_TRANSFER_PF 0.7     /* ... and the measures, before gp_transfer's (a tiling) */
+
+/* gp_transfer's g(r) (measure_transfer): bins of TRANSFER_DR up to TRANSFER_R_MAX, in units of
+ * the sample's d50, the final packing's on a block of at most TRANSFER_BLOCK tiles a side */
+#define TRANSFER_DR 0.05
+#define TRANSFER_R_MAX 5.0
+#define TRANSFER_R_MAX_BOX 0.75  /* r_max <= this x the box's shortest side (gp_transfer.h) */
+#define TRANSFER_BLOCK 2
 
 static const gp_sieve_row TABLE2[5] = {
     {0.010, 0}, {0.020, 2}, {0.050, 50}, {0.080, 95}, {0.100, 100}};
@@ -186,6 +198,8 @@ void gp_specimen3d_destroy(gp_specimen3d *s)
     free(s->stats.psd.target_number_midbin);
     free(s->stats.psd.achieved_weight);
     free(s->stats.psd.achieved_number);
+    free(s->transfer_sample);
+    free(s->transfer_final);
     free(s);
 }
 
@@ -1005,6 +1019,190 @@ static gp_status measure_final(build_run *R)
                    S->particles, R->cancel, R->res, R->err);
 }
 
+/* ---- the sample and the final packing side by side (gp_transfer.h) ----
+ * Only a tiled specimen. The sample: its spheres, box and own contacts. The final packing:
+ * its porosity, contacts, fabric and PSD on the whole tiling (the sample's contacts flipped
+ * as they are read, or the relaxed tiling's), and its g(r) on a block of at most
+ * TRANSFER_BLOCK tiles a side: the g(r) of a tiling costs O(spheres), ~0.5 us a pair (500 or
+ * so pairs a sphere within 5 d50), and a tiling may hold millions of spheres; the block's is
+ * at most TRANSFER_BLOCK^3 times the sample's, its box at least the sample's, so the same
+ * r_max fits in it. The whole tiling's own pass then runs with g(r) to one bin (r_max = dr:
+ * a pass over the spheres' neighbour cells, no pair in reach but the overlapping ones), and
+ * the block's g(r) takes its place. Every figure is a sum of integers or a pass in the
+ * spheres' order: the same bits for any thread count. */
+
+/* the spec's sieve diameters for gp_transfer: all of them, or GP_TRANSFER_MAX_SIEVES evenly
+ * chosen rows (the first and last among them) when it has more */
+static size_t transfer_sieves(const build_run *R, double *out)
+{
+    size_t ns = R->spec->nsieve;
+    if (ns <= GP_TRANSFER_MAX_SIEVES) {
+        memcpy(out, R->sd, ns * sizeof *out);
+        return ns;
+    }
+    for (size_t k = 0; k < GP_TRANSFER_MAX_SIEVES; k++)
+        out[k] = R->sd[k * (ns - 1) / (GP_TRANSFER_MAX_SIEVES - 1)];
+    return GP_TRANSFER_MAX_SIEVES;
+}
+
+/* the bins of g(r) in units of d50: min(TRANSFER_R_MAX, what TRANSFER_R_MAX_BOX of the sample
+ * box's shortest side allows) / TRANSFER_DR, as gp_transfer computes its reach */
+static double transfer_r_max(const double sb[3], double d50)
+{
+    double lmin = fmin(sb[0], fmin(sb[1], sb[2]));
+    double nb = floor(TRANSFER_R_MAX / TRANSFER_DR + 0.5);
+    double fit = floor(TRANSFER_R_MAX_BOX * lmin / (TRANSFER_DR * d50));
+    if (fit < nb) nb = fit;
+    while (nb > 1 && !(nb * (TRANSFER_DR * d50) <= TRANSFER_R_MAX_BOX * lmin))
+        nb--;
+    return (nb < 1 ? 1 : nb) * TRANSFER_DR;
+}
+
+/* the spheres of tiled (nt) whose centres lie in the block of tiles [o, o + b) of the sample
+ * box sb, moved by -o sb (into the block's box); *out malloc'ed, *m of them */
+static gp_status transfer_block_spheres(const double *tiled, size_t nt, const double sb[3],
+                                        const int o[3], const int b[3], double **out, size_t *m,
+                                        gp_error *err)
+{
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = o[a] * sb[a];
+        hi[a] = (o[a] + b[a]) * sb[a];
+    }
+    size_t k = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        k = 0;
+        for (size_t i = 0; i < nt; i++) {
+            const double *q = tiled + 4 * i;
+            if (!(q[0] >= lo[0] && q[0] < hi[0] && q[1] >= lo[1] && q[1] < hi[1] &&
+                  q[2] >= lo[2] && q[2] < hi[2]))
+                continue;
+            if (pass) {
+                for (int a = 0; a < 3; a++)
+                    (*out)[4 * k + a] = q[a] - lo[a];
+                (*out)[4 * k + 3] = q[3];
+            }
+            k++;
+        }
+        if (!pass && !(*out = malloc((k ? k : 1) * 4 * sizeof **out)))
+            return gp_error_set(err, GP_ERR_NOMEM, "out of memory (%zu spheres)", k);
+    }
+    *m = k;
+    return GP_OK;
+}
+
+static gp_status measure_transfer(build_run *R)
+{
+    gp_specimen3d *res = R->res;
+    gp_stats3d *S = &res->stats;
+    const gp_spec3d *spec = R->spec;
+    if (!R->tile || R->n < 2)
+        return GP_OK;
+    double t0 = gp_clock_seconds();
+    gp_error *err = R->err;
+    double sieve[GP_TRANSFER_MAX_SIEVES];
+    gp_transfer_params par;
+    gp_transfer_params_defaults(&par);
+    par.nsieve = transfer_sieves(R, sieve);
+    par.sieve = sieve;
+    par.dr = TRANSFER_DR;
+    par.r_max = TRANSFER_DR;
+    par.threads = spec->threads > 0 ? spec->threads : 1;
+    par.cancel = R->cancel;
+    gp_transfer_side *side = NULL, *blk = NULL;
+    double *bx = NULL;
+    gp_status st = GP_OK;
+    if (!(res->transfer_sample = malloc(sizeof *res->transfer_sample)) ||
+        !(res->transfer_final = malloc(sizeof *res->transfer_final)) ||
+        !(side = malloc(sizeof *side)) || !(blk = malloc(sizeof *blk))) {
+        st = gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    if (report(&R->rc, "tiling", 0.97, TILE_TRANSFER_PF, S->steps, R->p, S->stability, 0)) {
+        st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+        goto done;
+    }
+    /* the sample: its d50 (a pass with g(r) to one bin), then every figure in units of it */
+    gp_transfer_packing ps = {.xyzr = R->xyzr, .n = R->n, .contact_kind = GP_TRANSFER_CONTACTS_GIVEN,
+                              .contacts = R->con, .ncontacts = R->ncon};
+    memcpy(ps.box, res->sample_box, sizeof ps.box);
+    if ((st = gp_transfer_measure(&ps, &par, side, err)))
+        goto done;
+    par.unit = side->d50;
+    par.r_max = transfer_r_max(res->sample_box, side->d50);
+    if ((st = gp_transfer_measure(&ps, &par, res->transfer_sample, err)))
+        goto done;
+    if (report(&R->rc, "tiling", 0.98, TILE_TRANSFER_PF + 0.1, S->steps, R->p, S->stability, 0)) {
+        st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+        goto done;
+    }
+    /* the final packing, whole */
+    gp_transfer_packing pf = {.xyzr = R->tiled, .n = R->ntiled,
+                              .contact_kind = R->relaxed ? GP_TRANSFER_CONTACTS_GIVEN
+                                                         : GP_TRANSFER_CONTACTS_FLIPPED,
+                              .contacts = R->relaxed ? R->tcon : R->con,
+                              .ncontacts = R->relaxed ? R->ntcon : R->ncon};
+    memcpy(pf.box, res->box, sizeof pf.box);
+    memcpy(pf.tiles, spec->tiling, sizeof pf.tiles);
+    int whole = 1;
+    for (int a = 0; a < 3; a++) {
+        int b = spec->tiling[a] < TRANSFER_BLOCK ? spec->tiling[a] : TRANSFER_BLOCK;
+        res->transfer_block[a] = b;
+        res->transfer_block_origin[a] = (spec->tiling[a] - b) / 2;
+        whole &= b == spec->tiling[a];
+    }
+    double r_max = par.r_max;
+    if (!whole)
+        par.r_max = TRANSFER_DR;
+    if ((st = gp_transfer_measure(&pf, &par, res->transfer_final, err)))
+        goto done;
+    res->transfer_block_spheres = R->ntiled;
+    if (!whole) {
+        /* g(r) of the block: its spheres, no contacts, no sieve (only its g(r) is kept) */
+        if (report(&R->rc, "tiling", 0.99, TILE_TRANSFER_PF + 0.15, S->steps, R->p,
+                   S->stability, 0)) {
+            st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
+            goto done;
+        }
+        size_t m = 0;
+        if ((st = transfer_block_spheres(R->tiled, R->ntiled, res->sample_box,
+                                         res->transfer_block_origin, res->transfer_block, &bx,
+                                         &m, err)))
+            goto done;
+        gp_transfer_packing pb = {.xyzr = bx, .n = m, .contact_kind = GP_TRANSFER_CONTACTS_GIVEN};
+        for (int a = 0; a < 3; a++)
+            pb.box[a] = res->transfer_block[a] * res->sample_box[a];
+        par.r_max = r_max;
+        par.sieve = NULL;
+        par.nsieve = 0;
+        if ((st = gp_transfer_measure(&pb, &par, blk, err)))
+            goto done;
+        gp_transfer_side *f = res->transfer_final;
+        f->unit = blk->unit;
+        f->dr = blk->dr;
+        f->r_max = blk->r_max;
+        f->nbins = blk->nbins;
+        memcpy(f->g, blk->g, sizeof f->g);
+        memcpy(f->g_err, blk->g_err, sizeof f->g_err);
+        memcpy(f->neighbours, blk->neighbours, sizeof f->neighbours);
+        memcpy(f->pairs, blk->pairs, sizeof f->pairs);
+        memcpy(f->g_mirror, blk->g_mirror, sizeof f->g_mirror);
+        res->transfer_block_spheres = m;
+    }
+    st = gp_transfer_compare(res->transfer_sample, res->transfer_final, &res->transfer_diff, err);
+done:
+    free(side);
+    free(blk);
+    free(bx);
+    if (st) {
+        free(res->transfer_sample);
+        free(res->transfer_final);
+        res->transfer_sample = res->transfer_final = NULL;
+    }
+    res->t_transfer = gp_clock_seconds() - t0;
+    return st;
+}
+
 /* the final spheres move to the result (GP_OUT3_SPHERES) */
 static void hand_out_spheres(build_run *R)
 {
@@ -1045,13 +1243,15 @@ gp_status gp_specimen3d_build(const gp_spec3d *spec, gp_progress_fn progress, vo
     double t_phase = gp_clock_seconds(); /* t_tiling: the tiling and the measures */
     if (!st) st = tile_sample(&R);
     if (!st) st = measure_final(&R);
+    double t_measured = gp_clock_seconds();
+    if (!st) st = measure_transfer(&R);
     gp_specimen3d *res = R.res;
     if (st) {
         gp_specimen3d_destroy(res);
         build_run_release(&R);
         return st;
     }
-    res->t_tiling = gp_clock_seconds() - t_phase;
+    res->t_tiling = t_measured - t_phase;
     hand_out_spheres(&R);
     report(&R.rc, "tiling", 1.0, 1.0, res->stats.steps, res->stats.porosity, res->stats.stability,
            1);

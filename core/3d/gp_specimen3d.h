@@ -26,6 +26,7 @@
 #include "gp_dem3d.h" /* gp_contact3d */
 #include "gp_error.h"
 #include "gp_progress.h"
+#include "gp_transfer.h"
 
 /* The protocol's constants that an export reproduces outside grainpack (core/export's
  * lammps-relax writes a LAMMPS relaxation with them): gravity (m/s^2, along -z), the stability
@@ -148,8 +149,24 @@ typedef struct gp_specimen3d {
     gp_contact3d *contacts;      /* with GP_OUT3_CONTACTS (the type: gp_dem3d.h) */
     size_t ncontacts;
     gp_stats3d stats;
-    /* timings, seconds */
-    double t_deposition, t_compaction, t_relaxation, t_tiling, t_total;
+    /* Did the flip keep the sample's structure (gp_transfer.h)? Only a tiled specimen has
+     * them (NULL untiled): the sample (its spheres, sample_box, its own contacts) and the
+     * final packing (the tiled spheres and box, its contacts the sample's flipped, or the
+     * relaxed tiling's own), measured at the spec's sieves (at most GP_TRANSFER_MAX_SIEVES of
+     * them, evenly chosen, when it has more), g(r) in units of the sample's d50 by weight, in
+     * bins of 0.05 up to r_max = min(5, 3/4 of the sample box's shortest side), and the diff.
+     * The final side's porosity, coordination, fabric and PSD are those of the whole tiling;
+     * its g(r) (g, g_err, neighbours, pairs, g_mirror) is that of a block of at most 2 x 2 x 2
+     * tiles (the whole tiling when it has at most 2 tiles along every axis, else the block
+     * nearest its centre): transfer_block tiles from tile transfer_block_origin on each axis,
+     * its transfer_block_spheres spheres (centres in the block) in the block's box. Its cost is
+     * at most 8 times the sample's own g(r), whatever the tiling. */
+    gp_transfer_side *transfer_sample, *transfer_final;
+    gp_transfer_diff transfer_diff;
+    int transfer_block[3], transfer_block_origin[3];
+    size_t transfer_block_spheres;
+    /* timings, seconds (t_transfer: the measures above, not part of t_tiling) */
+    double t_deposition, t_compaction, t_relaxation, t_tiling, t_transfer, t_total;
 } gp_specimen3d;
 
 /* Builds the specimen. Returns GP_OK, or an error with a message:

@@ -31,6 +31,10 @@ typedef struct gpd_view {
     const char *name;
     const char *options; /* the query options it reads besides width, comma-separated ("" none) */
     gp_svg_view_fn open;
+    /* the member of the result's summary the view draws from, as a dotted path
+     * ("stats.transfer"), when only some results have it (NULL: every result): the dashboard
+     * offers the view only where it is */
+    const char *needs;
 } gpd_view;
 
 /* What the submit path lets a kind read of another job (gpd_kind.resolve): 0 with the job's

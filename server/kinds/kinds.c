@@ -140,8 +140,9 @@ static json_t *kind_json(const gpd_kind *k)
 {
     json_t *views = json_array();
     for (const gpd_view *v = k->views; views && v->name; v++)
-        json_array_append_new(views, json_pack("{s:s, s:o}", "name", v->name, "options",
-                                               words(v->options)));
+        json_array_append_new(views, json_pack("{s:s, s:o, s:o}", "name", v->name, "options",
+                                               words(v->options), "needs",
+                                               v->needs ? json_string(v->needs) : json_null()));
     char exports[256];
     gpd_kind_export_list(k, exports, sizeof exports);
     return json_pack("{s:o, s:o, s:o}", "example", json_loads(k->example, 0, NULL), "views",

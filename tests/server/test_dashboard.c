@@ -112,7 +112,8 @@ int main(void)
         "\"fourier-voronoi-2d\":{\"example\":", "\"spheres-3d\":{\"example\":", "\"packing\"",
         "\"cells\"", "\"size\"", "\"orientation\"", "\"descriptors\"", "\"section\"", "\"psd\"",
         "\"lammps\"", "\"liggghts\"", "\"yade\"", "\"vtk\"", "\"csv\"", "\"solid_fraction\":0.65",
-        "\"porosity\":0.38", "{\"name\":\"packing\",\"options\":[\"color\"]}", NULL};
+        "\"porosity\":0.38", "{\"name\":\"packing\",\"options\":[\"color\"],\"needs\":null}",
+        "{\"name\":\"transfer\",\"options\":[],\"needs\":\"stats.transfer\"}", NULL};
     CHECK(strncmp(h, "<!DOCTYPE html>", 15) == 0);
     check_all(h, page);
     /* the page itself names no kind: it takes them from the daemon */

@@ -665,12 +665,12 @@ static json_t *done_detail(const char *id, const void *specimen)
 }
 
 static const gpd_view views[] = {
-    {"packing", "color", svg_views2d_packing},
-    {"cells", "", svg_views2d_cells},
-    {"size", "", svg_stats2d_size},
-    {"orientation", "", svg_stats2d_orientation},
-    {"descriptors", "", svg_stats2d_descriptors},
-    {NULL, NULL, NULL},
+    {"packing", "color", svg_views2d_packing, NULL},
+    {"cells", "", svg_views2d_cells, NULL},
+    {"size", "", svg_stats2d_size, NULL},
+    {"orientation", "", svg_stats2d_orientation, NULL},
+    {"descriptors", "", svg_stats2d_descriptors, NULL},
+    {NULL, NULL, NULL, NULL},
 };
 
 /* the api.md example */

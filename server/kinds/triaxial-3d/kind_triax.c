@@ -304,10 +304,10 @@ static const char example[] =
     " \"drainage\": \"drained\", \"outputs\": [\"curves\", \"spheres\"]}";
 
 static const gpd_view views[] = {
-    {"stress-strain", "", svg_triax_stress_strain},
-    {"mohr", "", svg_triax_mohr},
-    {"section", "z", svg_triax_section},
-    {NULL, NULL, NULL},
+    {"stress-strain", "", svg_triax_stress_strain, NULL},
+    {"mohr", "", svg_triax_mohr, NULL},
+    {"section", "z", svg_triax_section, NULL},
+    {NULL, NULL, NULL, NULL},
 };
 
 static const gpd_kind_export exports[] = {

@@ -100,6 +100,92 @@ static void check_phase_steps(const gp_specimen3d *r, const gp_spec3d *s)
            S->phase_dt_ratio[1], S->phase_dt_ratio[2]);
 }
 
+/* the spheres of tiles [1, 3) on every axis of a 4 x 4 x 4 tiling (t n + i), moved by -1 tile:
+ * the central block where the final packing's g(r) is measured */
+static double *central_block(const gp_specimen3d *rt, size_t n, size_t *m)
+{
+    double *x = malloc(8 * 4 * n * sizeof *x);
+    *m = 0;
+    for (size_t t = 0; x && t < 64; t++) {
+        size_t k[3] = {t % 4, (t / 4) % 4, t / 16};
+        if (k[0] < 1 || k[0] > 2 || k[1] < 1 || k[1] > 2 || k[2] < 1 || k[2] > 2)
+            continue;
+        for (size_t i = 0; i < n; i++, (*m)++) {
+            const double *q = rt->spheres + 4 * (t * n + i);
+            for (int a = 0; a < 3; a++)
+                x[4 * *m + a] = q[a] - rt->sample_box[a];
+            x[4 * *m + 3] = q[3];
+        }
+    }
+    return x;
+}
+
+/* stats.transfer of rt (spec s tiled 4 x 4 x 4) against r (s untiled: the same sample): the
+ * final side's porosity, coordination and fabric are rt's own stats; the sample side is
+ * gp_transfer_measure on r's spheres and contacts; the final g(r) that of the central
+ * 2 x 2 x 2 tiles; the diff gp_transfer_compare's */
+static void check_transfer(const gp_specimen3d *r, const gp_specimen3d *rt, const gp_spec3d *s)
+{
+    const gp_transfer_side *A = rt->transfer_sample, *F = rt->transfer_final;
+    CHECK(A != NULL && F != NULL);
+    if (!A || !F)
+        return;
+    CHECK_NEAR(F->porosity, rt->stats.porosity, 1e-15);
+    CHECK(F->coordination == rt->stats.coordination_number);
+    CHECK(F->coordination_spheres == rt->stats.coordination_spheres);
+    CHECK(memcmp(F->fabric, rt->stats.fabric, sizeof F->fabric) == 0);
+    CHECK(F->n == rt->count && A->n == r->count);
+    CHECK(rt->transfer_diff.porosity <= 1e-12 && rt->transfer_diff.coordination == 0);
+    /* the sample side, measured here */
+    double sieve[3];
+    for (size_t k = 0; k < s->nsieve; k++)
+        sieve[k] = s->sieve[k].diameter;
+    gp_transfer_params par;
+    gp_transfer_params_defaults(&par);
+    par.sieve = sieve;
+    par.nsieve = s->nsieve;
+    par.r_max = A->r_max;
+    par.dr = 0.05;
+    CHECK(A->r_max == 5.0 && A->nbins == 100 && A->dr == 0.05 && A->unit == A->d50);
+    gp_transfer_packing p = {.xyzr = r->spheres, .n = r->count,
+                             .contact_kind = GP_TRANSFER_CONTACTS_GIVEN, .contacts = r->contacts,
+                             .ncontacts = r->ncontacts};
+    memcpy(p.box, r->box, sizeof p.box);
+    gp_transfer_side *mine = malloc(sizeof *mine);
+    gp_error e;
+    CHECK(mine && gp_transfer_measure(&p, &par, mine, &e) == GP_OK);
+    if (mine)
+        CHECK(memcmp(mine, A, sizeof *mine) == 0);
+    /* the final g(r): the central block's, in units of the sample's d50 */
+    for (int a = 0; a < 3; a++)
+        CHECK(rt->transfer_block[a] == 2 && rt->transfer_block_origin[a] == 1);
+    CHECK(rt->transfer_block_spheres == 8 * r->count);
+    size_t m = 0;
+    double *bx = central_block(rt, r->count, &m);
+    gp_transfer_packing pb = {.xyzr = bx, .n = m, .contact_kind = GP_TRANSFER_CONTACTS_GIVEN};
+    for (int a = 0; a < 3; a++)
+        pb.box[a] = 2 * rt->sample_box[a];
+    par.unit = A->d50;
+    CHECK(mine && bx && gp_transfer_measure(&pb, &par, mine, &e) == GP_OK);
+    if (mine && bx) {
+        CHECK(F->nbins == A->nbins && F->unit == A->unit && F->r_max == A->r_max);
+        CHECK(memcmp(F->g, mine->g, sizeof F->g) == 0);
+        CHECK(memcmp(F->pairs, mine->pairs, sizeof F->pairs) == 0);
+        CHECK(memcmp(F->g_mirror, mine->g_mirror, sizeof F->g_mirror) == 0);
+    }
+    gp_transfer_diff d;
+    CHECK(gp_transfer_compare(A, F, &d, &e) == GP_OK);
+    CHECK(memcmp(&d, &rt->transfer_diff, sizeof d) == 0);
+    /* the PSD of the flip is the sample's (by number, exactly) */
+    for (size_t k = 0; k < A->nsieve; k++)
+        CHECK(F->psd_number[k] == A->psd_number[k]);
+    printf("transfer, 4x4x4 of %zu spheres: g(r) largest difference %.3f at %.3f d50 (rms %.3f) "
+           "on the central %zu spheres, %.3f s\n", r->count, d.rdf, d.rdf_r, d.rdf_rms, m,
+           rt->t_transfer);
+    free(bx);
+    free(mine);
+}
+
 static void test_small_and_tiled(void)
 {
     gp_spec3d s;
@@ -130,7 +216,10 @@ static void test_small_and_tiled(void)
             CHECK_REL(rt->stats.stress[a][a], r->stats.stress[a][a], 1e-6);
         /* the sample inside is the same packing, bit for bit (tile 0 is the sample) */
         CHECK(memcmp(rt->spheres, r->spheres, 4 * r->count * sizeof(double)) == 0);
+        check_transfer(r, rt, &s);
     }
+    /* untiled: no transfer */
+    CHECK(r->transfer_sample == NULL && r->transfer_final == NULL);
     gp_specimen3d_destroy(rt);
     gp_specimen3d_destroy(r);
 }
@@ -292,6 +381,52 @@ static void test_contacts_output_invariant(void)
     CHECK(r == NULL && flag == 1);
 }
 
+/* stats.transfer of a tiling the same bit for bit for 1 and 2 threads (3 x 2 x 2: the block
+ * is 2 x 2 x 2 from tile 0), and of a relaxed tiling measured on the DEM's own contacts */
+static void test_transfer_threads_relaxed(void)
+{
+    gp_spec3d s;
+    short_spec(&s);
+    s.tiling[0] = 3;
+    s.tiling[1] = s.tiling[2] = 2;
+    s.outputs = GP_OUT3_FABRIC;
+    gp_specimen3d *a = NULL, *b = NULL;
+    gp_error e;
+    s.threads = 1;
+    gp_specimen3d_build(&s, NULL, NULL, NULL, &a, &e);
+    s.threads = 2;
+    gp_specimen3d_build(&s, NULL, NULL, NULL, &b, &e);
+    CHECK(a && b && a->transfer_sample && b->transfer_sample && a->transfer_final &&
+          b->transfer_final);
+    if (a && b && a->transfer_sample && b->transfer_sample && a->transfer_final &&
+        b->transfer_final) {
+        CHECK(memcmp(a->transfer_sample, b->transfer_sample, sizeof *a->transfer_sample) == 0);
+        CHECK(memcmp(a->transfer_final, b->transfer_final, sizeof *a->transfer_final) == 0);
+        CHECK(memcmp(&a->transfer_diff, &b->transfer_diff, sizeof a->transfer_diff) == 0);
+        CHECK(a->transfer_block[0] == 2 && a->transfer_block_origin[0] == 0);
+        CHECK(a->transfer_block_spheres == 8 * a->stats.sample_particles);
+        CHECK(a->transfer_final->coordination == a->stats.coordination_number);
+    }
+    gp_specimen3d_destroy(a);
+    gp_specimen3d_destroy(b);
+    /* relaxed by the DEM: the tiling's own contacts, the whole tiling (2 x 1 x 1) */
+    s.tiling[0] = 2;
+    s.tiling[1] = s.tiling[2] = 1;
+    s.tile_relax_steps = 300;
+    gp_specimen3d *c = NULL;
+    gp_specimen3d_build(&s, NULL, NULL, NULL, &c, &e);
+    CHECK(c && c->transfer_final);
+    if (c && c->transfer_final) {
+        const gp_transfer_side *F = c->transfer_final;
+        CHECK(F->coordination == c->stats.coordination_number);
+        CHECK(F->coordination_spheres == c->stats.coordination_spheres);
+        CHECK(memcmp(F->fabric, c->stats.fabric, sizeof F->fabric) == 0);
+        CHECK_NEAR(F->porosity, c->stats.porosity, 1e-15);
+        CHECK(c->transfer_block_spheres == c->count && c->transfer_block[0] == 2);
+    }
+    gp_specimen3d_destroy(c);
+}
+
 #ifndef GP_SANITIZED
 static void test_paper_example(void)
 {
@@ -320,6 +455,7 @@ int main(void)
     test_small_and_tiled();
     test_threads_deterministic();
     test_contacts_output_invariant();
+    test_transfer_threads_relaxed();
     test_one_size();
 #ifndef GP_SANITIZED
     test_paper_example();
