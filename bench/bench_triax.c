@@ -15,7 +15,21 @@
  * of their own where they do not (its "definitions" say), so that a script can set the two
  * codes' curves side by side.
  * --export DIR: the specimen as yade_triaxial.py reads it: DIR/spheres.txt ("x y z r" a line,
- * %.17g, SI) and DIR/box.json ({"lo", "hi", "box"}), the sample as its build ended. */
+ * %.17g, SI) and DIR/box.json ({"lo", "hi", "box"}), the sample as its build ended.
+ *
+ * The study (did the flip tiling keep the sample's strength?), on when --seeds or --tiling is
+ * given or --confining lists more than one stress:
+ *   bench_triax --seeds 7,8,9 --tiling 2 --confining 50,100 [--rate 1/S] [--strain E]
+ *               [--threads N] [--box M] [--porosity P] [--parts s0,tiled]
+ * Each seed's specimen is built once (tiling {N, N, N}); at each confining stress the sample
+ * S0 (sample_spheres) and, with N > 1, the tiled packing (spheres) are tested (--parts keeps
+ * one of them); then the Mohr-Coulomb envelope (gp_triax_mohr_coulomb, the peak states'
+ * sigma3 and sigma1) of each over the stresses, per seed. One line per run goes to stderr as
+ * it ends; at the end one markdown table to stdout: per seed and stress the peak, phi_peak, its
+ * axial strain, the largest I, seconds (wall) and steps of each run; per seed the envelopes;
+ * the mean and sample standard deviation (n - 1) over the seeds of S0's phi_peak and phi' and
+ * of the tiling's, and whether each tiled phi lies within S0's mean +- 2 sd. A run that fails
+ * is reported and left out. --json and --export are for the single run only. */
 #include "gp_clock.h"
 #include "gp_specimen3d.h"
 #include "gp_triax.h"
@@ -205,15 +219,295 @@ static int export_specimen(const char *dir, const gp_specimen3d *sp)
     return (fclose(f) != 0) | bad;
 }
 
+/* ------------------------------------------------------------------ the study */
+
+#define MAX_LIST 16
+
+/* a comma-separated list of numbers into v (at most MAX_LIST); the count, 0 if malformed */
+static int parse_list(const char *a, double *v)
+{
+    int n = 0;
+    const char *q = a;
+    while (*q) {
+        char *end;
+        double x = strtod(q, &end);
+        if (end == q || n == MAX_LIST)
+            return 0;
+        v[n++] = x;
+        if (*end == ',')
+            q = end + 1;
+        else if (*end == '\0')
+            q = end;
+        else
+            return 0;
+    }
+    return n;
+}
+
+typedef struct study_run {
+    int ok;
+    double peak, phi, eps_peak, imax, servo, seconds, cpu, sigma1, sigma3, dt;
+    long steps, consolidation_steps;
+    size_t spheres;
+} study_run;
+
+typedef struct study_mc {
+    int ok;
+    double phi, c, residual;
+} study_mc;
+
+static void study_one(const gp_spec3d *spec, const double *xyzr, size_t n, const double *hi,
+                      double confining_kpa, double rate, double strain, int threads,
+                      study_run *out)
+{
+    memset(out, 0, sizeof *out);
+    out->spheres = n;
+    gp_triax_params p;
+    gp_triax_params_defaults(&p);
+    p.confining = confining_kpa * 1e3;
+    p.strain_rate = rate;
+    p.axial_strain = strain;
+    p.threads = threads;
+    p.d50 = d50_by_mass(xyzr, n);
+    p.max_steps = gp_triax_estimate_steps(&spec->material, 0.5 * spec->sieve[0].diameter, &p);
+    const double lo[3] = {0, 0, 0};
+    gp_triax_result *r = NULL;
+    gp_error e;
+    double c0 = cpu_seconds(), t0 = gp_clock_seconds();
+    gp_status st = gp_triax_run(&spec->material, xyzr, n, lo, hi, &p, NULL, NULL, NULL, &r, &e);
+    out->seconds = gp_clock_seconds() - t0;
+    out->cpu = cpu_seconds() - c0;
+    if (st != GP_OK) {
+        fprintf(stderr, "  triax failed: %s\n", e.message);
+        return;
+    }
+    size_t kp = 0; /* the peak's sample, for its stresses (as the kind's envelope takes them) */
+    for (size_t k = 1; k < r->ncurve; k++)
+        if (r->curve[k].ratio > r->curve[kp].ratio)
+            kp = k;
+    out->ok = 1;
+    out->peak = r->peak_ratio;
+    out->phi = r->peak_phi_deg;
+    out->eps_peak = r->peak_axial_strain;
+    out->imax = r->inertial_number_max;
+    out->servo = r->servo_error_max;
+    out->sigma1 = r->curve[kp].sigma1;
+    out->sigma3 = r->curve[kp].sigma3;
+    out->steps = r->steps;
+    out->consolidation_steps = r->consolidation_steps;
+    out->dt = r->dt;
+    if (r->still_rising)
+        fprintf(stderr, "  warning: still rising at the end of the loading\n");
+    gp_triax_result_destroy(r);
+}
+
+static void study_envelope(const study_run *runs, int npress, study_mc *mc)
+{
+    double s3[MAX_LIST], s1[MAX_LIST];
+    int k = 0;
+    memset(mc, 0, sizeof *mc);
+    for (int j = 0; j < npress; j++)
+        if (runs[j].ok) {
+            s3[k] = runs[j].sigma3;
+            s1[k] = runs[j].sigma1;
+            k++;
+        }
+    if (k < 2) /* one test is its own phi: no envelope */
+        return;
+    gp_error e;
+    mc->ok = gp_triax_mohr_coulomb(s3, s1, (size_t)k, &mc->phi, &mc->c, &mc->residual, &e)
+             == GP_OK;
+    if (!mc->ok)
+        fprintf(stderr, "  Mohr-Coulomb: %s\n", e.message);
+}
+
+/* mean and sample standard deviation (n - 1) of the x[i] with ok[i]; the count */
+static int mean_sd(const double *x, const int *ok, int n, double *mean, double *sd)
+{
+    int k = 0;
+    double s = 0, ss = 0;
+    for (int i = 0; i < n; i++)
+        if (ok[i]) {
+            s += x[i];
+            k++;
+        }
+    *mean = k ? s / k : NAN;
+    for (int i = 0; i < n; i++)
+        if (ok[i])
+            ss += (x[i] - *mean) * (x[i] - *mean);
+    *sd = k > 1 ? sqrt(ss / (k - 1)) : NAN;
+    return k;
+}
+
+static void run_cells(char *b, size_t n, const study_run *r)
+{
+    if (!r->ok)
+        snprintf(b, n, "failed | - | - | - | %.1f / -", r->seconds);
+    else
+        snprintf(b, n, "%.4f | %.2f | %.2f %% | %.2e | %.1f / %ld + %ld", r->peak, r->phi,
+                 100 * r->eps_peak, r->imax, r->seconds, r->consolidation_steps,
+                 r->steps - r->consolidation_steps);
+}
+
+static int study(const gp_spec3d *base, const double *seeds, int nseeds, const double *press,
+                 int npress, int tiling, int parts, double rate, double strain, int threads)
+{
+    /* [seed][pressure][0 = S0, 1 = tiled] */
+    static study_run runs[MAX_LIST][MAX_LIST][2];
+    static study_mc mc[MAX_LIST][2];
+    const char *name[2] = {"S0", "tiled"};
+    double t_all = gp_clock_seconds();
+    size_t nsample = 0, ntiled = 0;
+    for (int i = 0; i < nseeds; i++) {
+        gp_spec3d spec = *base;
+        spec.seed = (uint64_t)seeds[i];
+        spec.tiling[0] = spec.tiling[1] = spec.tiling[2] = tiling;
+        gp_specimen3d *sp = NULL;
+        gp_error e;
+        double t0 = gp_clock_seconds();
+        gp_status st = gp_specimen3d_build(&spec, NULL, NULL, NULL, &sp, &e);
+        if (st != GP_OK) {
+            fprintf(stderr, "seed %llu: specimen: %s\n", (unsigned long long)spec.seed, e.message);
+            gp_specimen3d_destroy(sp);
+            for (int j = 0; j < npress; j++)
+                runs[i][j][0].ok = runs[i][j][1].ok = 0;
+            continue;
+        }
+        nsample = sp->stats.sample_particles;
+        ntiled = sp->count;
+        fprintf(stderr, "seed %llu: specimen built in %.2f s: sample %zu spheres (porosity %.4f), "
+                        "tiled %zu (porosity %.4f)\n",
+                (unsigned long long)spec.seed, gp_clock_seconds() - t0, nsample,
+                sp->stats.sample_porosity, ntiled, sp->stats.porosity);
+        for (int j = 0; j < npress; j++)
+            for (int w = 0; w < 2; w++) {
+                study_run *r = &runs[i][j][w];
+                memset(r, 0, sizeof *r);
+                if (!(parts & (1 << w)) || (w == 1 && tiling < 2))
+                    continue;
+                if (w == 0)
+                    study_one(&spec, sp->sample_spheres, nsample, sp->sample_box, press[j], rate,
+                              strain, threads, r);
+                else
+                    study_one(&spec, sp->spheres, sp->count, sp->box, press[j], rate, strain,
+                              threads, r);
+                fprintf(stderr, "seed %llu %s %g kPa: %s peak %.4f at %.2f %%, phi %.2f deg, "
+                                "I max %.2e, servo error max %.2e, %ld + %ld steps, dt %.2f us, "
+                                "%.1f s wall, %.1f s CPU (all %.0f s)\n",
+                        (unsigned long long)spec.seed, name[w], press[j],
+                        r->ok ? "ok" : "FAILED", r->peak, 100 * r->eps_peak, r->phi, r->imax,
+                        r->servo, r->consolidation_steps, r->steps - r->consolidation_steps,
+                        1e6 * r->dt, r->seconds, r->cpu, gp_clock_seconds() - t_all);
+            }
+        gp_specimen3d_destroy(sp);
+        for (int w = 0; w < 2; w++) {
+            study_run col[MAX_LIST];
+            for (int j = 0; j < npress; j++)
+                col[j] = runs[i][j][w];
+            study_envelope(col, npress, &mc[i][w]);
+        }
+    }
+    int tiled = tiling > 1 && (parts & 2);
+    /* the scatter of S0 over the seeds */
+    double m_phi[MAX_LIST], s_phi[MAX_LIST], m_t[MAX_LIST], s_t[MAX_LIST], m_mc[2], s_mc[2];
+    int k_phi[MAX_LIST], k_t[MAX_LIST], k_mc[2];
+    for (int j = 0; j < npress; j++) {
+        double x[MAX_LIST], y[MAX_LIST];
+        int ok[MAX_LIST], oky[MAX_LIST];
+        for (int i = 0; i < nseeds; i++) {
+            x[i] = runs[i][j][0].phi, ok[i] = runs[i][j][0].ok;
+            y[i] = runs[i][j][1].phi, oky[i] = runs[i][j][1].ok;
+        }
+        k_phi[j] = mean_sd(x, ok, nseeds, &m_phi[j], &s_phi[j]);
+        k_t[j] = mean_sd(y, oky, nseeds, &m_t[j], &s_t[j]);
+    }
+    for (int w = 0; w < 2; w++) {
+        double x[MAX_LIST];
+        int ok[MAX_LIST];
+        for (int i = 0; i < nseeds; i++)
+            x[i] = mc[i][w].phi, ok[i] = mc[i][w].ok;
+        k_mc[w] = mean_sd(x, ok, nseeds, &m_mc[w], &s_mc[w]);
+    }
+    char tn[32];
+    snprintf(tn, sizeof tn, "%dx%dx%d", tiling, tiling, tiling);
+    printf("\nS0: %zu spheres; %s tiling: %zu spheres; rate %g /s to axial strain %g, drained, "
+           "%d thread%s; wall time %.0f s in all\n\n",
+           nsample, tn, ntiled, rate, strain, threads, threads == 1 ? "" : "s",
+           gp_clock_seconds() - t_all);
+    printf("| seed | sigma3 (kPa) | S0 peak sigma1/sigma3 | S0 phi_peak (deg) | S0 eps_a at peak | "
+           "S0 I max | S0 s / steps (consolidation + loading) | %s peak sigma1/sigma3 | %s "
+           "phi_peak (deg) | %s eps_a at peak | %s I max | %s s / steps (consolidation + "
+           "loading) | %s phi_peak within S0 mean +- 2 sd |\n",
+           tn, tn, tn, tn, tn, tn);
+    printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (int i = 0; i < nseeds; i++)
+        for (int j = 0; j < npress; j++) {
+            char a[160], b[160], in[96] = "-";
+            run_cells(a, sizeof a, &runs[i][j][0]);
+            if (tiled)
+                run_cells(b, sizeof b, &runs[i][j][1]);
+            else
+                snprintf(b, sizeof b, "- | - | - | - | -");
+            if (tiled && runs[i][j][1].ok && k_phi[j] > 1) {
+                double d = (runs[i][j][1].phi - m_phi[j]) / s_phi[j];
+                snprintf(in, sizeof in, "%s (%+.2f sd)", fabs(d) <= 2 ? "yes" : "NO", d);
+            }
+            printf("| %.0f | %g | %s | %s | %s |\n", seeds[i], press[j], a, b, in);
+        }
+    for (int i = 0; i < nseeds; i++) {
+        char a[96] = "-", b[96] = "-", in[96] = "-";
+        if (mc[i][0].ok)
+            snprintf(a, sizeof a, "phi' %.2f deg (c' %.2f kPa)", mc[i][0].phi, mc[i][0].c / 1e3);
+        if (tiled && mc[i][1].ok)
+            snprintf(b, sizeof b, "phi' %.2f deg (c' %.2f kPa)", mc[i][1].phi, mc[i][1].c / 1e3);
+        if (tiled && mc[i][1].ok && k_mc[0] > 1) {
+            double d = (mc[i][1].phi - m_mc[0]) / s_mc[0];
+            snprintf(in, sizeof in, "%s (%+.2f sd)", fabs(d) <= 2 ? "yes" : "NO", d);
+        }
+        printf("| %.0f | Mohr-Coulomb | | %s | | | | | %s | | | | %s |\n", seeds[i], a, b, in);
+    }
+    for (int j = 0; j < npress; j++) {
+        char b[96] = "-";
+        if (tiled && k_t[j])
+            snprintf(b, sizeof b, "%.2f +- %.2f (n %d)", m_t[j], s_t[j], k_t[j]);
+        printf("| mean +- sd | %g | | %.2f +- %.2f (n %d; 2 sd band %.2f-%.2f) | | | | | %s | | "
+               "| | |\n",
+               press[j], m_phi[j], s_phi[j], k_phi[j], m_phi[j] - 2 * s_phi[j],
+               m_phi[j] + 2 * s_phi[j], b);
+    }
+    {
+        char b[96] = "-";
+        if (tiled && k_mc[1])
+            snprintf(b, sizeof b, "phi' %.2f +- %.2f (n %d)", m_mc[1], s_mc[1], k_mc[1]);
+        printf("| mean +- sd | Mohr-Coulomb | | phi' %.2f +- %.2f (n %d; 2 sd band %.2f-%.2f) | | "
+               "| | | %s | | | | |\n",
+               m_mc[0], s_mc[0], k_mc[0], m_mc[0] - 2 * s_mc[0], m_mc[0] + 2 * s_mc[0], b);
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     unsigned long long seed = 7;
     double confining_kpa = 50, rate = 0.01, strain = 0.2, box = 0.5, porosity = 0.38;
     int threads = 1;
     const char *json = NULL, *export_dir = NULL;
+    double seeds[MAX_LIST], press[MAX_LIST] = {50};
+    int nseeds = 0, npress = 1, tiling = 0, parts = 3, bad_list = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--confining") && v) confining_kpa = atof(argv[++i]);
+        if (!strcmp(a, "--confining") && v) {
+            npress = parse_list(argv[++i], press);
+            bad_list |= !npress;
+            confining_kpa = press[0];
+        }
+        else if (!strcmp(a, "--seeds") && v) bad_list |= !(nseeds = parse_list(argv[++i], seeds));
+        else if (!strcmp(a, "--tiling") && v) bad_list |= (tiling = atoi(argv[++i])) < 1;
+        else if (!strcmp(a, "--parts") && v) {
+            const char *q = argv[++i];
+            parts = (strstr(q, "s0") ? 1 : 0) | (strstr(q, "tiled") ? 2 : 0);
+            bad_list |= !parts;
+        }
         else if (!strcmp(a, "--rate") && v) rate = atof(argv[++i]);
         else if (!strcmp(a, "--strain") && v) strain = atof(argv[++i]);
         else if (!strcmp(a, "--threads") && v) threads = atoi(argv[++i]);
@@ -222,18 +516,31 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--json") && v) json = argv[++i];
         else if (!strcmp(a, "--export") && v) export_dir = argv[++i];
         else if (a[0] != '-') seed = strtoull(a, NULL, 10);
-        else {
-            fprintf(stderr, "usage: bench_triax [SEED] [--confining KPA] [--rate 1/S] "
-                            "[--strain E] [--threads N] [--box M] [--porosity P] [--json FILE] "
-                            "[--export DIR]\n");
-            return 2;
-        }
+        else
+            bad_list = 1;
+    }
+    int is_study = nseeds > 0 || tiling > 0 || npress > 1;
+    if (bad_list || (is_study && (json || export_dir))) {
+        fprintf(stderr, "usage: bench_triax [SEED] [--confining KPA] [--rate 1/S] "
+                        "[--strain E] [--threads N] [--box M] [--porosity P] [--json FILE] "
+                        "[--export DIR]\n"
+                        "       bench_triax --seeds S,S,... [--tiling N] [--confining KPA,KPA,...] "
+                        "[--parts s0,tiled] [--rate 1/S] [--strain E] [--threads N] [--box M] "
+                        "[--porosity P]\n");
+        return 2;
     }
     gp_spec3d spec;
     gp_spec3d_defaults(&spec);
     spec.seed = seed;
     spec.box[0] = spec.box[1] = spec.box[2] = box;
     spec.porosity = porosity;
+    if (is_study) {
+        if (!nseeds)
+            seeds[nseeds++] = (double)seed;
+        spec.threads = threads;
+        return study(&spec, seeds, nseeds, press, npress, tiling ? tiling : 1, parts, rate,
+                     strain, threads);
+    }
     gp_specimen3d *sp = NULL;
     gp_error e;
     double t0 = gp_clock_seconds();
