@@ -48,6 +48,32 @@ S0 = {"box": 0.5, "porosity": 0.38}
 SMALL = {"box": 0.3, "porosity": 0.42}
 
 
+def make_spec(small=False, seed=7, box=None, porosity=None, sieve=None):
+    """The spheres-3d spec submitted: S0 (or the --small preset), each of box (cube edge, m),
+    porosity and sieve (rows [d_mm, % passing by weight]) overriding the preset when given.
+    tests/integration/test_triaxial_yade.py imports it."""
+    preset = SMALL if small else S0
+    edge = box if box is not None else preset["box"]
+    return {"kind": "spheres-3d", "seed": seed, "box": [edge, edge, edge],
+            "sieve": sieve if sieve else TABLE2_SIEVE, "sieve_units": "mm",
+            "porosity": porosity if porosity is not None else preset["porosity"],
+            "material": dict(TABLE1),
+            "outputs": ["spheres", "contacts", "fabric", "stress"]}  # no tiling: the sample S0
+
+
+def box_info(jid, spec, result):
+    """box.json for yade_triaxial.py: the walls at [0, box] and grainpack's own figures."""
+    box = result["box"]
+    st = result.get("stats", {})
+    return {"lo": [0.0, 0.0, 0.0], "hi": box, "box": box, "axial_axis": 2,
+            "job": jid, "spec": spec,
+            "grainpack": {k: st.get(k) for k in (
+                "particles", "porosity", "coordination_number", "coordination_spheres",
+                "fabric", "stress", "stability", "stop_reason", "steps", "dt",
+                "compaction_friction_deg", "contacts", "wall_contacts")},
+            "timings": result.get("timings")}
+
+
 def log(msg):
     sys.stderr.write("triaxial_specimen: %s\n" % msg)
     sys.stderr.flush()
@@ -169,13 +195,8 @@ def main():
     ap.add_argument("--timeout", type=float, default=3600, help="seconds to wait for the job")
     a = ap.parse_args()
 
-    preset = SMALL if a.small else S0
-    edge = a.box if a.box is not None else preset["box"]
-    spec = {"kind": "spheres-3d", "seed": a.seed, "box": [edge, edge, edge],
-            "sieve": json.loads(a.sieve) if a.sieve else TABLE2_SIEVE, "sieve_units": "mm",
-            "porosity": a.porosity if a.porosity is not None else preset["porosity"],
-            "material": dict(TABLE1),
-            "outputs": ["spheres", "contacts", "fabric", "stress"]}  # no tiling: the sample S0
+    spec = make_spec(small=a.small, seed=a.seed, box=a.box, porosity=a.porosity,
+                     sieve=json.loads(a.sieve) if a.sieve else None)
     os.makedirs(a.out, exist_ok=True)
     with open(os.path.join(a.out, "spec.json"), "w") as f:
         json.dump(spec, f, indent=1)
@@ -201,15 +222,8 @@ def main():
         json.dump(result, f)
     box = result["box"]
     st = result.get("stats", {})
-    info = {"lo": [0.0, 0.0, 0.0], "hi": box, "box": box, "axial_axis": 2,
-            "job": jid, "spec": spec,
-            "grainpack": {k: st.get(k) for k in (
-                "particles", "porosity", "coordination_number", "coordination_spheres",
-                "fabric", "stress", "stability", "stop_reason", "steps", "dt",
-                "compaction_friction_deg", "contacts", "wall_contacts")},
-            "timings": result.get("timings")}
     with open(os.path.join(a.out, "box.json"), "w") as f:
-        json.dump(info, f, indent=1)
+        json.dump(box_info(jid, spec, result), f, indent=1)
     n = sum(1 for l in text.decode().splitlines() if l and not l.startswith("#"))
     por = (st.get("porosity") or {}).get("achieved")
     log("job %s: %d spheres, box %s, porosity %s -> %s" % (jid, n, box, por, a.out))
