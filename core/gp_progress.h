@@ -11,6 +11,10 @@
 #ifndef GP_PROGRESS_H
 #define GP_PROGRESS_H
 
+#include <math.h>
+
+#include "gp_clock.h"
+
 typedef struct gp_progress {
     const char *phase;
     double fraction;
@@ -27,5 +31,40 @@ typedef struct gp_progress {
 } gp_progress;
 
 typedef int (*gp_progress_fn)(void *user, const gp_progress *p);
+
+/* 1 when a cancel flag (another thread's atomic store; NULL: none) is up. */
+static inline int gp_progress_cancelled(const volatile int *cancel)
+{
+    return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
+}
+
+/* A caller's callback and cancel flag, paced: gp_progress_pace hands report r on at most every
+ * GP_PROGRESS_PERIOD seconds (always when forced), its fractions clamped to [0, 1] and a
+ * stability that is not finite given as 0. Non-zero when the computation is to stop (the flag
+ * is up, or the callback asked). The clock decides only which reports are sent. */
+#define GP_PROGRESS_PERIOD 0.05
+
+typedef struct gp_progress_pacer {
+    gp_progress_fn fn;          /* NULL: no reports (the cancel flag is still read) */
+    void *user;
+    const volatile int *cancel; /* may be NULL */
+    double last;                /* when the last report was sent (gp_clock_seconds) */
+} gp_progress_pacer;
+
+static inline int gp_progress_pace(gp_progress_pacer *c, gp_progress r, int force)
+{
+    if (gp_progress_cancelled(c->cancel))
+        return 1;
+    if (!c->fn)
+        return 0;
+    double t = gp_clock_seconds();
+    if (!force && t - c->last < GP_PROGRESS_PERIOD)
+        return 0;
+    c->last = t;
+    r.fraction = r.fraction < 0 ? 0 : (r.fraction > 1 ? 1 : r.fraction);
+    r.phase_fraction = r.phase_fraction < 0 ? 0 : (r.phase_fraction > 1 ? 1 : r.phase_fraction);
+    r.stability = isfinite(r.stability) ? r.stability : 0;
+    return c->fn(c->user, &r) != 0;
+}
 
 #endif /* GP_PROGRESS_H */

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gp_progress.h"
+
 static gp_status check_tiles(const int tiles[3], size_t n, size_t *ntile, gp_error *err)
 {
     size_t t = 1;
@@ -17,11 +19,6 @@ static gp_status check_tiles(const int tiles[3], size_t n, size_t *ntile, gp_err
         return gp_error_set(err, GP_ERR_INVALID, "tiling: too many spheres");
     *ntile = t;
     return GP_OK;
-}
-
-static int cancel_raised(const volatile int *cancel)
-{
-    return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
 }
 
 gp_status gp_flip_tile(const double *xyzr, size_t n, const double box[3], const int tiles[3],
@@ -48,7 +45,7 @@ gp_status gp_flip_tile(const double *xyzr, size_t n, const double box[3], const 
     for (int kz = 0; kz < tiles[2]; kz++)
         for (int ky = 0; ky < tiles[1]; ky++)
             for (int kx = 0; kx < tiles[0]; kx++) {
-                if (cancel_raised(cancel)) { /* a tile: n spheres, at most 400,000 */
+                if (gp_progress_cancelled(cancel)) { /* a tile: n spheres, at most 400,000 */
                     free(o);
                     return gp_error_set(err, GP_ERR_CANCELLED, "flip: cancelled");
                 }
@@ -177,7 +174,7 @@ static gp_status walk(const gp_contact3d *c, const flip_key *ord, size_t nc, siz
     for (int kz = 0; kz < tiles[2]; kz++)
         for (int ky = 0; ky < tiles[1]; ky++)
             for (int kx = 0; kx < tiles[0]; kx++) {
-                if (cancel_raised(cancel)) /* a tile: the sample's contacts, a few million */
+                if (gp_progress_cancelled(cancel)) /* a tile: the sample's contacts, a few million */
                     return gp_error_set(m->err, GP_ERR_CANCELLED, "flip: cancelled");
                 int k[3] = {kx, ky, kz};
                 size_t t = ((size_t)kz * (size_t)tiles[1] + (size_t)ky) * (size_t)tiles[0] + (size_t)kx;

@@ -77,10 +77,6 @@ void gp_geostatic_result_destroy(gp_geostatic_result *r)
     free(r);
 }
 
-static int cancel_raised(const volatile int *cancel)
-{
-    return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
-}
 
 /* ---- the frame of gravity ---- */
 
@@ -357,31 +353,15 @@ static gp_status validate_input(const gp_geostatic_params *p, const double *xyzr
 
 /* ---- progress ---- */
 
-typedef struct progress_ctx {
-    gp_progress_fn fn;
-    void *user;
-    const volatile int *cancel;
-    double last;
-} progress_ctx;
+typedef gp_progress_pacer progress_ctx;
 
-/* calls the callback at most every 0.05 s (unless forced); non-zero: stop */
+/* the callback, paced (gp_progress_pace); non-zero: stop */
 static int report(progress_ctx *c, const char *phase, double fraction, double pf, long steps,
                   double sc, int force)
 {
-    if (cancel_raised(c->cancel))
-        return 1;
-    if (!c->fn)
-        return 0;
-    double t = gp_clock_seconds();
-    if (!force && t - c->last < 0.05)
-        return 0;
-    c->last = t;
-    gp_progress p = {.phase = phase,
-                     .fraction = fraction < 0 ? 0 : (fraction > 1 ? 1 : fraction),
-                     .phase_fraction = pf < 0 ? 0 : (pf > 1 ? 1 : pf),
-                     .steps = steps,
-                     .stability = isfinite(sc) ? sc : 0};
-    return c->fn(c->user, &p) != 0;
+    gp_progress p = {.phase = phase, .fraction = fraction, .phase_fraction = pf, .steps = steps,
+                     .stability = sc};
+    return gp_progress_pace(c, p, force);
 }
 
 /* ---- the measures ---- */
@@ -556,7 +536,7 @@ static gp_status pass_spheres(meas *M, gp_geostatic_result *R, const volatile in
     size_t ns = M->ns;
     double solid_box = 0, vol = 0, mom = 0, surface = -INFINITY;
     for (size_t i = 0; i < M->n; i++) {
-        if (i % CANCEL_EVERY == 0 && cancel_raised(cancel))
+        if (i % CANCEL_EVERY == 0 && gp_progress_cancelled(cancel))
             return gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
         const double *p = M->xyzr + 4 * i;
         double *s = M->fx + 4 * i;
@@ -625,7 +605,7 @@ static gp_status pass_contacts(meas *M, const gp_contact3d *c, size_t nc,
 {
     size_t ns = M->ns;
     for (size_t q = 0; q < nc; q++) {
-        if (q % CANCEL_EVERY == 0 && cancel_raised(cancel))
+        if (q % CANCEL_EVERY == 0 && gp_progress_cancelled(cancel))
             return gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
         const gp_contact3d *k = c + q;
         if (k->i >= M->n || (k->j >= 0 && ((size_t)k->j >= M->n || (size_t)k->j == k->i))

@@ -142,39 +142,17 @@ void gp_spec3d_defaults(gp_spec3d *s)
     s->tile_relax_steps = 0;
 }
 
-/* the caller's progress callback and cancel flag; report() calls the callback at most every
- * 0.05 s (unless forced) and returns non-zero when the run is to stop */
-typedef struct progress_ctx {
-    gp_progress_fn fn;
-    void *user;
-    const volatile int *cancel;
-    double last;
-} progress_ctx;
+/* the caller's progress callback and cancel flag, paced (gp_progress_pace) */
+typedef gp_progress_pacer progress_ctx;
 
 /* the caller's cancel flag, raised by another thread with an atomic store */
-static int cancel_raised(const volatile int *cancel)
-{
-    return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
-}
 
 static int report(progress_ctx *c, const char *phase, double fraction, double pf, long steps,
                   double porosity, double sc, int force)
 {
-    if (cancel_raised(c->cancel))
-        return 1;
-    if (!c->fn)
-        return 0;
-    double t = gp_clock_seconds();
-    if (!force && t - c->last < 0.05)
-        return 0;
-    c->last = t;
-    gp_progress p = {.phase = phase,
-                     .fraction = fraction < 0 ? 0 : (fraction > 1 ? 1 : fraction),
-                     .phase_fraction = pf < 0 ? 0 : (pf > 1 ? 1 : pf),
-                     .steps = steps,
-                     .porosity = porosity,
-                     .stability = isfinite(sc) ? sc : 0};
-    return c->fn(c->user, &p) != 0;
+    gp_progress p = {.phase = phase, .fraction = fraction, .phase_fraction = pf, .steps = steps,
+                     .porosity = porosity, .stability = sc};
+    return gp_progress_pace(c, p, force);
 }
 
 /* How far a gap closing towards end has come from g0, on a log scale: 0 at g0, 1 at end or
@@ -236,7 +214,7 @@ static int place(const double *diam, size_t n, double lam, const double L[3], gp
         head[c] = -1;
     int ok = 1;
     for (size_t i = 0; i < n && ok; i++) {
-        if (i % 256 == 0 && cancel_raised(cancel)) {
+        if (i % 256 == 0 && gp_progress_cancelled(cancel)) {
             ok = -1;
             break;
         }
@@ -326,7 +304,7 @@ static gp_status measure_init(measure_acc *m, unsigned outputs, const double *xy
 static gp_status measure_add(void *user, const gp_contact3d *c, size_t k, gp_error *err)
 {
     measure_acc *m = user;
-    if (cancel_raised(m->cancel))
+    if (gp_progress_cancelled(m->cancel))
         return gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
     for (size_t q = 0; q < k; q++) {
         if (c[q].j >= 0) m->pairs++;
@@ -444,7 +422,7 @@ static gp_status tiled_porosity(const int tiling[3], const double sb[3], const d
     size_t nx = (size_t)tiling[0], ny = (size_t)tiling[1], ntile = nx * ny * (size_t)tiling[2];
     double solid = 0;
     for (size_t t = 0; t < ntile; t++) {
-        if (cancel_raised(cancel))
+        if (gp_progress_cancelled(cancel))
             return gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
         size_t kx = t % nx, ky = (t / nx) % ny, kz = t / (nx * ny);
         double tlo[3] = {kx * sb[0], ky * sb[1], kz * sb[2]};
@@ -452,6 +430,21 @@ static gp_status tiled_porosity(const int tiling[3], const double sb[3], const d
         solid += gp_dem3d_solid_volume(tiled + 4 * t * n, n, tlo, thi);
     }
     *porosity = 1 - solid / (box[0] * box[1] * box[2]);
+    return GP_OK;
+}
+
+gp_status gp_material3d_check(const gp_material3d *m, gp_error *err)
+{
+    if (!(m->density > 0) || !isfinite(m->density))
+        return gp_error_set(err, GP_ERR_INVALID, "material.density must be > 0");
+    if (!(m->young > 0) || !isfinite(m->young))
+        return gp_error_set(err, GP_ERR_INVALID, "material.young must be > 0");
+    if (!(m->poisson >= 0) || !(m->poisson <= 10))
+        return gp_error_set(err, GP_ERR_INVALID, "material.poisson (k_s/k_n) must be in [0, 10]");
+    if (!(m->friction_deg >= 0) || !(m->friction_deg < 90))
+        return gp_error_set(err, GP_ERR_INVALID, "material.friction_deg must be in [0, 90)");
+    if (!(m->damping >= 0) || !(m->damping < 1))
+        return gp_error_set(err, GP_ERR_INVALID, "material.damping must be in [0, 1)");
     return GP_OK;
 }
 
@@ -463,16 +456,9 @@ static gp_status validate(const gp_spec3d *s, gp_error *err)
     if (!(s->porosity > 0) || !(s->porosity < 1))
         return gp_error_set(err, GP_ERR_INVALID, "porosity must be in (0, 1)");
     const gp_material3d *m = &s->material;
-    if (!(m->density > 0) || !isfinite(m->density))
-        return gp_error_set(err, GP_ERR_INVALID, "material.density must be > 0");
-    if (!(m->young > 0) || !isfinite(m->young))
-        return gp_error_set(err, GP_ERR_INVALID, "material.young must be > 0");
-    if (!(m->poisson >= 0) || !(m->poisson <= 10))
-        return gp_error_set(err, GP_ERR_INVALID, "material.poisson (k_s/k_n) must be in [0, 10]");
-    if (!(m->friction_deg >= 0) || !(m->friction_deg < 90))
-        return gp_error_set(err, GP_ERR_INVALID, "material.friction_deg must be in [0, 90)");
-    if (!(m->damping >= 0) || !(m->damping < 1))
-        return gp_error_set(err, GP_ERR_INVALID, "material.damping must be in [0, 1)");
+    gp_status mst = gp_material3d_check(m, err);
+    if (mst)
+        return mst;
     for (int a = 0; a < 3; a++)
         if (s->tiling[a] < 1 || s->tiling[a] > 4096)
             return gp_error_set(err, GP_ERR_INVALID, "tiling[%d] must be in [1, 4096]", a);

@@ -66,6 +66,10 @@ typedef struct gp_material3d {
     double damping;      /* local (non-viscous) damping of forces and moments (0.2) */
 } gp_material3d;
 
+/* GP_OK, or GP_ERR_INVALID naming the field out of range: density and young > 0 and finite,
+ * poisson (k_s / k_n) in [0, 10], friction_deg in [0, 90), damping in [0, 1). */
+gp_status gp_material3d_check(const gp_material3d *m, gp_error *err);
+
 /* The spec of kind "spheres-3d" (names as in shared/spec/api.md). The caller owns the sieve
  * array; gp_specimen3d_build() only reads it. */
 typedef struct gp_spec3d {

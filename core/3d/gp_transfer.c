@@ -8,6 +8,7 @@
 #include "gp_flip.h"
 #include "gp_grid.h"
 #include "gp_team.h"
+#include "gp_progress.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -21,11 +22,6 @@ __extension__ typedef unsigned __int128 u128;
 #define STENCIL 3           /* g(r) cells at least r_max / STENCIL wide */
 #define D50_BINS 4096       /* bins of one pass of the d50 search */
 #define CHUNK 4096          /* contacts per chunk */
-
-static int cancel_raised(const volatile int *cancel)
-{
-    return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
-}
 
 void gp_transfer_params_defaults(gp_transfer_params *p)
 {
@@ -249,7 +245,7 @@ typedef struct contact_acc {
 static gp_status contact_visit(void *user, const gp_contact3d *c, size_t k, gp_error *err)
 {
     contact_acc *m = user;
-    if (cancel_raised(m->cancel))
+    if (gp_progress_cancelled(m->cancel))
         return gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
     for (size_t q = 0; q < k; q++) {
         if (c[q].j >= 0) m->pairs++;
@@ -451,7 +447,7 @@ static void rdf_work(void *ctx, int tid)
     u128 *ws = R->wsum + (size_t)tid * R->nbins;
     uint64_t *cnt = R->cnt + (size_t)tid * R->nbins, *mcnt = R->mcnt + (size_t)tid * R->nbins;
     for (;;) {
-        if (cancel_raised(R->cancel)) {
+        if (gp_progress_cancelled(R->cancel)) {
             __atomic_store_n(&R->stop, 1, __ATOMIC_RELAXED);
             return;
         }
@@ -681,7 +677,7 @@ gp_status gp_transfer_measure(const gp_transfer_packing *P, const gp_transfer_pa
     memcpy(S->box, P->box, sizeof S->box);
     S->porosity = porosity(P, ntile);
     st = psd(P, par, S, err);
-    if (!st && cancel_raised(par->cancel))
+    if (!st && gp_progress_cancelled(par->cancel))
         st = gp_error_set(err, GP_ERR_CANCELLED, "cancelled");
     if (!st)
         st = contacts(P, par, ntile, S, err);

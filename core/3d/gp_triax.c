@@ -213,30 +213,17 @@ typedef struct triax_run {
     double solid0;         /* the spheres' volume in the box at the start (progress reports) */
 } triax_run;
 
-static int cancel_raised(const volatile int *cancel)
-{
-    return cancel && __atomic_load_n((const int *)cancel, __ATOMIC_RELAXED) != 0;
-}
 
-/* the progress callback at most every 0.05 s (unless forced); non-zero: stop */
+/* the progress callback, paced (gp_progress_pace); non-zero: stop */
 static int report(triax_run *R, const char *phase, double fraction, double pf, double porosity,
                   double sc, int force)
 {
-    if (cancel_raised(R->cancel))
-        return 1;
-    if (!R->progress)
-        return 0;
-    double t = gp_clock_seconds();
-    if (!force && t - R->last_report < 0.05)
-        return 0;
-    R->last_report = t;
-    gp_progress p = {.phase = phase,
-                     .fraction = fraction < 0 ? 0 : (fraction > 1 ? 1 : fraction),
-                     .phase_fraction = pf < 0 ? 0 : (pf > 1 ? 1 : pf),
-                     .steps = R->ds.steps,
-                     .porosity = porosity,
-                     .stability = isfinite(sc) ? sc : 0};
-    return R->progress(R->user, &p) != 0;
+    gp_progress_pacer pc = {R->progress, R->user, R->cancel, R->last_report};
+    gp_progress p = {.phase = phase, .fraction = fraction, .phase_fraction = pf,
+                     .steps = R->ds.steps, .porosity = porosity, .stability = sc};
+    int stop = gp_progress_pace(&pc, p, force);
+    R->last_report = pc.last;
+    return stop;
 }
 
 static double box_volume(const double lo[3], const double hi[3])
@@ -333,16 +320,9 @@ static gp_status validate(const gp_material3d *m, const double *xyzr, size_t n,
         return gp_error_set(err, GP_ERR_INVALID, "triax: NULL argument");
     if (n < 1)
         return gp_error_set(err, GP_ERR_INVALID, "triax: no spheres");
-    if (!(m->density > 0) || !isfinite(m->density))
-        return gp_error_set(err, GP_ERR_INVALID, "material.density must be > 0");
-    if (!(m->young > 0) || !isfinite(m->young))
-        return gp_error_set(err, GP_ERR_INVALID, "material.young must be > 0");
-    if (!(m->poisson >= 0) || !(m->poisson <= 10))
-        return gp_error_set(err, GP_ERR_INVALID, "material.poisson (k_s/k_n) must be in [0, 10]");
-    if (!(m->friction_deg >= 0) || !(m->friction_deg < 90))
-        return gp_error_set(err, GP_ERR_INVALID, "material.friction_deg must be in [0, 90)");
-    if (!(m->damping >= 0) || !(m->damping < 1))
-        return gp_error_set(err, GP_ERR_INVALID, "material.damping must be in [0, 1)");
+    gp_status mst = gp_material3d_check(m, err);
+    if (mst)
+        return mst;
     for (int a = 0; a < 3; a++)
         if (!isfinite(lo[a]) || !isfinite(hi[a]) || !(hi[a] > lo[a]))
             return gp_error_set(err, GP_ERR_INVALID, "box: axis %d is empty or not finite", a);
