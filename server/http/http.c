@@ -299,20 +299,32 @@ static enum MHD_Result send_problem(struct MHD_Connection *c, req *r, const gp_s
                       p->message[0] ? p->message : dflt_msg);
 }
 
-/* gpd_job_lookup (kind.h) on the store: another job's kind, status and effective spec */
-static int lookup_job(const char *id, char kind[64], char status[16], json_t **spec)
+/* gpd_job_lookup (kind.h) on the store: another job's kind, status, effective spec and, once
+ * it has succeeded, its result's summary */
+static int lookup_job(const char *id, char kind[64], char status[16], json_t **spec,
+                      json_t **summary)
 {
-    char *k = NULL, *text = NULL;
+    char *k = NULL, *text = NULL, *sum = NULL;
     *spec = NULL;
+    if (summary) *summary = NULL;
     if (!gpd_id_is_plausible(id)) return 1;
     store_rc rc = store_get_text(id, "kind", &k, status);
     if (rc == STORE_OK) rc = store_get_text(id, "spec", &text, status);
+    if (rc == STORE_OK && summary && !strcmp(status, "succeeded"))
+        rc = store_get_summary(id, &sum, NULL, NULL, status);
     snprintf(kind, 64, "%s", k ? k : "");
     *spec = text ? json_loads(text, 0, NULL) : NULL;
+    if (summary && sum) *summary = json_loads(sum, 0, NULL);
+    int ok = *spec && (!sum || *summary);
     free(k);
     free(text);
+    free(sum);
     if (rc == STORE_NOT_FOUND) return 1;
-    return rc == STORE_OK && *spec ? 0 : -1;
+    if (rc == STORE_OK && ok) return 0;
+    json_decref(*spec);
+    *spec = NULL;
+    if (summary) json_decref(*summary), *summary = NULL;
+    return -1;
 }
 
 /* The body as a spec with its defaults filled in, of a kind this daemon runs, within the

@@ -38,9 +38,12 @@ typedef struct gpd_view {
 } gpd_view;
 
 /* What the submit path lets a kind read of another job (gpd_kind.resolve): 0 with the job's
- * kind and status and (*spec, a new reference) its effective spec; 1 when there is no job of
- * that id; -1 when the store failed. */
-typedef int (*gpd_job_lookup)(const char *id, char kind[64], char status[16], json_t **spec);
+ * kind and status, (*spec, a new reference) its effective spec and, when summary is not NULL
+ * and the job has succeeded, (*summary, a new reference) its result's summary
+ * (store_get_summary; else NULL); 1 when there is no job of that id; -1 when the store
+ * failed. */
+typedef int (*gpd_job_lookup)(const char *id, char kind[64], char status[16], json_t **spec,
+                              json_t **summary);
 
 /* An export a kind writes itself, from its stored result's summary (store_get_summary), rather
  * than from an export pack (core/export): what does not fit a pack, such as curves. */
@@ -164,6 +167,19 @@ const gpd_kind *gpd_kind_find(const char *name);
 /* The kind of a result without a "kind" member: the first that owns it, else the first of the
  * table. */
 const gpd_kind *gpd_kind_guess(const json_t *result);
+/* The reference ref = {"job": id, ...} (at pointer ptr of the spec) to a succeeded job of kind
+ * want, for a resolve hook: 0 with *spec (the job's effective spec) and, when summary is not
+ * NULL, *summary (its result's summary), new references; 1 when there is nothing to resolve
+ * (ref has no "job" string; or the job is gone and ref already holds member kept, its copy
+ * made when it was resolved); -1 with *p: invalid_spec at ptr/job (no such job, another kind,
+ * not succeeded) or internal (the store failed). */
+int gpd_resolve_job(const json_t *ref, const char *ptr, const char *want, const char *kept,
+                    gpd_job_lookup lookup, json_t **spec, json_t **summary, gp_spec_problem *p);
+
+/* A resolve hook for a spec whose "specimen" may be {"job": id} of a succeeded sphere
+ * packing (schema/gp_spec_specimen.h): the job's effective spec put at "spec" beside the id. */
+int gpd_resolve_specimen(json_t *spec, gpd_job_lookup lookup, gp_spec_problem *p);
+
 /* The i-th kind of the table (0-based), NULL past its end. */
 const gpd_kind *gpd_kind_at(size_t i);
 /* Its index in the table, -1 when it is not there. */

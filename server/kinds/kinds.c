@@ -5,13 +5,15 @@
 #include <string.h>
 
 #include "gp_export.h"
+#include "gp_spec_specimen.h"
 
 /* The table: one line a kind, in the order the dashboard and the messages list them; the first
  * is the kind a result without "kind" falls back to. */
 #define GPD_KINDS(X)          \
     X(gpd_kind_fv2d)          \
     X(gpd_kind_spheres3d)     \
-    X(gpd_kind_triax)
+    X(gpd_kind_triax)         \
+    X(gpd_kind_geostatic)
 
 #define DECLARE(k) extern const gpd_kind k;
 GPD_KINDS(DECLARE)
@@ -160,4 +162,44 @@ json_t *gpd_kinds_json(void)
         }
     }
     return all;
+}
+
+int gpd_resolve_job(const json_t *ref, const char *ptr, const char *want, const char *kept,
+                    gpd_job_lookup lookup, json_t **spec, json_t **summary, gp_spec_problem *p)
+{
+    *spec = NULL;
+    if (summary) *summary = NULL;
+    const char *id = json_string_value(json_object_get(ref, "job"));
+    if (!id) return 1; /* nothing to resolve (or the schema's to refuse) */
+    char kind[64], status[16], at[160];
+    snprintf(at, sizeof at, "%s/job", ptr);
+    int rc = lookup(id, kind, status, spec, summary);
+    if (rc < 0)
+        return gp_problem(p, "internal", at, "the job store failed while reading job %s (see "
+                          "the daemon log)", id);
+    if (rc > 0 && json_object_get(ref, kept)) return 1;
+    if (rc > 0)
+        return gp_problem(p, "invalid_spec", at, "no job %.64s: expected a succeeded %s job",
+                          id, want);
+    if (!strcmp(kind, want) && !strcmp(status, "succeeded")) return 0;
+    json_decref(*spec);
+    *spec = NULL;
+    if (summary) json_decref(*summary), *summary = NULL;
+    if (strcmp(kind, want))
+        return gp_problem(p, "invalid_spec", at, "job %s is of kind \"%s\": expected a "
+                          "succeeded %s job", id, kind, want);
+    return gp_problem(p, "invalid_spec", at, "job %s is %s, not succeeded: %s", id, status,
+                      strcmp(status, "queued") && strcmp(status, "running")
+                          ? "only a succeeded job can be used"
+                          : "submit this spec once it has succeeded");
+}
+
+int gpd_resolve_specimen(json_t *spec, gpd_job_lookup lookup, gp_spec_problem *p)
+{
+    json_t *sp = json_object_get(spec, "specimen"), *js;
+    int rc = gpd_resolve_job(sp, "/specimen", gp_spec_specimen_kind(), "spec", lookup, &js,
+                             NULL, p);
+    if (rc) return rc > 0 ? 0 : -1;
+    return json_object_set_new(sp, "spec", js) ? gp_problem(p, "internal", "", "out of memory")
+                                                : 0;
 }

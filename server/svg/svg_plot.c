@@ -374,7 +374,7 @@ static void x_ticks(sb *s, const frame *f, int grid)
 static double y_ticks(sb *s, const frame *f, int grid)
 {
     ticks t;
-    svg_plot_lin_ticks(f->ymin, f->ymax, f->h, 0, 6, &t);
+    svg_plot_lin_ticks(fmin(f->ymin, f->ymax), fmax(f->ymin, f->ymax), f->h, 0, 6, &t);
     double wmax = 0;
     for (int i = 0; i < t.n; i++) {
         double y = svg_plot_fy(f, t.v[i]);

@@ -84,7 +84,7 @@ double *svg_plot_jarray(const json_t *a, size_t *n);
 
 typedef struct frame {
     double x0, y0, w, h;           /* pixels: left, top, width, height */
-    double xmin, xmax, ymin, ymax; /* data */
+    double xmin, xmax, ymin, ymax; /* data; ymin > ymax turns the y axis down (depth) */
     int xlog;
 } frame;
 

@@ -462,7 +462,7 @@ def check_brief(b):
     assert isinstance(b["seed"], int) and b["seed"] >= 0, b
     h = b["headline"]
     assert set(h) == {"name", "target", "achieved"} and h["name"] in ("solid_fraction",
-                                                                       "porosity"), b
+                                                                       "porosity", "k0"), b
     assert isinstance(h["target"], (int, float)), b
     assert h["achieved"] is None or isinstance(h["achieved"], (int, float)), b
 

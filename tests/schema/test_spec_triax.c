@@ -11,6 +11,7 @@
 
 #include "gp_spec.h"
 #include "gp_test.h"
+#include "gp_spec_specimen.h"
 #include "kinds/triaxial-3d/gp_spec_triax.h"
 
 /* the contract's example with the paper's sample inline */
@@ -334,7 +335,7 @@ static void test_reader(void)
     CHECK(gp_spec_triax_read(full, &s, &p) != 0 && !strcmp(p.code, "internal"));
     gp_spec_triax_free(&s);
     json_decref(full);
-    CHECK(!strcmp(gp_spec_triax_specimen_kind(), "spheres-3d"));
+    CHECK(!strcmp(gp_spec_specimen_kind(), "spheres-3d"));
 }
 
 /* the kind is in the served document */

@@ -4,6 +4,7 @@
  * bounds. See gp_spec_triax.h. */
 #include "gp_spec_internal.h"
 
+#include "gp_spec_specimen.h"
 #include "gp_spec_triax.h"
 
 #include <math.h>
@@ -12,7 +13,6 @@
 #include <string.h>
 
 extern const gp_spec_kind gp_spec_kind_triaxial_3d; /* this kind, defined at the end */
-extern const gp_spec_kind gp_spec_kind_spheres_3d;  /* the specimen's */
 
 extern const unsigned char gp_schema_text_triaxial_3d[];
 
@@ -29,58 +29,6 @@ extern const unsigned char gp_schema_text_triaxial_3d[];
 /* the names of the outputs, at the index of their bit (GP_OUT_TRIAX_*) */
 static const char *const g_outputs[] = {"curves", "spheres"};
 
-const char *gp_spec_triax_specimen_kind(void) { return gp_spec_kind_spheres_3d.name; }
-
-/* ------------------------------------------------------------------------------------------ */
-/* the specimen's spec */
-
-/* the specimen spec's problem q as this spec's, at /specimen/spec<its pointer>; -1 */
-static int inner_problem(const gp_spec_problem *q, gp_spec_problem *p)
-{
-    char ptr[sizeof p->pointer];
-    snprintf(ptr, sizeof ptr, "/specimen/spec%.240s", q->pointer);
-    const char *head = q->pointer[0] ? q->pointer : "spec", *m = q->message;
-    size_t n = strlen(head);
-    if (!strncmp(m, head, n) && m[n] == ':') m += n + 1 + (m[n + 1] == ' ');
-    return gp_problem(p, q->code, ptr, "%s", m);
-}
-
-/* the specimen's spec as posted in spec, made a spheres-3d spec: its kind (which may be left
- * out) and, when it has none, the test's seed; a new object, or NULL with *p */
-static json_t *inner_posted(const json_t *spec, gp_spec_problem *p)
-{
-    json_t *in = json_object_get(json_object_get(spec, "specimen"), "spec");
-    const json_t *kind = json_object_get(in, "kind"), *seed = json_object_get(spec, "seed");
-    const char *want = gp_spec_triax_specimen_kind();
-    if (kind && !(json_is_string(kind) && !strcmp(json_string_value(kind), want))) {
-        char g[80];
-        gp_schema_describe_value(kind, g, sizeof g);
-        gp_problem(p, "invalid_spec", "/specimen/spec/kind",
-                   "expected \"%s\" (a specimen is a sphere packing), got %s", want, g);
-        return NULL;
-    }
-    json_t *c = json_copy(in);
-    if (!c || (!kind && json_object_set_new(c, "kind", json_string(want))) ||
-        (seed && !json_object_get(c, "seed") && json_object_set(c, "seed", (json_t *)seed))) {
-        json_decref(c);
-        gp_spec_no_memory(p);
-        return NULL;
-    }
-    return c;
-}
-
-/* the effective spec of the specimen's spec in spec; NULL with *p (at /specimen/spec/...) */
-static json_t *inner_effective(const json_t *spec, gp_spec_problem *p)
-{
-    json_t *in = inner_posted(spec, p);
-    if (!in) return NULL;
-    gp_spec_problem q;
-    json_t *eff = gp_spec_with_defaults(in, &q);
-    json_decref(in);
-    if (!eff) inner_problem(&q, p);
-    return eff;
-}
-
 /* ------------------------------------------------------------------------------------------ */
 /* the reader (an effective spec: nothing is checked but its form) */
 
@@ -89,17 +37,6 @@ void gp_spec_triax_free(gp_spec_triax *s)
     if (!s) return;
     gp_spec3d_free(&s->specimen);
     memset(s, 0, sizeof *s);
-}
-
-/* the diameter at which the sieve rows' percent passing crosses q, linearly */
-static double sieve_quantile(const gp_sieve_row *rows, size_t n, double q)
-{
-    for (size_t k = 1; k < n; k++)
-        if (rows[k].passing >= q && rows[k].passing > rows[k - 1].passing)
-            return rows[k - 1].diameter + (rows[k].diameter - rows[k - 1].diameter) *
-                                              fmax(0, q - rows[k - 1].passing) /
-                                              (rows[k].passing - rows[k - 1].passing);
-    return n ? rows[n - 1].diameter : 0;
 }
 
 /* the material's overrides of the specimen's */
@@ -139,7 +76,7 @@ static void settle_specimen(gp_spec_triax *s)
     gp_spec3d *sp = &s->specimen;
     sp->outputs = GP_OUT3_SPHERES;
     if (!s->tiled) sp->tiling[0] = sp->tiling[1] = sp->tiling[2] = 1;
-    s->d50 = sieve_quantile(sp->sieve, sp->nsieve, 50);
+    s->d50 = gp_spec_sieve_quantile(sp->sieve, sp->nsieve, 50);
     s->r_min = sp->nsieve ? 0.5 * sp->sieve[0].diameter : 0;
 }
 
@@ -151,14 +88,9 @@ int gp_spec_triax_read(const json_t *full, gp_spec_triax *out, gp_spec_problem *
     static const char *const parts[] = {"sample", "tiled"};
     gp_spec_reader r = {0};
     out->seed = (uint64_t)gp_rd_num(&r, full, "/seed", 0, GP_RD_COUNT);
-    const json_t *sp = gp_rd_member(&r, full, "/specimen", JSON_OBJECT, 0);
-    const json_t *job = gp_rd_member(&r, sp, "/specimen/job", JSON_STRING, 1);
-    if (job) snprintf(out->job, sizeof out->job, "%s", json_string_value(job));
-    out->tiled = gp_rd_enum(&r, sp, "/specimen/part", parts, 2);
-    const json_t *inner = gp_rd_member(&r, sp, "/specimen/spec", JSON_OBJECT, 0);
+    out->tiled = gp_rd_enum(&r, json_object_get(full, "specimen"), "/specimen/part", parts, 2);
     if (r.bad) return gp_rd_finish(&r, p);
-    gp_spec_problem q;
-    if (gp_spec3d_read(inner, &out->specimen, &q)) return inner_problem(&q, p);
+    if (gp_spec_specimen_read(full, &out->specimen, out->job, p)) return -1;
     read_test(&r, full, out);
     settle_specimen(out);
     int rc = gp_rd_finish(&r, p);
@@ -193,9 +125,7 @@ typedef struct triax_work {
 static int work_of(const json_t *full, const gp_spec_triax *s, triax_work *w,
                    gp_spec_problem *p)
 {
-    gp_spec_problem q;
-    const json_t *inner = json_object_get(json_object_get(full, "specimen"), "spec");
-    if (gp_spec_bounds(inner, &w->specimen, &q)) return inner_problem(&q, p);
+    if (gp_spec_specimen_bounds(full, &w->specimen, p)) return -1;
     w->spheres = s->tiled ? w->specimen.items : w->specimen.cells;
     w->steps = 0;
     for (size_t i = 0; i < s->ntests; i++) {
@@ -274,32 +204,6 @@ static int bounds_triax(const json_t *full, gp_spec_bounds_t *b, gp_spec_problem
 /* ------------------------------------------------------------------------------------------ */
 /* the semantic checks */
 
-/* a specimen, inline (the daemon has put a job's spec there) */
-static int check_posted_triax(const json_t *spec, gp_spec_problem *p)
-{
-    const json_t *sp = json_object_get(spec, "specimen");
-    const json_t *job = json_object_get(sp, "job"), *in = json_object_get(sp, "spec");
-    if (!job && !in)
-        return gp_problem(p, "invalid_spec", "/specimen", "expected {\"job\": \"<id of a "
-                          "succeeded %s job>\"} or {\"spec\": {...}}, got neither",
-                          gp_spec_triax_specimen_kind());
-    if (!in)
-        return gp_problem(p, "invalid_spec", "/specimen/job", "job %s is not resolved: only "
-                          "the daemon looks a specimen job up, at submit (give the specimen "
-                          "as {\"spec\": {...}} to validate it alone)", json_string_value(job));
-    json_t *eff = inner_effective(spec, p);
-    json_decref(eff);
-    return eff ? 0 : -1;
-}
-
-/* the specimen's spec replaced by its effective spec */
-static int settle_triax(json_t *full)
-{
-    gp_spec_problem q;
-    json_t *eff = inner_effective(full, &q);
-    return eff && !json_object_set_new(json_object_get(full, "specimen"), "spec", eff) ? 0 : -1;
-}
-
 /* part "tiled" needs a tiling */
 static int check_part(const gp_spec_triax *s, gp_spec_problem *p)
 {
@@ -339,8 +243,8 @@ static int check_triax(const json_t *full, gp_spec_problem *p)
 const gp_spec_kind gp_spec_kind_triaxial_3d = {
     .name = "triaxial-3d",
     .schema_text = gp_schema_text_triaxial_3d,
-    .check_posted = check_posted_triax,
-    .settle_defaults = settle_triax,
+    .check_posted = gp_spec_specimen_check_posted,
+    .settle_defaults = gp_spec_specimen_settle,
     .check = check_triax,
     .bounds = bounds_triax,
     .items = "spheres",

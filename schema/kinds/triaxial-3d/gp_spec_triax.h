@@ -71,7 +71,4 @@ void gp_spec_triax_free(gp_spec_triax *s);
  * gp_triax_estimate_steps (the work bound counts those steps). */
 void gp_spec_triax_params(const gp_spec_triax *s, size_t i, gp_triax_params *out);
 
-/* The kind a specimen job must be of (the spheres' kind). */
-const char *gp_spec_triax_specimen_kind(void);
-
 #endif /* GP_SPEC_TRIAX_H */

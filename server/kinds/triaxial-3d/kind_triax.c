@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "gp_spec.h"
+#include "gp_spec_specimen.h"
 #include "gp_specimen3d.h"
 #include "gp_triax.h"
 #include "kinds/kind.h"
@@ -164,37 +165,6 @@ static void failure_note(const void *specimen, char *buf, size_t n)
 
 /* ------------------------------------------------------------------ submit */
 
-/* {"job": id}: the job's effective spec put beside it, when it is a succeeded specimen */
-static int resolve(json_t *spec, gpd_job_lookup lookup, gp_spec_problem *p)
-{
-    json_t *sp = json_object_get(spec, "specimen");
-    const char *id = json_string_value(json_object_get(sp, "job"));
-    if (!id) return 0; /* nothing to resolve (or the schema's to refuse) */
-    const char *want = gp_spec_triax_specimen_kind();
-    char kind[64], status[16];
-    json_t *js = NULL;
-    int rc = lookup(id, kind, status, &js);
-    if (rc < 0)
-        return gp_problem(p, "internal", "/specimen/job", "the job store failed while "
-                          "reading job %s (see the daemon log)", id);
-    /* an effective spec whose job is gone keeps its own copy of the job's spec */
-    if (rc > 0 && json_object_get(sp, "spec")) return 0;
-    if (rc > 0)
-        return gp_problem(p, "invalid_spec", "/specimen/job", "no job %.64s: the specimen must "
-                          "be a succeeded %s job", id, want);
-    int ok = !strcmp(kind, want) && !strcmp(status, "succeeded");
-    if (ok && !json_object_set_new(sp, "spec", js)) return 0;
-    json_decref(js);
-    if (ok) return gp_problem(p, "internal", "", "out of memory");
-    if (strcmp(kind, want))
-        return gp_problem(p, "invalid_spec", "/specimen/job", "job %s is of kind \"%s\", not "
-                          "a specimen: the specimen must be a succeeded %s job", id, kind, want);
-    return gp_problem(p, "invalid_spec", "/specimen/job", "job %s is %s, not succeeded: %s", id,
-                      status, strcmp(status, "queued") && strcmp(status, "running")
-                                  ? "only a succeeded job is a specimen"
-                                  : "submit the test once it has succeeded");
-}
-
 /* the spheres tested once it has succeeded, and the Mohr-Coulomb friction angle */
 static json_t *brief(const json_t *spec, const json_t *stats)
 {
@@ -241,7 +211,7 @@ static void test_phases(const gp_spec_triax *s, size_t i, double n, gpd_phase *o
 /* the specimen's phases (its kind's plan, without its result), or one phase "specimen" */
 static int specimen_phases(const gp_spec_triax *s, const json_t *inner, gpd_phase *out)
 {
-    const gpd_kind *sk = gpd_kind_find(gp_spec_triax_specimen_kind());
+    const gpd_kind *sk = gpd_kind_find(gp_spec_specimen_kind());
     gpd_phase sp[GPD_PLAN_MAX];
     int n = sk && sk->plan ? sk->plan(&s->specimen, inner, sp, GPD_PLAN_MAX) : 0;
     if (n > 0 && !strcmp(sp[n - 1].name, "result")) n--;
@@ -320,7 +290,7 @@ static const char *const phases[] = {"specimen", "consolidation", "loading", "to
 
 const gpd_kind gpd_kind_triax = {
     .name = KIND_NAME, .example = example, .views = views, .owns_result = owns_result,
-    .resolve = resolve, .bounds = gp_spec_check_result, .brief = brief,
+    .resolve = gpd_resolve_specimen, .bounds = gp_spec_check_result, .brief = brief,
     GPD_KIND_CORE_OPS(gp_spec_triax), .progress_detail = progress_detail, .plan = plan,
     .result_cost = result_cost, .result = result, .pack = pack, .failure_note = failure_note,
     .export_dim = 0, .exports = exports, .pack_what = "curves", .pack_output = "curves",
