@@ -160,7 +160,9 @@ static int script_head(gp_export *e)
         "# Run it in this folder:   mpirun -np 2 lmp -in relax.in\n"
         "#   (as root, add --allow-run-as-root; more ranks: -np N). Options: -var maxsteps N\n"
         "#   (default %d), -var timeout HH:MM:SS (stop after this wall time, default off),\n"
-        "#   -var every N (S_c is looked at every N steps, default %d).\n"
+        "#   -var every N (S_c is looked at every N steps, default %d), -var ztop Z (the top\n"
+        "#   wall's height, default the box's top: above the packing, e.g. twice the box's top,\n"
+        "#   the surface settles free under gravity, as a geostatic-3d job settles it).\n"
         "# It writes relax.json (porosity, coordination number and S_c before and after, steps,\n"
         "# seconds), final.dump (id type radius x y z of the final spheres) and log.lammps.\n"
         "#\n"
@@ -203,6 +205,7 @@ static int script_model(gp_export *e)
                      "variable        maxsteps index %d\n"
                      "variable        every index %d\n"
                      "variable        timeout index off\n"
+                     "variable        ztop index %.17g\n"
                      "units           si\n"
                      "atom_style      sphere\n"
                      "boundary        f f f\n"
@@ -213,7 +216,7 @@ static int script_model(gp_export *e)
                      "# contact law: k_n of the classes' middle radii, k_t = %.6g k_n, mu = "
                      "tan(%.6g deg)\n"
                      "pair_style      granular\n",
-                     MAX_STEPS, EVERY, d->dt, d->poisson, d->friction_deg))
+                     MAX_STEPS, EVERY, e->info.hi[2], d->dt, d->poisson, d->friction_deg))
         return -1;
     double mu = tan(d->friction_deg * M_PI / 180);
     for (int a = 1; a <= e->ntypes; a++)
@@ -255,14 +258,19 @@ static int script_forces(gp_export *e)
                      rs, rho43, rs, rs, rs))
         return -1;
     const char ax[3] = {'x', 'y', 'z'};
-    for (int a = 0; a < 3; a++)
+    for (int a = 0; a < 3; a++) {
+        /* the top wall at ${ztop} (the box's top unless the run lifts it) */
+        char hi[32];
+        if (a == 2) snprintf(hi, sizeof hi, "${ztop}");
+        else snprintf(hi, sizeof hi, "%.17g", L[a]);
         if (gp_xw_printf(e,
                          "variable        h%cl atom 0.5*(c_r-(%c-%.17g)+abs(c_r-(%c-%.17g)))\n"
-                         "variable        h%ch atom 0.5*(c_r-(%.17g-%c)+abs(c_r-(%.17g-%c)))\n"
+                         "variable        h%ch atom 0.5*(c_r-(%s-%c)+abs(c_r-(%s-%c)))\n"
                          "variable        fw%c atom %.17g*c_r*(v_h%cl-v_h%ch)\n",
-                         ax[a], ax[a], e->info.lo[a], ax[a], e->info.lo[a], ax[a], L[a], ax[a], L[a],
+                         ax[a], ax[a], e->info.lo[a], ax[a], e->info.lo[a], ax[a], hi, ax[a], hi,
                          ax[a], ax[a], 2 * d->young, ax[a], ax[a]))
             return -1;
+    }
     /* only the spheres within rmax of a face can touch one: the others skip the variables */
     double rm = d->rmax;
     int thin = 0;

@@ -201,6 +201,10 @@ static void check_script(const member *s, int K)
     CHECK(contains(s, "variable        dx atom -0.69999999999999996*abs(fx)*((vx>0)-(vx<0))\n"));
     CHECK(contains(s, "c_r*c_r*c_r*((c_r<0.0020999999999999999)*(0.0020999999999999999/c_r)^2"));
     CHECK(contains(s, "fw") && contains(s, "*c_r*(v_hxl-v_hxh)\n"));
+    /* the top wall at ${ztop}, the box's top unless the run lifts it; the others fixed */
+    CHECK(contains(s, "variable        ztop index 0.10000000000000001\n"));
+    CHECK(contains(s, "variable        hzh atom 0.5*(c_r-(${ztop}-z)+abs(c_r-(${ztop}-z)))\n"));
+    CHECK(contains(s, "variable        hyh atom 0.5*(c_r-(0.10000000000000001-y)+"));
     CHECK(contains(s, "# grainpack measured porosity 0.410000 and coordination number 4.5000.\n"));
     CHECK(contains(s, "(tiling 2 x 1 x 1)"));
     CHECK(contains(s, "\"grainpack\": {\"porosity\": 0.40999999999999998, \"coordination_number\": 4.5}"));
