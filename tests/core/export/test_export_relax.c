@@ -203,6 +203,7 @@ static void check_script(const member *s, int K)
     CHECK(contains(s, "fw") && contains(s, "*c_r*(v_hxl-v_hxh)\n"));
     /* the top wall at ${ztop}, the box's top unless the run lifts it; the others fixed */
     CHECK(contains(s, "variable        ztop index 0.10000000000000001\n"));
+    CHECK(contains(s, "change_box      all z final 0 ${ztop} units box\n"));
     CHECK(contains(s, "variable        hzh atom 0.5*(c_r-(${ztop}-z)+abs(c_r-(${ztop}-z)))\n"));
     CHECK(contains(s, "variable        hyh atom 0.5*(c_r-(0.10000000000000001-y)+"));
     CHECK(contains(s, "# grainpack measured porosity 0.410000 and coordination number 4.5000.\n"));
