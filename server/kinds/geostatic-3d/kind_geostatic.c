@@ -27,6 +27,7 @@
 #include "kinds/geostatic-3d/result_geostatic.h"
 #include "kinds/geostatic-3d/svg_geostatic.h"
 #include "kinds/kind.h"
+#include "kinds/kind_specimen.h"
 
 #define KIND_NAME "geostatic-3d"
 
@@ -50,26 +51,12 @@ static void geo_destroy(gpd_geostatic_run *run)
     free(run);
 }
 
-/* the message of a failed step, after what failed */
-static gp_status failed_in(gp_status st, gp_error *err, const char *what)
-{
-    if (st == GP_OK || st == GP_ERR_CANCELLED) return st;
-    char m[GP_ERROR_MESSAGE_MAX];
-    snprintf(m, sizeof m, "%s", err->message);
-    return gp_error_set(err, st, "%s: %.200s", what, m);
-}
-
 static gp_status build_specimen(gpd_geostatic_run *run, const gp_spec_geostatic *s,
                                 gp_progress_fn fn, void *user, const volatile int *cancel,
                                 gp_error *err)
 {
-    gp_spec3d sp = s->specimen; /* its sieve shared, read only */
-    sp.threads = s->threads;
-    gp_status st = gp_specimen3d_build(&sp, fn, user, cancel, &run->specimen, err);
-    if (!st && (!run->specimen->spheres || !run->specimen->count))
-        st = gp_error_set(err, GP_ERR_INTERNAL, "the specimen has no spheres");
-    run->specimen_ok = st == GP_OK;
-    return failed_in(st, err, "the specimen");
+    return gpd_specimen_build(&s->specimen, s->threads, fn, user, cancel, &run->specimen,
+                              &run->specimen_ok, err);
 }
 
 static gp_status settle(gpd_geostatic_run *run, const gp_spec_geostatic *s, gp_progress_fn fn,
@@ -82,7 +69,7 @@ static gp_status settle(gpd_geostatic_run *run, const gp_spec_geostatic *s, gp_p
     gp_status st = gp_geostatic_run(&gp, sp->spheres, sp->count, lo, sp->box, fn, user, cancel,
                                     &run->state, err);
     if (st == GP_ERR_NOT_CONVERGED && run->state) return GP_OK; /* measured, with a warning */
-    return failed_in(st, err, "the settling");
+    return gpd_specimen_failed_in(st, err, "the settling");
 }
 
 static gp_status geo_build(const gp_spec_geostatic *s, gp_progress_fn fn, void *user,
@@ -171,10 +158,8 @@ static int plan(const void *spec_, const json_t *spec_json, gpd_phase *out, int 
 {
     const gp_spec_geostatic *s = spec_;
     const json_t *inner = json_object_get(json_object_get(spec_json, "specimen"), "spec");
-    const gpd_kind *sk = gpd_kind_find(gp_spec_specimen_kind());
     gpd_phase ph[GPD_PLAN_MAX];
-    int k = sk && sk->plan ? sk->plan(&s->specimen, inner, ph, GPD_PLAN_MAX) : 0;
-    if (k > 0 && !strcmp(ph[k - 1].name, "result")) k--;
+    int k = gpd_specimen_phases(&s->specimen, inner, ph);
     gp_spec_bounds_t b;
     gp_spec_problem prob;
     double n = gp_spec_bounds(inner, &b, &prob) ? 0 : s->tiled ? b.items : b.cells;

@@ -3,13 +3,13 @@
 #include "kinds/geostatic-3d/result_geostatic.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "jobs/progress.h"
+#include "kinds/kind_specimen.h"
 
 #define BYTES_SPHERE 90 /* a sphere [x, y, z, r] at 17 digits */
 #define BYTES_VALUE 24  /* a number of the profile or the map */
@@ -150,33 +150,22 @@ static json_t *stats_json(const gp_geostatic_result *g)
 
 /* ------------------------------------------------------------------ the warnings */
 
-static void warn(json_t *a, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void warn(json_t *a, const char *fmt, ...)
-{
-    char line[400];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(line, sizeof line, fmt, ap);
-    va_end(ap);
-    json_array_append_new(a, json_string(line));
-}
-
 static json_t *warnings_json(const gp_geostatic_result *g, const gp_spec_geostatic *s)
 {
     json_t *a = json_array();
     if (!a) return json_null();
     if (!g->converged)
-        warn(a, "the packing was not at rest after %ld DEM steps (S_c %.3g, above %g): the "
-             "stresses are those of the state reached; raise max_steps", g->steps, g->stability,
-             s->params.stability_tol);
+        gpd_warnf(a, "the packing was not at rest after %ld DEM steps (S_c %.3g, above %g): the "
+                  "stresses are those of the state reached; raise max_steps",
+                  g->steps, g->stability, s->params.stability_tol);
     if (g->equilibrium.slabs && g->equilibrium.max_error > RESULT_GEOSTATIC_EQUILIBRIUM_MAX)
-        warn(a, "sigma_v differs from the weight above by up to %.3g %% (more than %g %%): "
-             "the packing is not in equilibrium", 100 * g->equilibrium.max_error,
-             100 * RESULT_GEOSTATIC_EQUILIBRIUM_MAX);
+        gpd_warnf(a, "sigma_v differs from the weight above by up to %.3g %% (more than %g %%): "
+                  "the packing is not in equilibrium", 100 * g->equilibrium.max_error,
+                  100 * RESULT_GEOSTATIC_EQUILIBRIUM_MAX);
     if (!g->k0.slabs)
-        warn(a, "no slab is far enough from the top and the bottom for K0 (margin %g m, slab "
-             "%g m): use thinner slabs or a smaller wall_margin_dmax", g->profile.margin,
-             g->profile.thickness);
+        gpd_warnf(a, "no slab is far enough from the top and the bottom for K0 (margin %g m, slab "
+                  "%g m): use thinner slabs or a smaller wall_margin_dmax", g->profile.margin,
+                  g->profile.thickness);
     return a;
 }
 
@@ -193,13 +182,6 @@ static json_t *specimen_json(const gpd_geostatic_run *run, const gp_spec_geostat
                      vec(tiling, 3, 1), "porosity", gpd_jreal(sp->stats.porosity));
 }
 
-static json_t *material_json(const gp_material3d *m)
-{
-    return json_pack("{s:o, s:o, s:o, s:o, s:o}", "density", gpd_jreal(m->density), "young",
-                     gpd_jreal(m->young), "poisson", gpd_jreal(m->poisson), "friction_deg",
-                     gpd_jreal(m->friction_deg), "damping", gpd_jreal(m->damping));
-}
-
 static json_t *timings_json(const gpd_geostatic_run *run)
 {
     const gp_geostatic_result *g = run->state;
@@ -212,7 +194,7 @@ static json_t *timings_json(const gpd_geostatic_run *run)
 static void set_physics(json_t *r, const gp_spec_geostatic *s, const gp_geostatic_result *g)
 {
     const gp_geostatic_params *p = &s->params;
-    json_object_set_new(r, "material", material_json(&p->material));
+    json_object_set_new(r, "material", gpd_specimen_material_json(&p->material));
     json_object_set_new(r, "gravity", vec(p->gravity, 3, 1));
     json_object_set_new(r, "vertical", json_string(g_axis[g->axis_v]));
     json_object_set_new(r, "wall_friction_deg", gpd_jreal(p->wall_friction_deg));
@@ -232,7 +214,8 @@ static json_t *head_geostatic(const gpd_geostatic_run *run, const gp_spec_geosta
     set_physics(r, s, g);
     json_object_set_new(r, "box", vec(run->specimen->box, 3, 1));
     json_object_set_new(r, "stats", stats_json(g));
-    if (run->outputs & GP_OUT_GEO_PROFILE) json_object_set_new(r, "profile", profile_json(&g->profile));
+    if (run->outputs & GP_OUT_GEO_PROFILE)
+        json_object_set_new(r, "profile", profile_json(&g->profile));
     json_object_set_new(r, "map", map_json(&g->map, run->specimen));
     json_object_set_new(r, "warnings", warnings_json(g, s));
     json_object_set_new(r, "timings", timings_json(run));

@@ -25,6 +25,7 @@
 #include "gp_specimen3d.h"
 #include "gp_triax.h"
 #include "kinds/kind.h"
+#include "kinds/kind_specimen.h"
 #include "kinds/triaxial-3d/gp_spec_triax.h"
 #include "kinds/triaxial-3d/result_triax.h"
 #include "kinds/triaxial-3d/svg_triax.h"
@@ -100,26 +101,12 @@ static void triax_destroy(gpd_triax_run *run)
     free(run);
 }
 
-/* the message of a failed step, after what failed */
-static gp_status failed_in(gp_status st, gp_error *err, const char *what)
-{
-    if (st == GP_OK || st == GP_ERR_CANCELLED) return st;
-    char m[GP_ERROR_MESSAGE_MAX];
-    snprintf(m, sizeof m, "%s", err->message);
-    return gp_error_set(err, st, "%s: %.200s", what, m);
-}
-
 static gp_status build_specimen(gpd_triax_run *run, const gp_spec_triax *s, relay *rl,
                                 const volatile int *cancel, gp_error *err)
 {
-    gp_spec3d sp = s->specimen; /* its sieve shared, read only */
-    sp.threads = s->threads;
     rl->test = -1;
-    gp_status st = gp_specimen3d_build(&sp, relay_progress, rl, cancel, &run->specimen, err);
-    if (!st && (!run->specimen->spheres || !run->specimen->count))
-        st = gp_error_set(err, GP_ERR_INTERNAL, "the specimen has no spheres");
-    run->specimen_ok = st == GP_OK;
-    return failed_in(st, err, "the specimen");
+    return gpd_specimen_build(&s->specimen, s->threads, relay_progress, rl, cancel,
+                              &run->specimen, &run->specimen_ok, err);
 }
 
 static gp_status run_test(gpd_triax_run *run, const gp_spec_triax *s, size_t i, relay *rl,
@@ -135,7 +122,7 @@ static gp_status run_test(gpd_triax_run *run, const gp_spec_triax *s, size_t i, 
     if (!st) run->ntests = i + 1;
     char what[64];
     snprintf(what, sizeof what, "the test at %g kPa", s->confining[i] * 1e-3);
-    return failed_in(st, err, what);
+    return gpd_specimen_failed_in(st, err, what);
 }
 
 static gp_status triax_build(const gp_spec_triax *s, gp_progress_fn fn, void *user,
@@ -211,10 +198,8 @@ static void test_phases(const gp_spec_triax *s, size_t i, double n, gpd_phase *o
 /* the specimen's phases (its kind's plan, without its result), or one phase "specimen" */
 static int specimen_phases(const gp_spec_triax *s, const json_t *inner, gpd_phase *out)
 {
-    const gpd_kind *sk = gpd_kind_find(gp_spec_specimen_kind());
     gpd_phase sp[GPD_PLAN_MAX];
-    int n = sk && sk->plan ? sk->plan(&s->specimen, inner, sp, GPD_PLAN_MAX) : 0;
-    if (n > 0 && !strcmp(sp[n - 1].name, "result")) n--;
+    int n = gpd_specimen_phases(&s->specimen, inner, sp);
     if (!merged(s)) {
         memcpy(out, sp, (size_t)n * sizeof *sp);
         return n;

@@ -3,13 +3,13 @@
 #include "kinds/triaxial-3d/result_triax.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "jobs/progress.h"
+#include "kinds/kind_specimen.h"
 
 /* the arrays of a curve: name, member of gp_triax_point, factor to the unit of the name */
 typedef struct curve_col {
@@ -154,32 +154,25 @@ static json_t *stats_json(const gpd_triax_run *run)
 
 /* ------------------------------------------------------------------ the warnings */
 
-static void warn(json_t *a, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void warn(json_t *a, const char *fmt, ...)
-{
-    char line[400];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(line, sizeof line, fmt, ap);
-    va_end(ap);
-    json_array_append_new(a, json_string(line));
-}
-
 /* a test not quasi-static, its lateral stress off sigma3, its ratio still rising at the end */
 static void test_warnings(json_t *a, const gp_triax_result *t, const gp_spec_triax *s)
 {
     double kpa = t->confining * 1e-3;
     if (t->inertial_number_max > RESULT_TRIAX_INERTIAL_MAX)
-        warn(a, "test at %g kPa: the inertial number reached %.3g, above %g: the loading is not "
-             "quasi-static; use a slower strain_rate (%g /s now)", kpa, t->inertial_number_max,
-             RESULT_TRIAX_INERTIAL_MAX, s->strain_rate);
+        gpd_warnf(a,
+                  "test at %g kPa: the inertial number reached %.3g, above %g: the loading is not "
+                  "quasi-static; use a slower strain_rate (%g /s now)",
+                  kpa, t->inertial_number_max, RESULT_TRIAX_INERTIAL_MAX, s->strain_rate);
     if (t->servo_error_max > RESULT_TRIAX_SERVO_MAX)
-        warn(a, "test at %g kPa: the lateral walls' stress was up to %.3g %% off sigma3 (more "
-             "than %g %%); use a slower strain_rate", kpa, 100 * t->servo_error_max,
-             100 * RESULT_TRIAX_SERVO_MAX);
+        gpd_warnf(a,
+                  "test at %g kPa: the lateral walls' stress was up to %.3g %% off sigma3 (more "
+                  "than %g %%); use a slower strain_rate",
+                  kpa, 100 * t->servo_error_max, 100 * RESULT_TRIAX_SERVO_MAX);
     if (t->still_rising)
-        warn(a, "test at %g kPa: the stress ratio was still rising at the end (axial strain "
-             "%g): the peak may lie beyond it; use a larger axial_strain", kpa, s->axial_strain);
+        gpd_warnf(a,
+                  "test at %g kPa: the stress ratio was still rising at the end (axial strain "
+                  "%g): the peak may lie beyond it; use a larger axial_strain",
+                  kpa, s->axial_strain);
 }
 
 static json_t *warnings_json(const gpd_triax_run *run, const gp_spec_triax *s)
@@ -187,7 +180,7 @@ static json_t *warnings_json(const gpd_triax_run *run, const gp_spec_triax *s)
     json_t *a = json_array();
     for (size_t i = 0; a && i < run->ntests; i++) test_warnings(a, run->test[i], s);
     if (a && run->mc_error[0])
-        warn(a, "no Mohr-Coulomb envelope through the peaks: %s", run->mc_error);
+        gpd_warnf(a, "no Mohr-Coulomb envelope through the peaks: %s", run->mc_error);
     return a ? a : json_null();
 }
 
@@ -201,13 +194,6 @@ static json_t *specimen_json(const gpd_triax_run *run, const gp_spec_triax *s)
                      s->tiled ? "tiled" : "sample", "particles", (json_int_t)sp->count, "box",
                      vec3(sp->box), "porosity", gpd_jreal(sp->stats.porosity), "d50",
                      gpd_jreal(s->d50));
-}
-
-static json_t *material_json(const gp_material3d *m)
-{
-    return json_pack("{s:o, s:o, s:o, s:o, s:o}", "density", gpd_jreal(m->density), "young",
-                     gpd_jreal(m->young), "poisson", gpd_jreal(m->poisson), "friction_deg",
-                     gpd_jreal(m->friction_deg), "damping", gpd_jreal(m->damping));
 }
 
 static json_t *timings_json(const gpd_triax_run *run)
@@ -239,7 +225,7 @@ static json_t *head_triax(const gpd_triax_run *run, const gp_spec_triax *s,
     double size[3] = {t->box_hi[0] - t->box_lo[0], t->box_hi[1] - t->box_lo[1],
                       t->box_hi[2] - t->box_lo[2]};
     json_object_set_new(r, "specimen", specimen_json(run, s));
-    json_object_set_new(r, "material", material_json(&s->material));
+    json_object_set_new(r, "material", gpd_specimen_material_json(&s->material));
     json_object_set(r, "drainage", json_object_get(spec_json, "drainage"));
     json_object_set_new(r, "axial_strain", gpd_jreal(s->axial_strain));
     json_object_set_new(r, "strain_rate", gpd_jreal(s->strain_rate));
