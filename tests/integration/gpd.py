@@ -445,6 +445,17 @@ def check_error_body(status, body, code, pointer=None):
         assert e.get("pointer") == pointer, (e, pointer)
 
 
+def refused(d, spec, pointer, needle=None, code="invalid_spec"):
+    """POST /v1/jobs of spec is refused with 422, the error at pointer (and its message starting
+    with it, holding needle)."""
+    st, _, j = d.json("POST", "/v1/jobs", spec)
+    assert st == 422, (st, j, pointer)
+    check_error_body(st, j, code, pointer)
+    assert j["error"]["message"].startswith(pointer), j
+    if needle:
+        assert needle in j["error"]["message"], (j, needle)
+
+
 def check_job_object(j):
     assert set(j) == JOB_KEYS, sorted(j)
     assert j["status"] in ("queued", "running") + FINAL, j

@@ -254,42 +254,33 @@ def test_not_at_rest(env):
     assert d.stop() == 0, d.read_log()
 
 
-def refused(d, spec, pointer, needle=None, code="invalid_spec"):
-    st, _, j = d.json("POST", "/v1/jobs", spec)
-    assert st == 422, (st, j, pointer)
-    gpd.check_error_body(st, j, code, pointer)
-    assert j["error"]["message"].startswith(pointer), j
-    if needle:
-        assert needle in j["error"]["message"], (j, needle)
-
-
 def test_refused_at_submit(env):
     d = env.daemon(workers=1)
     sid = job_of(d, SPECIMEN)
     s = {"job": sid}
-    refused(d, geo({"job": "0" * 32}), "/specimen/job", "no job")
-    refused(d, geo({}), "/specimen")
-    refused(d, geo({"spec": dict(SPECIMEN, porosity=2)}), "/specimen/spec/porosity")
+    gpd.refused(d, geo({"job": "0" * 32}), "/specimen/job", "no job")
+    gpd.refused(d, geo({}), "/specimen")
+    gpd.refused(d, geo({"spec": dict(SPECIMEN, porosity=2)}), "/specimen/spec/porosity")
     # phi': both, an unknown job, a job of another kind, out of range
-    refused(d, geo(s, phi_deg=30, phi_from={"job": "1" * 32}), "/phi_from", "not both")
-    refused(d, geo(s, phi_from={"job": "1" * 32}), "/phi_from/job", "no job")
-    refused(d, geo(s, phi_from={"job": sid}), "/phi_from/job", "of kind \"spheres-3d\"")
-    refused(d, geo(s, phi_from={}), "/phi_from/job")
-    refused(d, geo(s, phi_deg=90), "/phi_deg")
+    gpd.refused(d, geo(s, phi_deg=30, phi_from={"job": "1" * 32}), "/phi_from", "not both")
+    gpd.refused(d, geo(s, phi_from={"job": "1" * 32}), "/phi_from/job", "no job")
+    gpd.refused(d, geo(s, phi_from={"job": sid}), "/phi_from/job", "of kind \"spheres-3d\"")
+    gpd.refused(d, geo(s, phi_from={}), "/phi_from/job")
+    gpd.refused(d, geo(s, phi_deg=90), "/phi_deg")
     # gravity along no axis, none at all; wall friction
-    refused(d, geo(s, gravity=[1, 0, -9.81]), "/gravity", "along one axis")
-    refused(d, geo(s, gravity=[0, 0, 0]), "/gravity", "along one axis")
-    refused(d, geo(s, gravity=[0, -9.81]), "/gravity")
-    refused(d, geo(s, wall_friction_deg=10), "/wall_friction_deg", "frictionless")
+    gpd.refused(d, geo(s, gravity=[1, 0, -9.81]), "/gravity", "along one axis")
+    gpd.refused(d, geo(s, gravity=[0, 0, 0]), "/gravity", "along one axis")
+    gpd.refused(d, geo(s, gravity=[0, -9.81]), "/gravity")
+    gpd.refused(d, geo(s, wall_friction_deg=10), "/wall_friction_deg", "frictionless")
     # slabs and map cells
-    refused(d, geo(s, slab=0.5), "/slab", "thicker than the packing")
-    refused(d, geo(s, slab=1e-5), "/slab", code="too_large")
-    refused(d, geo(s, map_cell=1e-4), "/map_cell", code="too_large")
-    refused(d, geo(s, max_steps=10), "/max_steps")
-    refused(d, geo(s, outputs=["curves"]), "/outputs/0")
+    gpd.refused(d, geo(s, slab=0.5), "/slab", "thicker than the packing")
+    gpd.refused(d, geo(s, slab=1e-5), "/slab", code="too_large")
+    gpd.refused(d, geo(s, map_cell=1e-4), "/map_cell", code="too_large")
+    gpd.refused(d, geo(s, max_steps=10), "/max_steps")
+    gpd.refused(d, geo(s, outputs=["curves"]), "/outputs/0")
     # the work bound: a large tiling settled for long
     big = dict(SPECIMEN, tiling=[8, 8, 8])
-    refused(d, geo({"spec": {k: v for k, v in big.items() if k != "kind"}},
+    gpd.refused(d, geo({"spec": {k: v for k, v in big.items() if k != "kind"}},
                    max_steps=10000000, slab=0.1), "/max_steps", code="too_large")
     st, _, lst = d.json("GET", "/v1/jobs?limit=500")
     assert sum(1 for j in lst["jobs"] if j["kind"] == KIND) == 0, lst
