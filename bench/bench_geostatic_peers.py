@@ -21,15 +21,13 @@ import io
 import os
 import re
 import shutil
-import subprocess
 import sys
 import tarfile
 import tempfile
-import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_export import proc_status, start, stop  # noqa: E402
-from bench_lammps_relax import SPEC, build, extrapolate, get, need, thermo_rows  # noqa: E402
+from bench_lammps_relax import SPEC, build, extrapolate, get, run_lammps, thermo_rows  # noqa: E402
 
 
 def reset_peak(pid):
@@ -44,25 +42,6 @@ def geostatic(url, pid, sid, phi):
             "outputs": ["profile"]}
     _, summ, secs = build(url, spec)
     return summ, secs, proc_status(pid)["VmHWM"] / 1024.0
-
-
-def run_lammps(folder, np_, minutes, ztop):
-    cmd = [need("mpirun", "openmpi-bin"), "-np", str(np_)]
-    if os.geteuid() == 0:
-        cmd.append("--allow-run-as-root")
-    cmd += [need("lmp", "lammps"), "-in", "relax.in", "-var", "timeout",
-            "%d" % round(minutes * 60), "-var", "ztop", repr(ztop), "-var", "maxsteps",
-            "10000000"]
-    print("running: (cd %s && %s)" % (folder, " ".join(cmd)), flush=True)
-    t0 = time.time()
-    p = subprocess.run(cmd, cwd=folder, capture_output=True, text=True,
-                       env=dict(os.environ, OMP_NUM_THREADS="1"))
-    wall = time.time() - t0
-    if p.returncode != 0:
-        sys.exit("LAMMPS failed (exit %d):\n%s" % (p.returncode, (p.stdout + p.stderr)[-4000:]))
-    import json
-    with open(os.path.join(folder, "relax.json")) as f:
-        return json.load(f), wall
 
 
 def lammps_memory_mb(log_path, np_):
@@ -150,7 +129,7 @@ def main():
         t.extractall(run_dir)
     folder = os.path.join(run_dir, "lammps-relax")
     ztop = 2 * spec_summ["box"][2]
-    rep, wall = run_lammps(folder, a.np_, a.minutes, ztop)
+    rep, wall = run_lammps(folder, a.np_, a.minutes, 10000000, ("-var", "ztop", repr(ztop)))
     lmem = lammps_memory_mb(os.path.join(folder, "log.lammps"), a.np_)
     ltop = surface(os.path.join(folder, "final.dump"))
     table(summ["stats"], secs, mem, rep, wall, lmem, ltop, tiling, a.np_, a.seed)

@@ -68,7 +68,8 @@ def need(binary, package):
     return path
 
 
-def run_lammps(folder, np_, minutes, max_steps):
+def run_lammps(folder, np_, minutes, max_steps, extra=()):
+    """Runs relax.in in folder (extra: more -var pairs); (relax.json, wall seconds)."""
     cmd = [need("mpirun", "openmpi-bin"), "-np", str(np_)]
     if os.geteuid() == 0:
         cmd.append("--allow-run-as-root")
@@ -76,6 +77,7 @@ def run_lammps(folder, np_, minutes, max_steps):
             "%d" % round(minutes * 60)]
     if max_steps:
         cmd += ["-var", "maxsteps", str(max_steps)]
+    cmd += list(extra)
     print("running: (cd %s && %s)" % (folder, " ".join(cmd)), flush=True)
     t0 = time.time()
     p = subprocess.run(cmd, cwd=folder, capture_output=True, text=True,
