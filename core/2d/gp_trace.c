@@ -313,7 +313,8 @@ static void skip_blank(scan *s)
     }
 }
 
-/* A decimal number up to max; 0 with *ok = 0 if there is none or it is larger. */
+/* A P2 value: a decimal number up to max (leading zeros allowed: some writers pad values into
+ * columns); 0 with *ok = 0 if there is none or it is larger. */
 static size_t read_uint(scan *s, size_t max, int *ok)
 {
     skip_blank(s);
@@ -331,20 +332,88 @@ static size_t read_uint(scan *s, size_t max, int *ok)
     return v;
 }
 
+/* One number of the header into *v: decimal digits, at most max, ended by whitespace or a
+ * comment. A zero-padded number is refused: a reader that counts digits would see another
+ * number than one that does not, and a header must mean one size to every check. Digits are
+ * read only while the value stays within max, so no number is too long to overflow. */
+static gp_status header_uint(scan *s, const char *what, size_t max, size_t *v, gp_error *err)
+{
+    skip_blank(s);
+    size_t start = s->pos;
+    *v = 0;
+    while (s->pos < s->len && s->b[s->pos] >= '0' && s->b[s->pos] <= '9') {
+        size_t d = (size_t)(s->b[s->pos] - '0');
+        if (*v > (max - d) / 10)
+            return gp_error_set(err, GP_ERR_INVALID, "pgm: the %s is over %zu", what, max);
+        *v = 10 * *v + d;
+        s->pos++;
+    }
+    if (s->pos == start)
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: the %s is missing or not a number", what);
+    if (s->b[start] == '0' && s->pos - start > 1)
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: the %s is zero-padded (a leading 0)",
+                            what);
+    if (s->pos < s->len && !is_space(s->b[s->pos]) && s->b[s->pos] != '#')
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: the %s is not followed by whitespace",
+                            what);
+    return GP_OK;
+}
+
+gp_status gp_trace_pgm_header(const void *buf, size_t len, gp_trace_pgm_info *out,
+                              gp_error *err)
+{
+    if (!out)
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: NULL output");
+    memset(out, 0, sizeof *out);
+    scan s = {buf, buf ? len : 0, 2};
+    if (s.len < 2 || s.b[0] != 'P' || (s.b[1] != '5' && s.b[1] != '2'))
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: not a PGM file (magic P5 or P2)");
+    if (s.pos >= s.len || (!is_space(s.b[s.pos]) && s.b[s.pos] != '#'))
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: no whitespace after the magic number");
+    int binary = s.b[1] == '5';
+    size_t w, h, maxval;
+    gp_status st = header_uint(&s, "width", GP_TRACE_MAX_PIXELS, &w, err);
+    if (st == GP_OK)
+        st = header_uint(&s, "height", GP_TRACE_MAX_PIXELS, &h, err);
+    if (st == GP_OK)
+        st = header_uint(&s, "maxval", 65535, &maxval, err);
+    if (st != GP_OK)
+        return st;
+    if (w == 0 || h == 0)
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: %zu x %zu pixels: a side is 0", w, h);
+    if (w > GP_TRACE_MAX_PIXELS / h)
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: %zu x %zu pixels is over %zu", w, h,
+                            GP_TRACE_MAX_PIXELS);
+    if (maxval == 0)
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: maxval 0 (1 .. 65535 expected)");
+    /* P5: exactly one whitespace byte ends the header, the next one is a value (so a "\r\n"
+     * leaves the '\n' as the first value); a comment may come before it, as netpbm reads it.
+     * P2: the values are read past blanks and comments. */
+    if (binary && s.pos < s.len && s.b[s.pos] == '#')
+        while (s.pos < s.len && s.b[s.pos] != '\n' && s.b[s.pos] != '\r')
+            s.pos++;
+    if (binary && (s.pos >= s.len || !is_space(s.b[s.pos])))
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: no whitespace after maxval");
+    out->w = w;
+    out->h = h;
+    out->maxval = (unsigned)maxval;
+    out->binary = binary;
+    out->data = binary ? s.pos + 1 : s.pos;
+    out->data_min = binary ? w * h * (maxval > 255 ? 2 : 1) : 2 * w * h - 1;
+    return GP_OK;
+}
+
+/* The values of g (allocated: w h of them) from s, at the header's data offset; for P5 the
+ * caller has checked that the bytes are there. */
 static gp_status read_values(scan *s, int binary, gp_trace_gray *g, gp_error *err)
 {
-    size_t n = g->w * g->h, bytes = g->maxval < 256 ? 1 : 2;
-    if (binary) {
-        s->pos++; /* the single whitespace after maxval */
-        if (s->len < s->pos || (s->len - s->pos) / bytes < n)
-            return gp_error_set(err, GP_ERR_INVALID, "pgm: truncated: %zu values expected", n);
-    }
+    size_t n = g->w * g->h;
     for (size_t i = 0; i < n; i++) {
         size_t v;
         int ok = 1;
         if (!binary) {
             v = read_uint(s, 65535, &ok);
-        } else if (bytes == 1) {
+        } else if (g->maxval < 256) {
             v = s->b[s->pos++];
         } else {
             v = ((size_t)s->b[s->pos] << 8) | s->b[s->pos + 1];
@@ -366,32 +435,24 @@ gp_status gp_trace_pgm_parse(const void *buf, size_t len, gp_trace_gray *out, gp
     if (!out)
         return gp_error_set(err, GP_ERR_INVALID, "pgm: NULL output");
     memset(out, 0, sizeof *out);
-    scan s = {buf, buf ? len : 0, 0};
-    if (s.len < 2 || s.b[0] != 'P' || (s.b[1] != '5' && s.b[1] != '2'))
-        return gp_error_set(err, GP_ERR_INVALID, "pgm: not a PGM file (magic P5 or P2)");
-    int binary = s.b[1] == '5', ok[3];
-    s.pos = 2;
-    if (s.pos < s.len && !is_space(s.b[s.pos]) && s.b[s.pos] != '#')
-        return gp_error_set(err, GP_ERR_INVALID, "pgm: no whitespace after the magic number");
-    size_t w = read_uint(&s, GP_TRACE_MAX_PIXELS, &ok[0]);
-    size_t h = read_uint(&s, GP_TRACE_MAX_PIXELS, &ok[1]);
-    size_t maxval = read_uint(&s, 65535, &ok[2]);
-    if (!ok[0] || !ok[1] || !ok[2] || w == 0 || h == 0 || maxval == 0)
-        return gp_error_set(err, GP_ERR_INVALID,
-                            "pgm: bad header (width, height, maxval 1 .. 65535 expected)");
-    if (w > GP_TRACE_MAX_PIXELS / h)
-        return gp_error_set(err, GP_ERR_INVALID, "pgm: %zu x %zu pixels is too many", w, h);
-    if (binary && (s.pos >= s.len || !is_space(s.b[s.pos])))
-        return gp_error_set(err, GP_ERR_INVALID, "pgm: no whitespace after maxval");
-    out->w = w;
-    out->h = h;
-    out->maxval = (unsigned)maxval;
-    out->v = malloc(w * h * sizeof *out->v);
-    if (!out->v) {
-        memset(out, 0, sizeof *out);
-        return gp_error_set(err, GP_ERR_NOMEM, "pgm: out of memory for %zu x %zu", w, h);
-    }
-    gp_status st = read_values(&s, binary, out, err);
+    gp_trace_pgm_info hdr;
+    gp_status st = gp_trace_pgm_header(buf, len, &hdr, err);
+    if (st != GP_OK)
+        return st;
+    /* the data must be there before anything is allocated: a header alone must not cost
+     * memory in proportion to the size it claims */
+    if (len - hdr.data < hdr.data_min)
+        return gp_error_set(err, GP_ERR_INVALID, "pgm: truncated: %zu x %zu values %s %zu bytes,"
+                            " %zu given", hdr.w, hdr.h, hdr.binary ? "take" : "take at least",
+                            hdr.data_min, len - hdr.data);
+    out->v = malloc(hdr.w * hdr.h * sizeof *out->v);
+    if (!out->v)
+        return gp_error_set(err, GP_ERR_NOMEM, "pgm: out of memory for %zu x %zu", hdr.w, hdr.h);
+    out->w = hdr.w;
+    out->h = hdr.h;
+    out->maxval = hdr.maxval;
+    scan s = {buf, len, hdr.data};
+    st = read_values(&s, hdr.binary, out, err);
     if (st != GP_OK)
         gp_trace_gray_free(out);
     return st;

@@ -3,7 +3,8 @@
  *
  * Input: a w x h image of bytes, row-major, row 0 at the TOP (as PGM and most formats store
  * it); nonzero = grain. gp_trace_pgm_parse + gp_trace_threshold make one from a PGM file's
- * bytes (the caller reads the file: core does no I/O).
+ * bytes (the caller reads the file: core does no I/O); gp_trace_pgm_header reads only the
+ * header, for a caller that bounds the image's size before its values are read.
  *
  * Algorithm:
  *  1. Grains are the 4-connected components of the nonzero pixels (one breadth-first pass,
@@ -92,12 +93,36 @@ typedef struct gp_trace_gray {
     unsigned short *v;
 } gp_trace_gray;
 
-/* Parses a PGM file held in buf (len bytes): "P5" (binary: one byte per value for
- * maxval < 256, else two, most significant first) or "P2" (ASCII decimal values), with
- * '#' comments in the header (and, for P2, anywhere between values). Bytes after the last
- * value are ignored (a second image is not read). GP_ERR_INVALID with the reason for a bad
- * or truncated file, a value above maxval, or more than GP_TRACE_MAX_PIXELS pixels;
- * GP_ERR_NOMEM. On error *out is zeroed. */
+/* A PGM file's header, as gp_trace_pgm_header reads it. */
+typedef struct gp_trace_pgm_info {
+    size_t w, h;     /* >= 1 each, w h <= GP_TRACE_MAX_PIXELS */
+    unsigned maxval; /* 1 .. 65535 */
+    int binary;      /* 1: P5, 0: P2 */
+    size_t data;     /* offset of the values: past the one whitespace byte that ends a P5
+                      * header; for P2 where the header's last number ends */
+    size_t data_min; /* bytes the values take at least from data: P5 exactly w h, or 2 w h
+                      * for maxval > 255; P2 2 w h - 1 (a digit each, a blank between two) */
+} gp_trace_pgm_info;
+
+/* Reads the header of a PGM file held in buf (len bytes) without touching its values: the
+ * magic "P5" or "P2", width, height and maxval, separated by whitespace (space, tab, CR, LF,
+ * VT, FF) and '#' comments (to the end of their line). A number is plain decimal digits
+ * without a leading zero (zero-padded numbers are refused, so that every reader of a header
+ * sees the same sizes), each side at most GP_TRACE_MAX_PIXELS and their product too, maxval
+ * 1 .. 65535; a P5 header ends with exactly one whitespace byte. The one header reader: a
+ * caller that bounds the sizes before parsing (the daemon's side limit) calls it, and
+ * gp_trace_pgm_parse calls it too. GP_ERR_INVALID with the reason; on error *out is
+ * zeroed. No allocation. */
+gp_status gp_trace_pgm_header(const void *buf, size_t len, gp_trace_pgm_info *out,
+                              gp_error *err);
+
+/* Parses a PGM file held in buf (len bytes): the header as gp_trace_pgm_header, then the
+ * values: "P5" (binary: one byte per value for maxval < 256, else two, most significant
+ * first) or "P2" (ASCII decimal values, with '#' comments anywhere between them). The data
+ * length is checked against the header (data_min) before the image is allocated, so the
+ * memory taken is at most twice the input's size. Bytes after the last value are ignored (a
+ * second image is not read). GP_ERR_INVALID with the reason for a bad header, truncated
+ * data, a missing value or one above maxval; GP_ERR_NOMEM. On error *out is zeroed. */
 gp_status gp_trace_pgm_parse(const void *buf, size_t len, gp_trace_gray *out, gp_error *err);
 
 void gp_trace_gray_free(gp_trace_gray *g); /* zeroes it; NULL is fine */

@@ -422,43 +422,25 @@ static int b64_decode(const char *s, size_t n, unsigned char **out, size_t *len,
     return 0;
 }
 
-/* the width and height of a PGM header, to refuse an oversized image before its pixels are
- * allocated; 0 when the header cannot be read (the parser then says why) */
-static int pgm_peek(const unsigned char *b, size_t n, size_t *w, size_t *h)
-{
-    size_t i = 2, v[2] = {0, 0};
-    if (n < 2 || b[0] != 'P' || (b[1] != '2' && b[1] != '5')) return 0;
-    for (int f = 0; f < 2; f++) {
-        while (i < n && (b[i] == '#' || b[i] == ' ' || (b[i] >= '\t' && b[i] <= '\r'))) {
-            if (b[i] == '#')
-                while (i < n && b[i] != '\n' && b[i] != '\r') i++;
-            else i++;
-        }
-        size_t d = 0;
-        for (; i < n && b[i] >= '0' && b[i] <= '9' && d < 12; i++, d++)
-            v[f] = 10 * v[f] + (size_t)(b[i] - '0');
-        if (!d) return 0;
-    }
-    *w = v[0];
-    *h = v[1];
-    return 1;
-}
-
 /* the PGM of o decoded and parsed into g, within SHAPES_IMAGE_SIDE_MAX a side; -1 when
- * answered */
+ * answered. The side limit is checked on the header as the parser itself reads it
+ * (gp_trace_pgm_header), before any pixel is allocated. */
 static int read_pgm(const image_opts *o, gp_trace_gray *g, answer *a)
 {
     unsigned char *bytes = NULL;
-    size_t n = 0, w = 0, h = 0;
+    size_t n = 0;
     memset(g, 0, sizeof *g);
     if (b64_decode(o->pgm, o->pgm_len, &bytes, &n, a)) return -1;
     int rc = 0;
-    if (pgm_peek(bytes, n, &w, &h) && (w > SHAPES_IMAGE_SIDE_MAX || h > SHAPES_IMAGE_SIDE_MAX)) {
+    gp_trace_pgm_info hdr;
+    gp_error e;
+    gp_status st = gp_trace_pgm_header(bytes, n, &hdr, &e);
+    if (st == GP_OK && (hdr.w > SHAPES_IMAGE_SIDE_MAX || hdr.h > SHAPES_IMAGE_SIDE_MAX)) {
         rc = fail(a, 422, "too_large", "/image/pgm", "/image/pgm: %zu x %zu pixels, over the "
-                  "limit of %d x %d", w, h, SHAPES_IMAGE_SIDE_MAX, SHAPES_IMAGE_SIDE_MAX);
+                  "limit of %d x %d", hdr.w, hdr.h, SHAPES_IMAGE_SIDE_MAX,
+                  SHAPES_IMAGE_SIDE_MAX);
     } else {
-        gp_error e;
-        gp_status st = gp_trace_pgm_parse(bytes, n, g, &e);
+        if (st == GP_OK) st = gp_trace_pgm_parse(bytes, n, g, &e);
         if (st == GP_ERR_NOMEM) rc = oom(a);
         else if (st != GP_OK)
             rc = fail(a, 422, "invalid_spec", "/image/pgm", "/image/pgm: %s", e.message);
