@@ -45,7 +45,7 @@
  *                     point, crosses itself or has no area (at /shape/outlines/<i>, the first,
  *                     naming the others), ...);
  *   "too_large"    -- a 2D sieve law whose derived cell count exceeds the schema's particles
- *                     maximum (/size/sieve); 2D shape.outlines of more than 1,000,000 vertices
+ *                     maximum (/size/sieve); 2D shape.outlines of more than 2,000,000 vertices
  *                     in all (/shape/outlines); a 3D sample of more spheres than the DEM takes
  *                     (/box) or a tiling beyond its sphere limit (/tiling); a spec whose
  *                     estimated work is over GP_SPEC_WORK_BUDGET_S (see gp_spec_bounds), at the

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "http/http.h"
@@ -69,6 +70,50 @@ static void db_for_log(const char *db, char *out, size_t len)
         snprintf(out, len, "%s", db);
     else
         snprintf(out, len, "%.*s:***%s", (int)(colon - db), db, at);
+}
+
+/* Descriptors kept for the daemon's own use, out of the connections' reach: the database's
+ * (SQLite: a file, its WAL and its shared memory per connection; PostgreSQL: a socket), the
+ * workers' (their connections and the temporary files of results), the log, the listening
+ * socket and the threads' wake-ups. */
+#define FD_RESERVE 64
+#define FD_RESERVE_PER_WORKER 8
+/* the descriptors one HTTP connection may take: its socket and, while it downloads, a private
+ * database connection (SQLite: three files) */
+#define FD_PER_CONNECTION 4
+
+/* The soft limit of open files raised to the hard one: the common default of 1,024 is spent by
+ * a thousand idle clients, and the daemon then cannot open its database. The limit in force. */
+static long raise_open_files(void)
+{
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_NOFILE, &rl) != 0) return 1024;
+    rlim_t was = rl.rlim_cur, want = rl.rlim_max == RLIM_INFINITY ? (rlim_t)1 << 20 : rl.rlim_max;
+    if (was < want) {
+        rl.rlim_cur = want;
+        if (setrlimit(RLIMIT_NOFILE, &rl) == 0) {
+            gpd_log(GPD_LOG_INFO, "open files: soft limit raised from %llu to %llu",
+                    (unsigned long long)was, (unsigned long long)want);
+            return (long)want;
+        }
+    }
+    return was == RLIM_INFINITY ? 1L << 20 : (long)was;
+}
+
+/* --max-connections within the open files, less the daemon's reserve (said when it is
+ * lowered). */
+static unsigned connection_limit(long wanted, long nworkers)
+{
+    long files = raise_open_files();
+    long fit = (files - FD_RESERVE - FD_RESERVE_PER_WORKER * nworkers) / FD_PER_CONNECTION;
+    if (fit < 1) fit = 1;
+    if (fit >= wanted) return (unsigned)wanted;
+    gpd_log(GPD_LOG_WARN,
+            "--max-connections %ld lowered to %ld: the process may open %ld files, and each "
+            "connection may take %d after the daemon's own (raise the hard limit: LimitNOFILE= "
+            "under systemd, ulimit -Hn)",
+            wanted, fit, files, FD_PER_CONNECTION);
+    return (unsigned)fit;
 }
 
 /* Opens the job store (its lock first, before recovery touches any job) and applies the
@@ -160,6 +205,9 @@ int main(int argc, char **argv)
     sigaddset(&set, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &set, NULL);
     signal(SIGPIPE, SIG_IGN);
+    /* a file-size limit fails the write (EFBIG: the job fails with a reason) rather than
+     * killing the daemon */
+    signal(SIGXFSZ, SIG_IGN);
 
     /* the cores the workers leave idle go to each job's threads (filling, ODEC, descriptors and
      * the DEM run in parallel inside a job; the result is the same whatever their number) */
@@ -167,10 +215,15 @@ int main(int argc, char **argv)
     if (jthreads == 0) jthreads = ncpu / nworkers > 1 ? ncpu / nworkers : 1;
     workers_set_job_threads((int)jthreads);
     store_set_lease((double)o.v[GPD_OPT_LEASE].n);
+    store_set_max_connections((int)o.v[GPD_OPT_DB_CONNECTIONS].n);
     if (open_store(db)) return 1;
     gpd_http_config cfg = {.threads = (unsigned)nthreads,
-                           .max_connections = (unsigned)o.v[GPD_OPT_MAX_CONNECTIONS].n,
+                           .max_connections =
+                               connection_limit(o.v[GPD_OPT_MAX_CONNECTIONS].n, nworkers),
+                           .per_ip = (unsigned)o.v[GPD_OPT_MAX_CONNECTIONS_PER_IP].n,
                            .timeout_s = (unsigned)o.v[GPD_OPT_TIMEOUT].n,
+                           .header_timeout_s = (unsigned)o.v[GPD_OPT_HEADER_TIMEOUT].n,
+                           .max_pending = (unsigned)o.v[GPD_OPT_MAX_PENDING].n,
                            .max_body = (size_t)o.v[GPD_OPT_MAX_BODY].n,
                            .max_result_mb = (double)o.v[GPD_OPT_MAX_RESULT_MB].n,
                            .max_queued = o.v[GPD_OPT_MAX_QUEUED].n,

@@ -38,6 +38,10 @@
  *     double   density    kg/m^3
  *     double   lo[3], hi[3]  the box (3D: [0, box]; 2D: the container's bounding box, z 0)
  *     double   max_extent 2D: the largest grain's bounding-box diagonal (for LAMMPS' cutoff)
+ *     uint64   relax_bytes   3D with the DEM block: the size of lammps-relax's data file,
+ *                            counted when the pack is made (0: not counted, as in packs made
+ *                            before it was; a download counts it then)
+ *     uint32   relax_layout  the data file layout it was counted for
  *     (zero padding to 128)
  *   3D: nitems records of 4 doubles x, y, z, r; then, with flag GP_EXPORT_HAS_DEM
  *       (gp_export_pack_3d_dem), the DEM block of 128 bytes that lammps-relax needs:

@@ -47,6 +47,8 @@ struct gp_export {
     gp_export_grain grain; /* the grain at e->index (2D), loaded by the family */
     double aux;           /* per-grain scratch (e.g. LAMMPS 2D density scale) */
     uint64_t file_bytes;  /* lammps-relax: size of the data file in the tar */
+    uint64_t relax_bytes; /* lammps-relax: that size as counted into the pack (0: not) */
+    uint64_t written;     /* lammps-relax: bytes of the data file written so far */
     int ntypes;           /* lammps-relax: size classes (atom types) */
     double type_ratio;    /* lammps-relax: radius ratio of one class */
     int done;
@@ -90,5 +92,13 @@ int gp_export_step_vtk3d(gp_export *e);
 int gp_export_step_vtk2d(gp_export *e);
 int gp_export_step_csv(gp_export *e);
 int gp_export_step_lammps_relax(gp_export *e);
+
+/* lammps-relax's data file layout: a pack's counted size (gp_export.h, "relax_bytes") holds for
+ * this layout only; change it with the data file's format, and older packs are counted again
+ * at the download. */
+#define GP_EXPORT_RELAX_LAYOUT 1u
+/* The bytes of lammps-relax's data file for the pack of e (an export opened in that format,
+ * not yet read): every atom line formatted once. 0, or -1 with e->err set. */
+int gp_export_relax_count(gp_export *e, uint64_t *bytes);
 
 #endif /* GP_EXPORT_INTERNAL_H */

@@ -18,9 +18,13 @@
  * per-atom torque fix), and grainpack's free flight of fines is not reproduced.
  *
  * The tar is a stream in O(1) memory like every export: a ustar header carries its file's size,
- * so the data file is first sized by formatting each atom line once (a pass over the pack),
- * then written. Records: [folder header, script header, script, padding] [data header, data
- * file header] [one atom line per step] [padding, the two zero blocks that end a tar].
+ * which is counted by formatting each atom line once (a pass over the pack, 0.8 s at 525,000
+ * spheres). The pack carries that count, made when the job wrote it (gp_export.h, relax_bytes),
+ * so that a download starts at once; a pack without it (made before it was counted) is counted
+ * at the first read. The atom lines are counted again as they are written: a data file that
+ * would differ from its header fails the download rather than make a corrupt tar. Records:
+ * [folder header, script header, script, padding] [data header, data file header] [one atom
+ * line per step] [padding, the two zero blocks that end a tar].
  */
 #include "gp_export_internal.h"
 
@@ -126,7 +130,7 @@ static int data_atom(gp_export *e, uint64_t i, const double q[4])
 }
 
 /* The data file's size: its header and every atom line formatted once into the (empty)
- * staging buffer and dropped. */
+ * staging buffer and dropped (size_classes first). */
 static int data_size(gp_export *e, uint64_t *bytes)
 {
     uint64_t n = 0;
@@ -141,6 +145,15 @@ static int data_size(gp_export *e, uint64_t *bytes)
     }
     *bytes = n;
     return 0;
+}
+
+int gp_export_relax_count(gp_export *e, uint64_t *bytes)
+{
+    size_classes(e);
+    e->len = e->pos = 0;
+    int rc = data_size(e, bytes);
+    e->len = e->pos = 0;
+    return rc;
 }
 
 /* ------------------------------------------------------------------ the input script */
@@ -382,8 +395,8 @@ static int script_run(gp_export *e)
 static int write_script(gp_export *e)
 {
     size_classes(e);
-    uint64_t bytes;
-    if (data_size(e, &bytes)) return -1;
+    uint64_t bytes = e->relax_bytes;
+    if (!bytes && data_size(e, &bytes)) return -1;
     if (bytes > TAR_MAX_SIZE)
         return gp_error_set(&e->err, GP_ERR_INVALID,
                             "lammps-relax: a data file of %llu bytes is over the 8 GiB of a tar "
@@ -406,7 +419,21 @@ static int write_data_head(gp_export *e)
 {
     unsigned char h[TAR_BLOCK];
     tar_header(h, DIR "spheres.data", '0', e->file_bytes);
-    return gp_xw_bytes(e, h, TAR_BLOCK) || data_head(e) ? -1 : 0;
+    if (gp_xw_bytes(e, h, TAR_BLOCK)) return -1;
+    size_t at = e->len;
+    if (data_head(e)) return -1;
+    e->written = e->len - at;
+    return 0;
+}
+
+/* The data file written whole: its bytes as its tar header announced them. */
+static int data_complete(gp_export *e)
+{
+    if (e->written == e->file_bytes) return 0;
+    return gp_error_set(&e->err, GP_ERR_INVALID,
+                        "lammps-relax: the data file is %llu bytes, its header says %llu (the "
+                        "pack's count is stale)",
+                        (unsigned long long)e->written, (unsigned long long)e->file_bytes), -1;
 }
 
 int gp_export_step_lammps_relax(gp_export *e)
@@ -422,10 +449,13 @@ int gp_export_step_lammps_relax(gp_export *e)
     case SEC_ATOMS: {
         double q[4];
         if (gp_xr_sphere(e, e->index, q) || data_atom(e, e->index, q)) return -1;
+        e->written += e->len;
         if (++e->index >= e->info.nitems) e->section = SEC_END;
         return 0;
     }
     default: /* the data file's padding, then the end of the archive: two zero blocks */
-        return tar_pad(e, e->file_bytes) || gp_xw_bytes(e, NULL, 2 * TAR_BLOCK) ? -1 : 1;
+        return data_complete(e) || tar_pad(e, e->file_bytes) || gp_xw_bytes(e, NULL, 2 * TAR_BLOCK)
+                   ? -1
+                   : 1;
     }
 }

@@ -4,11 +4,13 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <netdb.h>
-#include <stdint.h>
 #include <stdarg.h>
+#include <stdatomic.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/socket.h>
 #include <sys/types.h>
 #include <time.h>
@@ -20,8 +22,10 @@
 #include "gp_export.h"
 #include "gp_spec.h"
 #include "kinds/kind.h"
+#include "jobs/file_errors.h"
 #include "jobs/maint.h"
 #include "jobs/metrics.h"
+#include "http/conns.h"
 #include "http/offload.h"
 #include "http/page.h"
 #include "http/routes.h"
@@ -36,6 +40,13 @@
 
 static struct MHD_Daemon *daemon_ = NULL;
 static size_t max_body = 1 << 20;
+/* The request bodies held at once, all connections together, are bounded by this many of the
+ * largest (max_body): beyond it a body is dropped and answered 503 busy, whatever the
+ * connection limits (a body is parsed off the HTTP threads into a few times its size) */
+#define BODIES_HELD_MAX 4
+#define BODY_BUSY_RETRY_S 5
+static atomic_size_t bodies_held; /* bytes of r->cap over every request */
+static unsigned max_pending = 16;
 static double max_result_mb = 8192;
 static long max_queued = 10000;
 static double started_at = 0;
@@ -45,7 +56,10 @@ static double started_at = 0;
 typedef struct req {
     char *body;
     size_t len, cap;
+    size_t limit;      /* the body this method of this route may carry (routes.h) */
+    size_t dropped;    /* body bytes read and dropped (over the limit, or refused) */
     int too_big;
+    int busy;        /* its body would take the bodies held over their bound: 503 */
     int refused;     /* answered before routing (414, 403): its body is discarded */
     int status;      /* the status sent, for the access log */
     size_t url_len;  /* the request target as sent (path and query), in bytes */
@@ -220,11 +234,28 @@ static int valid_status(const char *s)
 
 /* ------------------------------------------------------------------ handlers */
 
+/* A download refused for want of a database connection (STORE_BUSY: --db-connections are
+ * held by downloads in progress): 503 busy, and when to try again. */
+static enum MHD_Result send_busy(struct MHD_Connection *c, req *r)
+{
+    char retry[16];
+    snprintf(retry, sizeof retry, "%d", STORE_BUSY_RETRY_S);
+    return send_error_hdr(c, r, 503, "busy", NULL, "Retry-After", retry,
+                          "this daemon holds all the database connections it may "
+                          "(--db-connections) for downloads in progress; try again in %d s",
+                          STORE_BUSY_RETRY_S);
+}
+
+/* GET /v1/health answers within a second whatever the database does: its counts wait this
+ * long at most (a stalled server answers 503 "unreachable") */
+#define HEALTH_DB_WAIT_S 0.5
+
 static enum MHD_Result h_health(struct MHD_Connection *c, req *r, const char *id)
 {
     (void)id;
-    long q = 0, run = 0, su = 0, f = 0, ca = 0;
-    store_rc rc = store_counts(&q, &run, &su, &f, &ca);
+    long n[5] = {0};
+    store_rc rc = store_counts_within(HEALTH_DB_WAIT_S, n);
+    long q = n[0], run = n[1], su = n[2], f = n[3], ca = n[4];
     json_t *j = json_object();
     json_object_set_new(j, "status", json_string(rc == STORE_OK ? "ok" : "degraded"));
     json_object_set_new(j, "version", json_string(GPD_VERSION));
@@ -242,7 +273,12 @@ static enum MHD_Result h_health(struct MHD_Connection *c, req *r, const char *id
     char wmsg[256], wat[40];
     long wcount = 0;
     int werr = store_last_write_error(HEALTH_WRITE_WINDOW_S, wmsg, sizeof wmsg, wat, &wcount);
-    const char *db = rc != STORE_OK ? "error" : werr ? "write_failed" : "ok";
+    /* a result's temporary file that could not be written (a full disk) is a write failure */
+    if (!werr) werr = gpd_file_error_last(HEALTH_WRITE_WINDOW_S, wmsg, sizeof wmsg, wat, &wcount);
+    const char *db = rc == STORE_UNREACHABLE ? "unreachable"
+                     : rc != STORE_OK        ? "error"
+                     : werr                  ? "write_failed"
+                                             : "ok";
     json_object_set_new(j, "database", json_string(db));
     if (werr)
         json_object_set_new(j, "database_error",
@@ -478,8 +514,9 @@ static enum MHD_Result h_job(struct MHD_Connection *c, req *r, const char *id)
     return send_json(c, r, 200, j);
 }
 
-/* DELETE /v1/jobs/{id}?purge=1: a finished job removed with everything it has (204), its space
- * given back in the background (maint.h) */
+/* DELETE /v1/jobs/{id}?purge=1: a finished job removed (204): out of view at once, in a short
+ * transaction of a few small rows whatever the job's size; its result and pack are freed, and
+ * their space given back, by the maintenance thread in paced steps (maint.h), never here */
 static enum MHD_Result h_purge(struct MHD_Connection *c, req *r, const char *id)
 {
     char st[16];
@@ -571,6 +608,7 @@ static enum MHD_Result h_result(struct MHD_Connection *c, req *r, const char *id
     store_stream *s = NULL;
     store_rc rc = store_stream_open(id, "result", STREAM_SMALL, &s, &text, &len, st);
     if (rc == STORE_NOT_FOUND) return not_found(c, r, id);
+    if (rc == STORE_BUSY) return send_busy(c, r);
     if (rc != STORE_OK) return send_store_error(c, r);
     if (strcmp(st, "succeeded") || (!text && !s)) {
         free(text);
@@ -754,6 +792,7 @@ static int export_open(struct MHD_Connection *c, req *r, const char *id, const g
     size_t len = 0;
     store_rc rc = store_stream_open(id, "pack", STREAM_SMALL, &d->stream, &d->pack, &len, st);
     if (rc == STORE_NOT_FOUND) *ret = not_found(c, r, id);
+    else if (rc == STORE_BUSY) *ret = send_busy(c, r);
     else if (rc != STORE_OK) *ret = send_store_error(c, r);
     else if (!d->pack && !d->stream)
         *ret = send_error(c, r, 409, "missing_output", "/outputs",
@@ -911,27 +950,56 @@ static enum MHD_Result method_not_allowed(struct MHD_Connection *c, req *r, cons
                             "%s is not allowed on %s; allowed: %s", method, url, allow);
 }
 
-/* runs r's handler on a pool thread, then wakes its connection */
+/* Whether the client of suspended request r has closed its connection (libmicrohttpd does not
+ * look at a suspended connection): the end of the stream, or an error, at the socket. A
+ * pipelined request waiting there is a client still present. */
+static int client_gone(void *arg)
+{
+    req *r = arg;
+    const union MHD_ConnectionInfo *ci =
+        MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_CONNECTION_FD);
+    if (!ci) return 0;
+    char b;
+    ssize_t n = recv(ci->connect_fd, &b, 1, MSG_PEEK | MSG_DONTWAIT);
+    return n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR);
+}
+
+/* runs r's handler on a pool thread, then wakes its connection; the work of a client that has
+ * gone meanwhile (an analysis given up after a second) is dropped unanswered */
 static void run_offloaded(void *arg)
 {
     req *r = arg;
-    if (r->handler(r->conn, r, r->id) != MHD_YES && !r->resp) r->status = -1; /* close it */
+    if (client_gone(r)) {
+        gpd_log(GPD_LOG_DEBUG, "http %s %s: dropped, its client has gone", r->method, r->url);
+        r->status = -1; /* close it */
+    } else if (r->handler(r->conn, r, r->id) != MHD_YES && !r->resp) {
+        r->status = -1;
+    }
     MHD_resume_connection(r->conn);
 }
 
-/* Answers r by h off the HTTP threads (offload.h): the connection is suspended until the
- * response is ready, and on_request queues it. Where the pool does not take it (shutting
- * down), h runs here. */
-static enum MHD_Result offload(struct MHD_Connection *c, req *r, handler_fn h)
+/* Answers r by h off the HTTP threads, on the pool's lane (offload.h): the connection is
+ * suspended until the response is ready, and on_request queues it. A full lane is a 503 busy
+ * with Retry-After; where the pool does not take it (shutting down), h runs here. */
+static enum MHD_Result offload(struct MHD_Connection *c, req *r, handler_fn h, int lane)
 {
     r->conn = c;
     r->handler = h;
     r->offloaded = 1;
     MHD_suspend_connection(c);
-    if (gpd_offload_submit(run_offloaded, r) == 0) return MHD_YES;
+    int retry_s = 1;
+    int rc = gpd_offload_submit((gpd_lane)lane, run_offloaded, client_gone, r, &retry_s);
+    if (rc == 0) return MHD_YES;
     MHD_resume_connection(c);
     r->offloaded = 0;
-    return h(c, r, r->id);
+    if (rc < 0) return h(c, r, r->id);
+    char retry[16];
+    snprintf(retry, sizeof retry, "%d", retry_s);
+    return send_error_hdr(c, r, 503, "busy", NULL, "Retry-After", retry,
+                          "the daemon is busy: %u %s are waiting, the most it queues "
+                          "(--max-pending %u); send again after Retry-After seconds",
+                          max_pending, lane == GPD_LANE_ANALYSIS ? "shape analyses" : "submits",
+                          max_pending);
 }
 
 /* Answers r by the route table (routes.h): 404 for a path no route matches, 405 with the
@@ -958,7 +1026,189 @@ static enum MHD_Result route(struct MHD_Connection *c, req *r, const char *url,
     handler_fn h = handlers[op->handler];
     if (!h) return send_error(c, r, 500, "internal", NULL, "no handler for %s %s", method, path);
     if (r->id[0] && !gpd_id_is_plausible(r->id)) return not_found(c, r, r->id);
-    return op->offload ? offload(c, r, h) : h(c, r, r->id);
+    return op->offload ? offload(c, r, h, op->lane) : h(c, r, r->id);
+}
+
+/* What the headers say of the request's framing and size (scan_header). */
+typedef struct head_scan {
+    unsigned n_length, n_encoding; /* Content-Length and Transfer-Encoding headers */
+    const char *encoding;          /* the last Transfer-Encoding */
+    size_t bytes;                  /* the header lines as sent, about */
+} head_scan;
+
+static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const char *key,
+                                   const char *value)
+{
+    (void)kind;
+    head_scan *h = cls;
+    h->bytes += strlen(key) + (value ? strlen(value) : 0) + 4; /* ": " and CRLF */
+    if (!strcasecmp(key, MHD_HTTP_HEADER_CONTENT_LENGTH)) h->n_length++;
+    if (!strcasecmp(key, MHD_HTTP_HEADER_TRANSFER_ENCODING)) {
+        h->n_encoding++;
+        h->encoding = value;
+    }
+    return MHD_YES;
+}
+
+/* value is exactly the token tok, but for spaces around it and case */
+static int is_token(const char *value, const char *tok)
+{
+    if (!value) return 0;
+    value += strspn(value, " \t");
+    size_t n = strlen(tok), rest;
+    if (strncasecmp(value, tok, n)) return 0;
+    rest = strspn(value + n, " \t");
+    return value[n + rest] == '\0';
+}
+
+/* A refusal of the request as framed, answered at once and with the connection closed: what
+ * follows on it cannot be told apart from this request's body. */
+#define send_error_close(c, r, status, code, ...) \
+    send_error_hdr(c, r, status, code, NULL, MHD_HTTP_HEADER_CONNECTION, "close", __VA_ARGS__)
+
+/* The headers' size and the body's framing: 431 for headers over GPD_MAX_HEADERS, 400 for a
+ * body announced both by Content-Length and Transfer-Encoding (libmicrohttpd reads such a body
+ * as chunked, a proxy in front may read it by its length: the bytes one takes for the next
+ * request are the other's body, a smuggled request), for more than one of either header, and
+ * for a transfer coding other than chunked. Returns 1 when a response has been queued (in
+ * *ret), 0 to go on. */
+static int framing(struct MHD_Connection *c, req *r, enum MHD_Result *ret)
+{
+    head_scan h = {0, 0, NULL, 0};
+    MHD_get_connection_values(c, MHD_HEADER_KIND, scan_header, &h);
+    if (h.bytes + r->url_len > GPD_MAX_HEADERS)
+        *ret = send_error_close(c, r, 431, "headers_too_large",
+                                "the request line and headers are %zu bytes, over the limit of "
+                                "%u bytes", h.bytes + r->url_len, GPD_MAX_HEADERS);
+    else if (h.n_length && h.n_encoding)
+        *ret = send_error_close(c, r, 400, "invalid_request",
+                                "the request has both Content-Length and Transfer-Encoding; "
+                                "send one of them");
+    else if (h.n_length > 1 || h.n_encoding > 1)
+        *ret = send_error_close(c, r, 400, "invalid_request",
+                                "the request has more than one %s header",
+                                h.n_length > 1 ? "Content-Length" : "Transfer-Encoding");
+    else if (h.n_encoding && !is_token(h.encoding, "chunked"))
+        *ret = send_error_close(c, r, 400, "invalid_request",
+                                "Transfer-Encoding \"%.64s\" is not taken; send the body with "
+                                "Content-Length or Transfer-Encoding: chunked",
+                                h.encoding ? h.encoding : "");
+    else
+        return 0;
+    return 1;
+}
+
+static enum MHD_Result send_too_large(struct MHD_Connection *c, req *r, const char *method,
+                                      int now)
+{
+    const char *pattern = r->route ? r->route->pattern : r->url;
+    if (now) /* before reading it: the connection goes with the unread body */
+        return send_error_close(c, r, 413, "payload_too_large",
+                                "the request body is over the limit of %zu bytes for %s %s",
+                                r->limit, method, pattern);
+    return send_error(c, r, 413, "payload_too_large", NULL,
+                      "the request body is over the limit of %zu bytes for %s %s", r->limit,
+                      method, pattern);
+}
+
+/* The body limit of r's route and method (routes.h), and a body announced over it: answered
+ * 413 at once when the client waits for 100 Continue (it sends nothing), or when it is more
+ * than GPD_DRAIN_MAX over (reading it would cost more than the answer is worth); else it is
+ * read, dropped, and answered 413 once read, so that a client that sends without waiting (as
+ * Python's urllib does) reads the answer instead of a reset. */
+static enum MHD_Result announced_body(struct MHD_Connection *c, req *r, const char *method)
+{
+    int m = gpd_route_method_of(method);
+    r->limit = r->route && m >= 0 && r->route->op[m].offload ? max_body : GPD_ROUTE_NO_BODY_MAX;
+    const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
+                                                 MHD_HTTP_HEADER_CONTENT_LENGTH);
+    if (!cl) return MHD_YES;
+    char *end = NULL;
+    unsigned long long n = strtoull(cl, &end, 10);
+    if (!end || *end != '\0' || n <= r->limit) return MHD_YES;
+    r->too_big = 1;
+    const char *expect = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_EXPECT);
+    if (!is_token(expect, "100-continue") && n - r->limit <= GPD_DRAIN_MAX) return MHD_YES;
+    r->refused = 1;
+    return send_too_large(c, r, method, 1);
+}
+
+/* The first call of a request: its headers are in. */
+static enum MHD_Result request_start(struct MHD_Connection *c, req *r, const char *method)
+{
+    gpd_conns_headers_done(c);
+    /* 414, 403 forbidden_host / forbidden_origin, CORS preflight, 431 and the framing's 400:
+     * before anything else, so that a refused request creates or reads nothing */
+    enum MHD_Result ret;
+    if (gate(c, r, method, &ret) || framing(c, r, &ret)) {
+        r->refused = 1;
+        return ret;
+    }
+    return announced_body(c, r, method);
+}
+
+/* Body bytes not kept (over the limit, a refused request's): read up to GPD_DRAIN_MAX over the
+ * limit, then the connection is closed (the answer could no longer be queued). */
+static enum MHD_Result drop_body(req *r, size_t n)
+{
+    r->dropped += n;
+    return r->dropped > r->limit + GPD_DRAIN_MAX ? MHD_NO : MHD_YES;
+}
+
+/* Frees r's body (its bytes leave the bodies held); returns the bytes it had read. */
+static size_t release_body(req *r)
+{
+    atomic_fetch_sub(&bodies_held, r->cap);
+    free(r->body);
+    r->body = NULL;
+    size_t had = r->len;
+    r->len = r->cap = 0;
+    return had;
+}
+
+/* 503 busy: the bodies held by every connection are at their bound */
+static enum MHD_Result send_bodies_busy(struct MHD_Connection *c, req *r)
+{
+    char retry[16];
+    snprintf(retry, sizeof retry, "%d", BODY_BUSY_RETRY_S);
+    return send_error_hdr(c, r, 503, "busy", NULL, "Retry-After", retry,
+                          "the request bodies this daemon holds are at their bound (%d times "
+                          "--max-body); try again in %d s", BODIES_HELD_MAX, BODY_BUSY_RETRY_S);
+}
+
+/* A piece of the body: kept for POST, counted for the others (their bodies are ignored). */
+static enum MHD_Result body_piece(req *r, const char *method, const char *data, size_t n)
+{
+    if (r->too_big || r->busy || r->refused) return drop_body(r, n);
+    if (r->len + n > r->limit) {
+        r->too_big = 1;
+        return drop_body(r, release_body(r) + n);
+    }
+    if (strcmp(method, "POST")) {
+        r->len += n; /* counted against the limit, not kept */
+        return MHD_YES;
+    }
+    if (r->len + n + 1 > r->cap) {
+        size_t cap = r->cap ? r->cap : 4096;
+        while (cap < r->len + n + 1) cap *= 2;
+        if (cap > r->limit + 1) cap = r->limit + 1;
+        size_t grow = cap - r->cap, bound = BODIES_HELD_MAX * max_body;
+        if (atomic_fetch_add(&bodies_held, grow) + grow > bound) {
+            atomic_fetch_sub(&bodies_held, grow);
+            r->busy = 1;
+            return drop_body(r, release_body(r) + n);
+        }
+        char *b = realloc(r->body, cap);
+        if (!b) {
+            atomic_fetch_sub(&bodies_held, grow);
+            return MHD_NO;
+        }
+        r->body = b;
+        r->cap = cap;
+    }
+    memcpy(r->body + r->len, data, n);
+    r->len += n;
+    return MHD_YES;
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const char *url,
@@ -978,55 +1228,15 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         snprintf(r->url, sizeof r->url, "%s", url);
         r->route = gpd_route_match(url, r->id, sizeof r->id);
         *con_cls = r;
-        /* 414, 403 forbidden_host / forbidden_origin, CORS preflight: before anything else,
-         * so that a refused request creates or reads nothing */
-        enum MHD_Result ret;
-        if (gate(c, r, method, &ret)) {
-            r->refused = 1;
-            return ret;
-        }
-        /* refuse an announced oversized body before reading any of it */
-        const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
-                                                     MHD_HTTP_HEADER_CONTENT_LENGTH);
-        if (cl) {
-            char *end = NULL;
-            unsigned long long n = strtoull(cl, &end, 10);
-            if (end && *end == '\0' && n > max_body) {
-                r->too_big = 1;
-                return send_error(c, r, 413, "payload_too_large", NULL,
-                                  "request body of %llu bytes is over the limit of %zu bytes", n,
-                                  max_body);
-            }
-        }
-        return MHD_YES;
+        return request_start(c, r, method);
     }
     if (*upload_data_size) {
         size_t n = *upload_data_size;
         *upload_data_size = 0;
-        if (r->too_big || r->refused) return MHD_YES; /* discard */
-        if (strcmp(method, "POST")) return MHD_YES; /* bodies of other methods are ignored */
-        if (r->len + n > max_body) {
-            r->too_big = 1;
-            free(r->body);
-            r->body = NULL;
-            r->len = r->cap = 0;
-            return MHD_YES;
-        }
-        if (r->len + n + 1 > r->cap) {
-            size_t cap = r->cap ? r->cap : 4096;
-            while (cap < r->len + n + 1) cap *= 2;
-            if (cap > max_body + 1) cap = max_body + 1;
-            char *b = realloc(r->body, cap);
-            if (!b) return MHD_NO;
-            r->body = b;
-            r->cap = cap;
-        }
-        memcpy(r->body + r->len, upload_data, n);
-        r->len += n;
-        return MHD_YES;
+        return body_piece(r, method, upload_data, n);
     }
     if (r->offloaded) {
-        /* resumed: the pool thread's response, or none (out of memory): close */
+        /* resumed: the pool thread's response, or none (out of memory, client gone): close */
         struct MHD_Response *resp = r->resp;
         r->resp = NULL;
         r->offloaded = 0;
@@ -1036,9 +1246,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         return ret;
     }
     if (r->refused) return MHD_YES; /* answered at the first call */
-    if (r->too_big)
-        return send_error(c, r, 413, "payload_too_large", NULL,
-                          "request body over the limit of %zu bytes", max_body);
+    if (r->too_big) return send_too_large(c, r, method, 0);
+    if (r->busy) return send_bodies_busy(c, r);
     return route(c, r, url, method);
 }
 
@@ -1071,8 +1280,9 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
     }
     /* by the route matched when the request arrived (refused ones too) */
     metrics_http_request(r->route, r->status);
+    gpd_conns_request_done(c);
     if (r->resp) MHD_destroy_response(r->resp);
-    free(r->body);
+    release_body(r);
     free(r);
     *con_cls = NULL;
 }
@@ -1189,6 +1399,7 @@ int gpd_http_start(const gpd_http_config *cfg)
 {
     if (!handlers_complete()) return -1;
     max_body = cfg->max_body;
+    max_pending = cfg->max_pending;
     if (cfg->max_result_mb > 0) max_result_mb = cfg->max_result_mb;
     max_queued = cfg->max_queued;
     started_at = gpd_monotonic_s();
@@ -1197,8 +1408,13 @@ int gpd_http_start(const gpd_http_config *cfg)
         gpd_log(GPD_LOG_ERROR, "cannot build the dashboard page (out of memory)");
         return -1;
     }
-    if (gpd_offload_start(cfg->threads) != 0) {
+    if (gpd_offload_start(cfg->threads, cfg->max_pending) != 0) {
         gpd_log(GPD_LOG_ERROR, "cannot start the request pool");
+        return -1;
+    }
+    if (gpd_conns_start(cfg->header_timeout_s, cfg->timeout_s) != 0) {
+        gpd_log(GPD_LOG_ERROR, "cannot start the connection watch");
+        gpd_offload_stop();
         return -1;
     }
     unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_ERROR_LOG | MHD_USE_AUTO |
@@ -1207,15 +1423,19 @@ int gpd_http_start(const gpd_http_config *cfg)
         flags, 0, NULL, NULL, &on_request, NULL, MHD_OPTION_EXTERNAL_LOGGER, &mhd_log, NULL,
         MHD_OPTION_LISTEN_SOCKET, cfg->listen_fd,
         MHD_OPTION_THREAD_POOL_SIZE, cfg->threads, MHD_OPTION_CONNECTION_LIMIT,
-        cfg->max_connections, MHD_OPTION_CONNECTION_TIMEOUT, cfg->timeout_s,
-        /* a request line up to this size reaches on_uri, which answers a JSON 414 above
-         * GPD_MAX_URL; past it libmicrohttpd answers 414 itself. The pool is mmap'ed: pages
-         * are used only as far as a client fills them. */
+        cfg->max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT, cfg->per_ip,
+        MHD_OPTION_CONNECTION_TIMEOUT, cfg->timeout_s,
+        MHD_OPTION_NOTIFY_CONNECTION, &gpd_conns_notify, NULL,
+        /* a request line and headers up to this size reach on_uri and on_request, which
+         * answer a JSON 414 above GPD_MAX_URL and 431 above GPD_MAX_HEADERS; past it
+         * libmicrohttpd answers 414 or 431 itself. The pool is mmap'ed: pages are used only
+         * as far as a client fills them. */
         MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)GPD_CONN_MEMORY,
         MHD_OPTION_URI_LOG_CALLBACK, &on_uri, NULL, MHD_OPTION_NOTIFY_COMPLETED,
         &on_completed, NULL, MHD_OPTION_END);
     if (!daemon_) {
         gpd_log(GPD_LOG_ERROR, "cannot start the HTTP server");
+        gpd_conns_stop();
         gpd_offload_stop();
         return -1;
     }
@@ -1233,4 +1453,5 @@ void gpd_http_stop(void)
     gpd_offload_stop();
     MHD_stop_daemon(daemon_);
     daemon_ = NULL;
+    gpd_conns_stop();
 }

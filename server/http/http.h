@@ -35,9 +35,15 @@
 typedef struct gpd_http_config {
     int listen_fd;               /* bound and listening (gpd_listen_socket) */
     unsigned threads;            /* MHD thread pool size */
-    unsigned max_connections;    /* connection limit */
+    unsigned max_connections;    /* connection limit (main.c keeps it within the descriptors
+                                    the process may open, less a reserve) */
+    unsigned per_ip;             /* connections of one client address at most; 0 = no limit */
     unsigned timeout_s;          /* idle timeout per connection */
-    size_t max_body;             /* request body limit in bytes (413 above) */
+    unsigned header_timeout_s;   /* a request's headers must be in within this (conns.h) */
+    unsigned max_pending;        /* requests each lane of the request pool queues (offload.h):
+                                    503 busy beyond */
+    size_t max_body;             /* body limit in bytes of the methods that take one (POST
+                                    /v1/jobs, POST /v1/shapes/analyze; 413 above) */
     double max_result_mb;        /* specs whose estimated result is larger get 422 too_large */
     long max_queued;             /* a submit while this many jobs are queued gets 503 queue_full
                                     (with Retry-After); 0 = no cap */
@@ -49,7 +55,14 @@ typedef struct gpd_http_config {
 /* request targets longer than this get 414 uri_too_long (JSON); libmicrohttpd itself answers
  * (with its own HTML body) only past its per-connection buffer of GPD_CONN_MEMORY bytes */
 #define GPD_MAX_URL 8192
-#define GPD_CONN_MEMORY (256u * 1024u)
+/* a request line and headers of more bytes than this get 431 headers_too_large (JSON); past
+ * GPD_CONN_MEMORY libmicrohttpd answers 431 itself, with its own HTML body */
+#define GPD_MAX_HEADERS (64u * 1024u)
+#define GPD_CONN_MEMORY (1024u * 1024u)
+/* A body announced over its limit by a client that does not wait for 100 Continue is read and
+ * dropped, up to this many bytes over the limit, before the 413: a client that is still
+ * sending when the answer comes and the connection closes sees a reset, not the answer. */
+#define GPD_DRAIN_MAX ((size_t)64 << 20)
 
 /* Parses "HOST:PORT" ("[v6]:PORT", ":PORT" = 127.0.0.1), binds and listens. Returns the fd
  * and the bound port in *port (the actual one when PORT was 0), -1 with a message on stderr

@@ -3,22 +3,26 @@
 
 #include <string.h>
 
-#define ON_GET(h) [GPD_ROUTE_GET] = {(h), 0}
-#define ON_POST_OFFLOADED(h) [GPD_ROUTE_POST] = {(h), 1}
-#define ON_DELETE(h) [GPD_ROUTE_DELETE] = {(h), 0}
+#include "http/offload.h"
+
+#define ON_GET(h) [GPD_ROUTE_GET] = {(h), 0, 0}
+#define ON_POST_OFFLOADED(h, lane) [GPD_ROUTE_POST] = {(h), 1, (lane)}
+#define ON_DELETE(h) [GPD_ROUTE_DELETE] = {(h), 0, 0}
 
 /* A row: the pattern (as api.md heads it), the metrics label, and for each method it answers
- * its handler (http.c) and whether it is offloaded (run on the request pool). In the order
- * grainpack_http_requests_total lists the routes (api.md, "GET /metrics"). */
+ * its handler (http.c) and whether it is offloaded (run on the request pool, in which lane).
+ * In the order grainpack_http_requests_total lists the routes (api.md, "GET /metrics"). */
 static const gpd_route table[] = {
     {"/", "/", {ON_GET(GPD_H_DASHBOARD)}},
     {"/metrics", "/metrics", {ON_GET(GPD_H_METRICS)}},
     {"/v1/health", "/v1/health", {ON_GET(GPD_H_HEALTH)}},
     {"/v1/schema", "/v1/schema", {ON_GET(GPD_H_SCHEMA)}},
-    /* the analysis costs CPU in proportion to the body: off the HTTP threads */
-    {"/v1/shapes/analyze", "/v1/shapes/analyze", {ON_POST_OFFLOADED(GPD_H_SHAPES)}},
+    /* the analysis costs CPU in proportion to the body: off the HTTP threads, in a lane of
+     * its own (seconds each: submits must not wait behind it) */
+    {"/v1/shapes/analyze", "/v1/shapes/analyze",
+     {ON_POST_OFFLOADED(GPD_H_SHAPES, GPD_LANE_ANALYSIS)}},
     /* parsing and validating a body costs CPU in proportion to it: off the HTTP threads */
-    {"/v1/jobs", "/v1/jobs", {ON_GET(GPD_H_LIST), ON_POST_OFFLOADED(GPD_H_SUBMIT)}},
+    {"/v1/jobs", "/v1/jobs", {ON_GET(GPD_H_LIST), ON_POST_OFFLOADED(GPD_H_SUBMIT, GPD_LANE_SPEC)}},
     {"/v1/jobs/{id}", "/v1/jobs/:id", {ON_GET(GPD_H_JOB), ON_DELETE(GPD_H_CANCEL)}},
     {"/v1/jobs/{id}/result", "/v1/jobs/:id/result", {ON_GET(GPD_H_RESULT)}},
     {"/v1/jobs/{id}/svg", "/v1/jobs/:id/svg", {ON_GET(GPD_H_SVG)}},

@@ -58,8 +58,13 @@ typedef enum gpd_handler {
 typedef struct gpd_route_op {
     gpd_handler handler; /* GPD_H_NONE: 405 */
     int offload;         /* 1: run on the request pool (offload.h), off the HTTP threads: its
-                            cost grows with the request body */
+                            cost grows with the request body; such a method takes a body of
+                            up to --max-body, any other one at most GPD_ROUTE_NO_BODY_MAX */
+    int lane;            /* the pool's lane (offload.h: gpd_lane) when offloaded */
 } gpd_route_op;
+
+/* the body a method that takes none may carry (read and ignored): 413 above */
+#define GPD_ROUTE_NO_BODY_MAX (64u * 1024u)
 
 typedef struct gpd_route {
     const char *pattern; /* as docs/api.md writes it: "/v1/jobs/{id}/result" */

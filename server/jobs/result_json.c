@@ -12,6 +12,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "jobs/file_errors.h"
+
 json_t *gpd_jreal(double x)
 {
     return isfinite(x) ? json_real(x) : json_null();
@@ -110,8 +112,10 @@ static void spill(gpd_jw *w)
     if (first) {
         w->fd = temp_file(w->spill_dir);
         if (w->fd < 0) {
+            int err = errno;
+            gpd_file_error_note("a result's temporary file could not be made", err);
             gpd_log(GPD_LOG_WARN, "cannot make a temporary file for a result in %s (%s); it "
-                                  "stays in memory", w->spill_dir, strerror(errno));
+                                  "stays in memory", w->spill_dir, strerror(err));
             w->flush_at = SIZE_MAX;
             return;
         }
@@ -120,6 +124,7 @@ static void spill(gpd_jw *w)
     if (write_all(w->fd, w->b.buf, w->b.len)) {
         w->err = errno;
         w->state = GPD_JW_IO;
+        gpd_file_error_note("a result's temporary file could not be written", w->err);
         return;
     }
     w->spilled += w->b.len;

@@ -15,6 +15,7 @@
 /* chosen by store_open (before any thread) and kept to the end: reads need no lock */
 static const store_backend *be = &store_sqlite;
 static double lease_s = STORE_LEASE_DEFAULT_S;
+static int max_connections = STORE_MAX_CONNECTIONS_DEFAULT;
 static void (*cancel_hook)(const char *id) = NULL;
 static void (*wal_hook)(void) = NULL;
 
@@ -31,6 +32,16 @@ void store_set_lease(double seconds)
 double store_lease(void)
 {
     return lease_s;
+}
+
+void store_set_max_connections(int n)
+{
+    max_connections = n > 0 ? n : STORE_MAX_CONNECTIONS_DEFAULT;
+}
+
+int store_max_connections(void)
+{
+    return max_connections;
 }
 
 void store_on_cancel(void (*fn)(const char *id))
@@ -116,6 +127,12 @@ store_rc store_counts(long *queued, long *running, long *succeeded, long *failed
     return STORE_OK;
 }
 
+store_rc store_counts_within(double wait_s, long n[STORE_NSTATUS])
+{
+    memset(n, 0, STORE_NSTATUS * sizeof *n);
+    return be->counts_within(n, wait_s);
+}
+
 store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts)
 {
     return be->claim(id, kind, spec_json, attempts);
@@ -145,7 +162,18 @@ int store_purge_finished_before(const char *before, int max)
     return be->purge_finished_before(before, max);
 }
 
-int store_reclaim(void) { return be->reclaim(); }
+int store_free_purged(void) { return be->free_purged(); }
+int store_vacuum_step(void) { return be->vacuum_step(); }
+
+int store_reclaim(void)
+{
+    int rc;
+    while ((rc = be->free_purged()) > 0) {
+    }
+    while (rc == 0 && (rc = be->vacuum_step()) > 0) {
+    }
+    return rc < 0 ? -1 : be->checkpoint(0);
+}
 int store_checkpoint(int may_yield) { return be->checkpoint(may_yield); }
 void store_checkpoint_yield(void) { be->checkpoint_yield(); }
 

@@ -5,9 +5,12 @@
  * both; where PostgreSQL differs it is said under "PostgreSQL" at the end of this comment.
  *
  * SQLite: one table, jobs (WAL journal, busy_timeout 5 s, synchronous=FULL; a new database is
- * made with auto_vacuum=INCREMENTAL so that purged jobs give their space back (store_reclaim),
- * and every connection sets journal_size_limit=64 MB so that the WAL shrinks after a
- * checkpoint; no connection checkpoints by itself -- see "Checkpoints" below):
+ * made with auto_vacuum=INCREMENTAL so that purged jobs give their space back
+ * (store_vacuum_step), and every connection sets journal_size_limit=64 MB so that the WAL
+ * shrinks after a checkpoint, and secure_delete=FAST: SQLite as Debian builds it overwrites
+ * every freed page with zeros, which makes freeing a result of hundreds of MB write as much
+ * again to the WAL while holding the write lock; FAST still clears deleted cells in the pages
+ * a change writes anyway. No connection checkpoints by itself -- see "Checkpoints" below):
  *   seq         INTEGER PRIMARY KEY AUTOINCREMENT  submission order (newest = largest)
  *   id          TEXT NOT NULL UNIQUE               32 hex digits, 128 random bits (/dev/urandom)
  *   kind        TEXT NOT NULL
@@ -31,7 +34,9 @@
  * succeeded job (core/export/gp_export.h), committed with the result;
  * and summaries(seq INTEGER PRIMARY KEY = jobs.seq, summary TEXT NOT NULL, arrays TEXT): the
  * result's summary and where its arrays are in its text (store_get_summary), committed with
- * the result.
+ * the result;
+ * and purged(seq INTEGER PRIMARY KEY): jobs purged whose values (results, exports,
+ * value_parts rows) are still to be freed (store_purge, store_free_purged).
  *
  * Connections: one per thread (opened lazily, closed when the thread exits or on
  * store_close()); every write is a single statement or an IMMEDIATE transaction, so claims and
@@ -80,10 +85,21 @@
  * store_recover applies the restart rule only to jobs of this host's daemons that are dead
  * (same host and boot, pid gone); other daemons' jobs are left to their leases. A graceful
  * shutdown requeues only this daemon's jobs. No file lock: many daemons is the point.
- * Connections: one per thread, like SQLite's, every statement prepared and parameterised.
- * On PostgreSQL store_reclaim does nothing (autovacuum makes purged space reusable) and
- * store_size is pg_database_size; store_fill_briefs has nothing to fill (every job of a
- * PostgreSQL store had its brief at submit).
+ * Connections: one per thread, like SQLite's, every statement prepared and parameterised;
+ * plus one per download in progress (its snapshot), within store_set_max_connections: a
+ * PostgreSQL server serves a fixed number of clients for every daemon on it, and slow
+ * downloads on one daemon must not take them all (STORE_BUSY beyond it).
+ * A server that stops answering (stalled, a lost network) must not stall the daemon: every
+ * call waits for the server at most a bounded time without hearing from it, and while the
+ * server is known not to answer calls fail at once with nothing sent (STORE_UNREACHABLE for
+ * store_counts_within); a thread of the store probes it and everything works again, with new
+ * connections where the old ones broke, once it answers. Server side, every connection sets
+ * statement_timeout and idle_in_transaction_session_timeout, so that neither a runaway
+ * statement nor a stalled client holds rows or a snapshot for long; TCP keepalives find a
+ * server gone from the network.
+ * On PostgreSQL store_vacuum_step and store_checkpoint do nothing (autovacuum makes purged
+ * space reusable) and store_size is pg_database_size; store_fill_briefs has nothing to fill
+ * (every job of a PostgreSQL store had its brief at submit).
  *
  * Thread safety (both): every function may be called from any thread, each using its own
  * connection; store_open, store_set_lease and store_close from the main thread only, before
@@ -104,13 +120,18 @@
 #define STORE_MAX_ATTEMPTS 3
 
 /* STORE_TOOBIG: a row larger than the database can hold (SQLITE_TOOBIG); retrying is futile.
- * STORE_FULL: the queue already holds the most jobs it may (store_insert's max_queued). */
+ * STORE_FULL: the queue already holds the most jobs it may (store_insert's max_queued).
+ * STORE_BUSY: a download would take a database connection over store_set_max_connections
+ * (store_stream_open; try again later).
+ * STORE_UNREACHABLE: the database server does not answer (store_counts_within). */
 typedef enum {
     STORE_OK = 0,
     STORE_NOT_FOUND = 1,
     STORE_CONFLICT = 2,
     STORE_TOOBIG = 3,
     STORE_FULL = 4,
+    STORE_BUSY = 5,
+    STORE_UNREACHABLE = 6,
     STORE_ERROR = -1
 } store_rc;
 
@@ -133,6 +154,14 @@ const char *store_backend_name(void);
 #define STORE_LEASE_DEFAULT_S 30.0
 void store_set_lease(double seconds);
 double store_lease(void);
+/* PostgreSQL: the most connections this daemon holds at once (--db-connections; default
+ * STORE_MAX_CONNECTIONS_DEFAULT), set before store_open. The threads' own connections (one
+ * per thread that uses the store) are always made; a download (store_stream_open of a large
+ * value) gets one only while fewer are open, else STORE_BUSY. SQLite: no limit. */
+#define STORE_MAX_CONNECTIONS_DEFAULT 32
+void store_set_max_connections(int n);
+/* The seconds a client should wait before trying a download again after STORE_BUSY. */
+#define STORE_BUSY_RETRY_S 5
 /* fn(id) is called (from the store's own thread) when another daemon cancelled job id, which
  * may be running here (PostgreSQL; never with SQLite, where every cancel is local). */
 void store_on_cancel(void (*fn)(const char *id));
@@ -175,6 +204,12 @@ json_t *store_list(const char *status, int limit, const char *after, store_rc *r
 /* Counts per status (any pointer may be NULL). */
 store_rc store_counts(long *queued, long *running, long *succeeded, long *failed,
                       long *cancelled);
+
+/* store_counts for a liveness probe (/v1/health): waits for the database at most wait_s
+ * seconds, and answers STORE_UNREACHABLE then, or at once while the server is known not to
+ * answer (PostgreSQL); SQLite: store_counts. n in store_counts' order (queued, running,
+ * succeeded, failed, cancelled). */
+store_rc store_counts_within(double wait_s, long n[5]);
 
 /* The last failed write (any SQLite error on a statement that writes, a failed commit of a
  * result): 1 and its message, time (RFC 3339) and how many writes have failed since the start,
@@ -235,13 +270,19 @@ store_rc store_cancel(const char *id, int *was_running, char status_out[16], cha
 
 /* ---- operations: purging finished jobs, giving the space back, sizes ---- */
 
-/* DELETE ?purge=1: removes a finished job (succeeded, failed or cancelled) -- its row with the
- * result, its export pack and its summary -- in one transaction. STORE_CONFLICT (with the
- * status in status_out) when the job is queued or running, STORE_NOT_FOUND when unknown.
+/* DELETE ?purge=1: removes a finished job (succeeded, failed or cancelled) from view -- it is
+ * unknown to every call at once -- in one short transaction that writes a few rows whatever
+ * the job's size: the job's seq goes into the table purged(seq), and its result, export pack
+ * and their parts stay where they are until store_free_purged frees them, a bounded piece per
+ * write transaction (on the maintenance thread, maint.h). Freeing a value of hundreds of MB in
+ * the request's transaction would hold SQLite's write lock for seconds (every freed page
+ * written again), so that other writers time out. STORE_CONFLICT (with the status in
+ * status_out) when the job is queued or running, STORE_NOT_FOUND when unknown (or purged).
  * A download of its result or pack in progress keeps reading the value as it was: a stream
  * (store_stream_open) holds a read transaction, whose snapshot a later write never changes.
- * The space the job took is free for reuse at once; store_reclaim gives it back to the file
- * system. */
+ * SQLite: the job's row and summary are deleted; PostgreSQL: its row is marked
+ * status='purged' (deleting it would delete its result's first part with it, up to 256 MiB of
+ * TOAST rows) and every read leaves such rows out. */
 store_rc store_purge(const char *id, char status_out[16]);
 
 /* The retention sweep: purges (store_purge, each job its own short transaction) at most max
@@ -249,17 +290,33 @@ store_rc store_purge(const char *id, char status_out[16]);
  * oldest first. Returns how many were purged, -1 when the candidates could not be read. */
 int store_purge_finished_before(const char *before, int max);
 
-/* Gives the space of purged jobs back and empties the WAL: incremental vacuum (in steps of a
- * few MB, each its own short write transaction), a PASSIVE checkpoint (copies the WAL into the
- * database without blocking anyone: the long part after a large result) and a checkpoint in
- * TRUNCATE mode that does not wait: a writer at that moment or a reader of an older snapshot
- * (a download in progress) blocks it, and the caller tries again later. 0 when done, 1 when the
- * checkpoint was blocked, -1 on an error (logged). A database made without auto_vacuum (before
- * it was set at creation) only checkpoints: its file keeps its size, its free pages are
- * reused. */
+/* Frees one piece of what purged jobs left (a part of a result or pack: at most STORE_PART
+ * bytes; then the job's last rows), in its own short write transaction that waits for the
+ * write lock only briefly (a writer that holds it wins: the caller tries again later). 1 when
+ * more is left, 0 when nothing is, -1 on an error or a busy database (logged at debug). The
+ * caller paces the calls (maint.h), so that other writers get the lock between them. Any
+ * daemon may free any purged job (PostgreSQL: rows of purged are claimed with SKIP LOCKED). */
+int store_free_purged(void);
+
+/* One step of giving free space back to the file system (SQLite: an incremental vacuum of
+ * STORE_VACUUM_STEP bytes of free pages, its own short write transaction; every page it moves
+ * is written to the WAL). 1 when free pages are left, 0 when none (or the database was made
+ * without auto_vacuum; PostgreSQL: always, its autovacuum makes the space reusable), -1 on an
+ * error or a busy database. Paced by the caller as store_free_purged. */
+#define STORE_VACUUM_STEP (2 << 20)
+int store_vacuum_step(void);
+
+/* Everything at once, for a caller that may hold the store (tests, tools): store_free_purged
+ * and store_vacuum_step until nothing is left, then a checkpoint in TRUNCATE mode (as
+ * store_checkpoint(0)). 0 when done, 1 when the checkpoint was blocked, -1 on an error. A
+ * database made without auto_vacuum (before it was set at creation) only checkpoints: its file
+ * keeps its size, its free pages are reused. */
 int store_reclaim(void);
 
-/* The WAL checkpoint of store_reclaim alone (no vacuum): 0 done, 1 blocked (try again later),
+/* Empties the WAL: a PASSIVE checkpoint (copies the WAL into the database without blocking
+ * anyone: the long part after a large result) and a checkpoint in TRUNCATE mode that does not
+ * wait: a writer at that moment or a reader of an older snapshot (a download in progress)
+ * blocks it, and the caller tries again later. 0 done, 1 blocked (try again later),
  * 2 given way to a job (may_yield: a claim on any thread interrupted it, store_checkpoint_yield;
  * its copying starts over next time), -1 an error (logged). PostgreSQL: 0. */
 int store_checkpoint(int may_yield);
@@ -268,7 +325,7 @@ void store_checkpoint_yield(void);
 
 /* fn() is called (on the committing thread, which must not wait for it) after a commit that
  * left the WAL over STORE_WAL_KICK_BYTES (SQLite; never on PostgreSQL): a checkpoint is due
- * (store_reclaim). NULL: none. */
+ * (store_checkpoint). NULL: none. */
 #define STORE_WAL_KICK_BYTES (4 << 20) /* SQLite's own autocheckpoint threshold, 1000 pages of
                                           its default 4 KB */
 void store_on_wal_grown(void (*fn)(void));
@@ -288,7 +345,12 @@ typedef struct store_stream store_stream;
  * STORE_OK with the job's status and one of: *text (malloc'ed, NUL-terminated, *text_len
  * bytes) when the value has at most `small` bytes; *out, a stream on a private connection, when
  * it is larger; neither when the job has no such value (not finished, or no pack). The stream
- * may be read from any one thread at a time and must be closed. */
+ * may be read from any one thread at a time and must be closed. STORE_BUSY when a stream
+ * would take a connection over store_set_max_connections (PostgreSQL). A PostgreSQL stream's
+ * transaction ends, and its next read fails, when it stays idle for STORE_STREAM_IDLE_S (a
+ * reader that stopped reading must not hold a snapshot, which keeps vacuum from every row
+ * deleted since, for long). */
+#define STORE_STREAM_IDLE_S 60
 store_rc store_stream_open(const char *id, const char *what, size_t small, store_stream **out,
                            char **text, size_t *text_len, char status[16]);
 uint64_t store_stream_size(const store_stream *s);

@@ -20,6 +20,9 @@
 
 #include "store/store.h"
 
+/* store_set_max_connections' value (PostgreSQL). */
+int store_max_connections(void);
+
 /* The statuses in the order of store_counts' arguments. */
 enum { STORE_NSTATUS = 5 };
 
@@ -37,6 +40,8 @@ typedef struct store_backend {
     json_t *(*list)(const char *status, int limit, const char *after, store_rc *rc);
     /* adds each status's count at n[store_status_slot(status)] (n zeroed by store.c) */
     store_rc (*counts)(long n[STORE_NSTATUS]);
+    /* store_counts_within: the same, waiting at most wait_s for the database */
+    store_rc (*counts_within)(long n[STORE_NSTATUS], double wait_s);
     store_rc (*claim)(char id[33], char **kind, char **spec_json, int *attempts);
     store_rc (*progress)(const char *id, const char *progress_json);
     /* store_succeed after the shared part: summary (may be NULL) of slen bytes and its arrays'
@@ -51,7 +56,8 @@ typedef struct store_backend {
     store_rc (*cancel)(const char *id, int *was_running, char status_out[16], char kind_out[64]);
     store_rc (*purge)(const char *id, char status_out[16]);
     int (*purge_finished_before)(const char *before, int max);
-    int (*reclaim)(void);
+    int (*free_purged)(void);
+    int (*vacuum_step)(void);
     int (*checkpoint)(int may_yield);
     void (*checkpoint_yield)(void);
     int (*count_by_kind)(void (*fn)(void *user, const char *kind, const char *status, long n),

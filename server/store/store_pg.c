@@ -11,18 +11,35 @@
  *
  * Ownership: every write that ends or updates a running job is conditioned on
  * status='running' AND owner=<this daemon>; the claim is the only way to become the owner.
- * The lease thread (one per daemon, its own connection) renews lease_until of this daemon's
- * running jobs every lease/3 s and LISTENs on gp_cancel for cancels made by other daemons.
+ * The store thread (one per daemon, its own connection) renews lease_until of this daemon's
+ * running jobs every lease/3 s, LISTENs on gp_cancel for cancels made by other daemons, and
+ * watches the server (below).
+ *
+ * Purge: a purged job's row stays, status 'purged', out of every read, until the maintenance
+ * thread deletes its rows one at a time (store_free_purged); its seq waits in purged.
  *
  * Threads: one connection per thread (a pthread key, opened lazily; statements prepared once
  * per connection, by the address of their SQL literal, as store_sqlite.c caches them); a
  * download has a private connection holding a REPEATABLE READ transaction (its snapshot: a
- * purge meanwhile does not change what it reads). A connection that breaks is dropped and the
- * next call opens a new one. No user data is ever formatted into SQL.
+ * purge meanwhile does not change what it reads), made only while the daemon holds fewer than
+ * store_max_connections. A connection that breaks is dropped and the next call opens a new one.
+ * No user data is ever formatted into SQL.
+ *
+ * Calls never block on the server: connections are made with PQconnectStartParams and run in
+ * non-blocking mode, and every call waits in poll() with a bound (PG_WAIT_S without a word from
+ * the server, past the server's own statement_timeout; a liveness probe's own, shorter one).
+ * Silence is not proof of a stalled server (a statement may wait for a row lock that another
+ * transaction holds for long): a call silent for PG_SUSPECT_S asks the store thread to probe,
+ * and only that probe, a statement that never waits for a lock, marks the server unreachable
+ * when it gets no answer in PG_PROBE_WAIT_S. Every call then ends (its connection dropped) and
+ * calls fail at once until the store thread finds the server answering again. A stopped
+ * server (SIGSTOP, a lost network) thus costs a request a few seconds at most, and /v1/health
+ * half a second.
  */
 #include "store/store_impl.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <poll.h>
 #include <pthread.h>
 #include <signal.h>
@@ -44,6 +61,257 @@ static long long max_value = 0;  /* the largest value stored (PostgreSQL: 1 GB a
 #define PG_STMT_CACHE 48
 #define PG_MAX_VALUE 1000000000LL /* under PostgreSQL's 1 GB limit of one field */
 
+/* How long a call waits without a word from the server before it gives up: past the server's
+ * statement_timeout (60 s), so that a statement that runs long ends with the server's own
+ * error; a stalled server ends every call sooner, through the probe (PG_SUSPECT_S). */
+#define PG_WAIT_S 65.0
+#define PG_CONNECT_WAIT_S 5.0
+#define PG_SUSPECT_S 1.0     /* a call silent this long asks the store thread to probe */
+#define PG_PROBE_WAIT_S 3.0  /* the probe's bound: no answer marks the server unreachable */
+#define PG_PROBE_EVERY_S 0.5 /* the probes while the server does not answer */
+/* libpq's and the server's own bounds, set on every connection (before the URL's, which may
+ * change them): keepalives find a server gone from the network in about 25 s, the TCP user
+ * timeout a send that is never acknowledged; statement_timeout ends a runaway statement;
+ * idle_in_transaction_session_timeout ends the transaction (and the snapshot) of a download
+ * whose reader stopped reading (STORE_STREAM_IDLE_S) */
+#define PG_STATEMENT_TIMEOUT_MS 60000
+static const char *const CONN_KEYS[] = {
+    "connect_timeout", "keepalives", "keepalives_idle", "keepalives_interval",
+    "keepalives_count", "tcp_user_timeout", "client_encoding", "application_name", "options",
+    "dbname", NULL};
+static char conn_options[160]; /* the server's settings (set by pg_open) */
+static const char *conn_vals[] = {
+    "5", "1", "10", "5", "3", "20000", "UTF8", "grainpackd", conn_options,
+    NULL /* the URL, expanded: set by pg_open */, NULL};
+#define CONN_URL_SLOT (sizeof CONN_KEYS / sizeof *CONN_KEYS - 2)
+
+/* The server's settings of every connection. A testing hook (environment, never needed in
+ * production) shortens the idle transaction's bound: GRAINPACK_TEST_PG_IDLE_S, seconds. */
+static void conn_options_init(void)
+{
+    const char *t = getenv("GRAINPACK_TEST_PG_IDLE_S");
+    long idle = t && atol(t) > 0 ? atol(t) : STORE_STREAM_IDLE_S;
+    snprintf(conn_options, sizeof conn_options,
+             "-c statement_timeout=%d -c idle_in_transaction_session_timeout=%ld",
+             PG_STATEMENT_TIMEOUT_MS, idle * 1000);
+}
+
+/* The server's state as this daemon sees it: 0 while it does not answer (a call waited past
+ * its bound, or the store thread's probe did); calls then fail at once with nothing sent, and
+ * the store thread probes it every PG_PROBE_EVERY_S until it answers. Atomic. */
+static int reachable = 1;
+static double down_since = 0; /* monotonic; written by whoever marks the server down */
+/* the connections this daemon holds (threads' and downloads'): atomic */
+static int open_conns = 0;
+
+/* Per thread: the bound of this thread's calls (0: PG_WAIT_S); stalled: the last call got no
+ * answer, or found the server marked unreachable; probing: the store thread's own calls,
+ * which are made whatever the server's state, and whose silence marks it unreachable. */
+static __thread double tl_wait_s = 0;
+static __thread int tl_stalled = 0, tl_probing = 0;
+/* Per thread: when set (monotonic), no wait goes past it: a liveness probe's whole budget,
+ * connecting and asking together. */
+static __thread double tl_until = 0;
+
+static int lease_pipe[2] = {-1, -1}; /* to the store thread: 'x' stop, 'p' probe now */
+
+static double call_wait(void) { return tl_wait_s > 0 ? tl_wait_s : PG_WAIT_S; }
+
+/* 1 when calls must fail at once: the server is marked unreachable (the probe excepted) */
+static int db_closed(void)
+{
+    return !tl_probing && !__atomic_load_n(&reachable, __ATOMIC_ACQUIRE);
+}
+
+static void wake_store_thread(char what)
+{
+    if (lease_pipe[1] < 0) return;
+    ssize_t w = write(lease_pipe[1], &what, 1); /* non-blocking: a full pipe has one already */
+    (void)w;
+}
+
+static void mark_down(const char *why)
+{
+    if (__atomic_exchange_n(&reachable, 0, __ATOMIC_ACQ_REL)) {
+        double now = gpd_monotonic_s();
+        __atomic_store(&down_since, &now, __ATOMIC_RELEASE);
+        gpd_log(GPD_LOG_WARN, "postgresql: the server does not answer (%s); database calls fail "
+                              "at once until it does (probed every %.1f s)",
+                why, PG_PROBE_EVERY_S);
+    }
+    wake_store_thread('p');
+}
+
+static void mark_up(void)
+{
+    double since;
+    __atomic_load(&down_since, &since, __ATOMIC_ACQUIRE);
+    if (!__atomic_exchange_n(&reachable, 1, __ATOMIC_ACQ_REL))
+        gpd_log(GPD_LOG_WARN, "postgresql: the server answers again, after %.1f s",
+                gpd_monotonic_s() - since);
+}
+
+/* A call got no answer: past its bound (wait, seconds), or the server was marked unreachable
+ * meanwhile. The store thread's own silence marks the server unreachable; another thread's
+ * only asks it for a probe. */
+static void stalled(const char *what, double wait)
+{
+    tl_stalled = 1;
+    if (db_closed()) return;
+    char why[160];
+    snprintf(why, sizeof why, "%.40s: no answer within %.1f s", what, wait);
+    if (tl_probing) {
+        mark_down(why);
+        return;
+    }
+    gpd_log(GPD_LOG_DEBUG, "postgresql %s", why);
+    wake_store_thread('p');
+}
+
+/* Waits until pg's socket is ready for events (POLLIN, POLLOUT) or the deadline (and the
+ * thread's tl_until); asks for a probe after PG_SUSPECT_S of it, and gives up early when the
+ * server is marked unreachable meanwhile. The events seen, or -1. */
+static int wait_socket(PGconn *pg, short events, double deadline)
+{
+    if (tl_until > 0 && tl_until < deadline) deadline = tl_until;
+    double suspect = gpd_monotonic_s() + PG_SUSPECT_S;
+    for (;;) {
+        int fd = PQsocket(pg);
+        double now = gpd_monotonic_s(), left = deadline - now;
+        if (fd < 0 || left <= 0 || db_closed()) return -1;
+        if (!tl_probing && suspect > 0 && now >= suspect) {
+            wake_store_thread('p');
+            suspect = 0;
+        }
+        struct pollfd p = {fd, events, 0};
+        int n = poll(&p, 1, left > 0.1 ? 100 : (int)(left * 1000) + 1);
+        if (n > 0) return p.revents;
+        if (n < 0 && errno != EINTR) return -1;
+    }
+}
+
+/* Takes a connection slot: a download's only while fewer than store_max_connections are
+ * held. 0, or -1. */
+static int take_slot(int download)
+{
+    int n = __atomic_add_fetch(&open_conns, 1, __ATOMIC_ACQ_REL);
+    if (!download || n <= store_max_connections()) return 0;
+    __atomic_sub_fetch(&open_conns, 1, __ATOMIC_ACQ_REL);
+    return -1;
+}
+
+static void disconnect(PGconn *pg)
+{
+    if (!pg) return;
+    PQfinish(pg);
+    __atomic_sub_fetch(&open_conns, 1, __ATOMIC_ACQ_REL);
+}
+
+/* A new connection to the server, made without blocking past the call's bound (NULL, logged,
+ * when it fails; at once while the server is marked unreachable). Its slot is taken by the
+ * caller (take_slot) and given back by disconnect. */
+static PGconn *connect_raw(void)
+{
+    if (!conninfo || db_closed()) {
+        tl_stalled = 1;
+        return NULL;
+    }
+    PGconn *pg = PQconnectStartParams(CONN_KEYS, conn_vals, 1);
+    double wait = tl_wait_s > 0 && tl_wait_s < PG_CONNECT_WAIT_S ? tl_wait_s : PG_CONNECT_WAIT_S;
+    double deadline = gpd_monotonic_s() + wait;
+    PostgresPollingStatusType st = pg && PQstatus(pg) != CONNECTION_BAD ? PGRES_POLLING_WRITING
+                                                                         : PGRES_POLLING_FAILED;
+    while (st == PGRES_POLLING_READING || st == PGRES_POLLING_WRITING) {
+        if (wait_socket(pg, st == PGRES_POLLING_READING ? POLLIN : POLLOUT, deadline) < 0) {
+            stalled("connect", wait);
+            PQfinish(pg);
+            return NULL;
+        }
+        st = PQconnectPoll(pg);
+    }
+    if (st != PGRES_POLLING_OK || PQsetnonblocking(pg, 1)) {
+        gpd_log(tl_until > 0 ? GPD_LOG_DEBUG : GPD_LOG_ERROR, "postgresql connect: %s",
+                pg ? PQerrorMessage(pg) : "out of memory");
+        tl_stalled = 1; /* no server to talk to: unreachable for /v1/health */
+        PQfinish(pg);
+        return NULL;
+    }
+    return pg;
+}
+
+/* connect_raw within a slot: a thread's (always) or a download's (within the limit). */
+static PGconn *connect_new(int download)
+{
+    if (take_slot(download)) return NULL;
+    PGconn *pg = connect_raw();
+    if (!pg) __atomic_sub_fetch(&open_conns, 1, __ATOMIC_ACQ_REL);
+    return pg;
+}
+
+static int ok_result(const PGresult *r)
+{
+    ExecStatusType s = PQresultStatus(r);
+    return s == PGRES_COMMAND_OK || s == PGRES_TUPLES_OK;
+}
+
+/* Waits for the result of what a PQsend* call (sent: its return) put on pg: sends what libpq
+ * holds, then reads until the result is whole, each wait bounded (call_wait(): the bound is
+ * renewed whenever the server is heard). The result (of several statements: the first
+ * failed one, else the last), or NULL: nothing sent, or no answer (stalled()); the connection
+ * is then unusable (a command is still in progress on it). */
+static PGresult *await_result(PGconn *pg, int sent, const char *what)
+{
+    if (!sent) return NULL;
+    double wait = call_wait(), deadline = gpd_monotonic_s() + wait;
+    int f;
+    while ((f = PQflush(pg)) == 1) {
+        int ev = wait_socket(pg, POLLOUT | POLLIN, deadline);
+        if (ev < 0) {
+            stalled(what, wait);
+            return NULL;
+        }
+        if ((ev & POLLIN) && !PQconsumeInput(pg)) return NULL;
+        deadline = gpd_monotonic_s() + wait;
+    }
+    if (f < 0) return NULL;
+    PGresult *res = NULL;
+    for (;;) {
+        while (PQisBusy(pg)) {
+            if (wait_socket(pg, POLLIN, deadline) < 0) {
+                stalled(what, wait);
+                PQclear(res);
+                return NULL;
+            }
+            if (!PQconsumeInput(pg)) {
+                PQclear(res);
+                return NULL;
+            }
+            deadline = gpd_monotonic_s() + wait;
+        }
+        PGresult *r = PQgetResult(pg);
+        if (!r) break;
+        if (res && !ok_result(res)) { /* the first failure stays */
+            PQclear(r);
+            continue;
+        }
+        PQclear(res);
+        res = r;
+    }
+    return res;
+}
+
+/* The text of one statement with parameters on pg (not prepared: the store thread's and
+ * downloads' own connections), as await_result. */
+static PGresult *exec_params(PGconn *pg, const char *sql, int n, const char *const *vals,
+                             int binary)
+{
+    if (db_closed()) {
+        tl_stalled = 1;
+        return NULL;
+    }
+    return await_result(pg, PQsendQueryParams(pg, sql, n, NULL, vals, NULL, NULL, binary), sql);
+}
+
 typedef struct pg_conn {
     PGconn *pg;
     int n;
@@ -54,41 +322,31 @@ static void conn_destroy(void *p)
 {
     pg_conn *c = p;
     if (!c) return;
-    PQfinish(c->pg);
+    disconnect(c->pg);
     free(c);
 }
 
-/* A new connection to the server (NULL, logged, when it fails). */
-static PGconn *connect_new(void)
-{
-    if (!conninfo) return NULL;
-    PGconn *pg = PQconnectdb(conninfo);
-    if (PQstatus(pg) != CONNECTION_OK) {
-        gpd_log(GPD_LOG_ERROR, "postgresql connect: %s", PQerrorMessage(pg));
-        PQfinish(pg);
-        return NULL;
-    }
-    PQsetClientEncoding(pg, "UTF8");
-    return pg;
-}
-
-static void close_handle(void *pg) { PQfinish(pg); }
-static void *open_handle(void) { return connect_new(); }
+static void close_handle(void *pg) { disconnect(pg); }
+static void *open_handle(void) { return connect_new(0); }
 static store_tls tls = {open_handle, close_handle, sizeof(pg_conn), conn_destroy, 0, 0};
 
-static pg_conn *conn(void) { return store_tls_get(&tls); }
-
-/* After a failure: a connection that broke is dropped (the next call makes a new one). */
-static void check_broken(pg_conn *c)
+/* This thread's connection; NULL (at once) while the server is marked unreachable. */
+static pg_conn *conn(void)
 {
-    if (PQstatus(c->pg) == CONNECTION_OK) return;
-    store_tls_drop(&tls);
+    if (db_closed()) {
+        tl_stalled = 1;
+        return NULL;
+    }
+    return store_tls_get(&tls);
 }
 
-static int ok_result(const PGresult *r)
+/* After a failure: a connection that broke, or that still has a command in progress (a call
+ * that got no answer), is dropped (the next call makes a new one). */
+static void check_broken(pg_conn *c)
 {
-    ExecStatusType s = PQresultStatus(r);
-    return s == PGRES_COMMAND_OK || s == PGRES_TUPLES_OK;
+    PGTransactionStatusType t = PQtransactionStatus(c->pg);
+    if (PQstatus(c->pg) == CONNECTION_OK && t != PQTRANS_ACTIVE && t != PQTRANS_UNKNOWN) return;
+    store_tls_drop(&tls);
 }
 
 /* The name of sql's prepared statement on c ("s<i>"), preparing it the first time; NULL when
@@ -102,13 +360,29 @@ static int prepared(pg_conn *c, const char *sql, char name[16])
         }
     if (c->n == PG_STMT_CACHE) return -1; /* never: the SQL literals here are fewer */
     snprintf(name, 16, "s%d", c->n);
-    PGresult *r = PQprepare(c->pg, name, sql, 0, NULL);
-    int ok = ok_result(r);
-    if (!ok) gpd_log(GPD_LOG_ERROR, "postgresql prepare: %s(%s)", PQerrorMessage(c->pg), sql);
+    PGresult *r = await_result(c->pg, PQsendPrepare(c->pg, name, sql, 0, NULL), "prepare");
+    int ok = r && ok_result(r);
+    if (!ok && !tl_stalled)
+        gpd_log(GPD_LOG_ERROR, "postgresql prepare: %s(%s)", PQerrorMessage(c->pg), sql);
     PQclear(r);
     if (!ok) return -1;
     c->sql[c->n++] = sql;
     return 0;
+}
+
+/* A failed call on c: logged and, for a write the server refused, noted for /v1/health (not
+ * when the server did not answer: /v1/health says unreachable while it does not). */
+static void call_failed(pg_conn *c, PGresult *r, const char *sql, const char *what)
+{
+    const char *em = r ? PQresultErrorMessage(r) : NULL;
+    if (!em || !*em) em = PQerrorMessage(c->pg);
+    if (tl_stalled) {
+        gpd_log(GPD_LOG_DEBUG, "postgresql: no answer (%.60s...)", sql);
+    } else {
+        gpd_log(GPD_LOG_ERROR, "postgresql: %s(%.60s...)", em, sql);
+        if (what) store_note_write_error(what, em);
+    }
+    check_broken(c);
 }
 
 /* Runs sql (a literal) with n parameters (vals; lens and fmts NULL = all text) on this
@@ -117,6 +391,7 @@ static int prepared(pg_conn *c, const char *sql, char name[16])
 static PGresult *run(const char *sql, int n, const char *const *vals, const int *lens,
                      const int *fmts, int binary)
 {
+    tl_stalled = 0;
     pg_conn *c = conn();
     if (!c) return NULL;
     char name[16];
@@ -124,30 +399,24 @@ static PGresult *run(const char *sql, int n, const char *const *vals, const int 
         check_broken(c);
         return NULL;
     }
-    PGresult *r = PQexecPrepared(c->pg, name, n, vals, lens, fmts, binary);
-    if (ok_result(r)) return r;
-    const char *em = PQresultErrorMessage(r);
-    if (!em || !*em) em = PQerrorMessage(c->pg);
-    gpd_log(GPD_LOG_ERROR, "postgresql: %s(%.60s...)", em, sql);
-    if (strncmp(sql, "SELECT", 6)) store_note_write_error("a job update", em);
+    PGresult *r = await_result(
+        c->pg, PQsendQueryPrepared(c->pg, name, n, vals, lens, fmts, binary), "a statement");
+    if (r && ok_result(r)) return r;
+    call_failed(c, r, sql, strncmp(sql, "SELECT", 6) ? "a job update" : NULL);
     PQclear(r);
-    check_broken(c);
     return NULL;
 }
 
 /* A statement without parameters or result (BEGIN, COMMIT, ROLLBACK); 0, or -1. */
 static int simple(const char *sql)
 {
+    tl_stalled = 0;
     pg_conn *c = conn();
     if (!c) return -1;
-    PGresult *r = PQexec(c->pg, sql);
-    int ok = ok_result(r);
-    if (!ok) {
-        gpd_log(GPD_LOG_ERROR, "postgresql %s: %s", sql, PQerrorMessage(c->pg));
-        if (strcmp(sql, "ROLLBACK")) store_note_write_error(sql, PQerrorMessage(c->pg));
-    }
+    PGresult *r = await_result(c->pg, PQsendQuery(c->pg, sql), sql);
+    int ok = r && ok_result(r);
+    if (!ok) call_failed(c, r, sql, strcmp(sql, "ROLLBACK") ? sql : NULL);
     PQclear(r);
-    if (!ok) check_broken(c);
     return ok ? 0 : -1;
 }
 
@@ -156,8 +425,10 @@ static int simple(const char *sql)
 static store_rc end_tx(store_rc rc)
 {
     if (rc == STORE_OK) return simple("COMMIT") ? STORE_ERROR : STORE_OK;
+    int stall = tl_stalled;
     pg_conn *c = store_tls_peek(&tls);
     if (c && PQtransactionStatus(c->pg) != PQTRANS_IDLE) simple("ROLLBACK");
+    tl_stalled |= stall;
     return rc;
 }
 
@@ -194,7 +465,9 @@ static const char *SCHEMA_SQL =
     " part INTEGER NOT NULL, data BYTEA NOT NULL, PRIMARY KEY(seq, what, part));"
     "ALTER TABLE value_parts ALTER COLUMN data SET STORAGE EXTERNAL;"
     "CREATE TABLE IF NOT EXISTS summaries(seq BIGINT PRIMARY KEY, summary TEXT NOT NULL,"
-    " arrays TEXT);";
+    " arrays TEXT);"
+    /* jobs purged (status 'purged') whose rows are still to be deleted (store_free_purged) */
+    "CREATE TABLE IF NOT EXISTS purged(seq BIGINT PRIMARY KEY);";
 
 /* host/boot/pid/random: the host and its boot tell whether a dead pid names a dead daemon
  * (store_recover); the random part keeps ids apart across pid reuse. */
@@ -218,23 +491,28 @@ static int make_owner(void)
     return 0;
 }
 
-/* ------------------------------------------------------------------ the lease thread */
+/* ------------------------------------------------------------------ the store thread */
 
 static pthread_t lease_thread;
 static int lease_running = 0;
-static int lease_pipe[2] = {-1, -1}; /* a byte on it stops the thread */
+static int lease_quit = 0; /* atomic: the thread stops (with a byte on the pipe to wake it) */
 
-/* Renews this daemon's leases on pg; 0, or -1. */
+/* Renews this daemon's leases on pg (the store thread's connection); 0, or -1. */
 static int renew(PGconn *pg)
 {
     char secs[32];
     snprintf(secs, sizeof secs, "%.3f", store_lease());
     const char *v[2] = {owner, secs};
-    PGresult *r = PQexecParams(pg, "UPDATE jobs SET lease_until = now() + $2::float8 * "
-                                   "interval '1 second' WHERE status='running' AND owner=$1",
-                               2, NULL, v, NULL, NULL, 0);
-    int ok = ok_result(r);
-    if (!ok) gpd_log(GPD_LOG_WARN, "postgresql lease renewal: %s", PQerrorMessage(pg));
+    /* SKIP LOCKED: the renewal is also the probe of the server, and must never wait for a
+     * lock (a worker storing a large result holds its job's row for seconds; that job's lease
+     * is renewed at the next turn, or ended by its success) */
+    PGresult *r = exec_params(pg, "UPDATE jobs SET lease_until = now() + $2::float8 * "
+                                  "interval '1 second' WHERE seq IN (SELECT seq FROM jobs "
+                                  "WHERE status='running' AND owner=$1 FOR UPDATE SKIP LOCKED)",
+                              2, v, 0);
+    int ok = r && ok_result(r);
+    if (!ok && !tl_stalled)
+        gpd_log(GPD_LOG_WARN, "postgresql lease renewal: %s", PQerrorMessage(pg));
     PQclear(r);
     return ok ? 0 : -1;
 }
@@ -253,51 +531,90 @@ static void drain_notifies(PGconn *pg)
 
 static PGconn *listener_open(void)
 {
-    PGconn *pg = connect_new();
+    PGconn *pg = connect_new(0);
     if (!pg) return NULL;
-    PGresult *r = PQexec(pg, "LISTEN gp_cancel");
-    int ok = ok_result(r);
+    PGresult *r = exec_params(pg, "LISTEN gp_cancel", 0, NULL, 0);
+    int ok = r && ok_result(r);
     PQclear(r);
     if (!ok) {
-        gpd_log(GPD_LOG_WARN, "postgresql LISTEN: %s", PQerrorMessage(pg));
-        PQfinish(pg);
+        if (!tl_stalled) gpd_log(GPD_LOG_WARN, "postgresql LISTEN: %s", PQerrorMessage(pg));
+        disconnect(pg);
         return NULL;
     }
     return pg;
 }
 
-/* Every lease/3 s: renew; between, wait for notifications or the stop. A lost connection is
- * made again at the next turn (jobs keep running; their leases may lapse meanwhile, in which
- * case another daemon takes them over and their writes here are refused). */
+/* Reads what callers wrote on the pipe: 1 when a probe was asked for. */
+static int read_pipe(void)
+{
+    char buf[64];
+    int asked = 0;
+    ssize_t n;
+    while ((n = read(lease_pipe[0], buf, sizeof buf)) > 0)
+        asked |= memchr(buf, 'p', (size_t)n) != NULL;
+    return asked;
+}
+
+/* One turn's database work on *pg: renew when due or asked (a probe), a new connection first
+ * when there is none (while the server is marked unreachable, at most every
+ * PG_PROBE_EVERY_S). Updates the times of the next renewal and probe. */
+static void lease_turn(PGconn **pg, int asked, double *next_renew, double *next_probe)
+{
+    double now = gpd_monotonic_s();
+    int up = __atomic_load_n(&reachable, __ATOMIC_ACQUIRE);
+    if (!up && now < *next_probe) return;
+    if (!up) *next_probe = now + PG_PROBE_EVERY_S;
+    if (!*pg && !(*pg = listener_open())) return;
+    if (up && !asked && now < *next_renew) return;
+    if (renew(*pg) == 0) {
+        mark_up();
+        *next_renew = now + store_lease() / 3.0;
+        drain_notifies(*pg);
+        return;
+    }
+    disconnect(*pg); /* made again at the next turn */
+    *pg = NULL;
+}
+
+/* The store thread: every lease/3 s it renews this daemon's leases, and between it waits for
+ * notifications (LISTEN gp_cancel), a request to probe the server or the stop. It is the
+ * server's watchman too: its renewal, and a probe a caller asks for (a /v1/health that got no
+ * answer in time), wait at most PG_PROBE_WAIT_S, and no answer marks the server unreachable;
+ * while it is, the thread tries a new connection every PG_PROBE_EVERY_S, and the first that
+ * answers marks it reachable again. A lost connection is made again at the next turn (jobs
+ * keep running; their leases may lapse meanwhile, in which case another daemon takes them
+ * over and their writes here are refused). */
 static void *lease_main(void *arg)
 {
     (void)arg;
+    tl_probing = 1;
+    tl_wait_s = PG_PROBE_WAIT_S;
     PGconn *pg = NULL;
-    double period = store_lease() / 3.0, next = 0;
-    for (;;) {
-        if (!pg || PQstatus(pg) != CONNECTION_OK) {
-            PQfinish(pg);
-            pg = listener_open();
-        }
+    double next_renew = 0, next_probe = 0;
+    int asked = 0;
+    while (!__atomic_load_n(&lease_quit, __ATOMIC_ACQUIRE)) {
+        lease_turn(&pg, asked, &next_renew, &next_probe);
+        asked = 0;
         double now = gpd_monotonic_s();
-        if (pg && now >= next) {
-            renew(pg);
-            next = now + period;
-        }
+        double until = !pg ? now + 1.0 : next_renew;
+        if (!__atomic_load_n(&reachable, __ATOMIC_ACQUIRE)) until = next_probe;
         struct pollfd p[2] = {{lease_pipe[0], POLLIN, 0}, {pg ? PQsocket(pg) : -1, POLLIN, 0}};
-        double wait = pg ? next - gpd_monotonic_s() : 1.0;
-        int ms = wait > 0 ? (int)(wait * 1000) + 1 : 0;
+        int ms = until > now ? (int)((until - now) * 1000) + 1 : 0;
         if (poll(p, 2, ms) < 0 && errno != EINTR) break;
-        if (p[0].revents) break;
+        if (p[0].revents) asked = read_pipe();
         if (pg && p[1].revents) drain_notifies(pg);
     }
-    PQfinish(pg);
+    disconnect(pg);
     return NULL;
 }
 
 static int lease_start(void)
 {
     if (pipe(lease_pipe)) return -1;
+    /* callers never wait on it (a full pipe already holds a probe request) */
+    fcntl(lease_pipe[0], F_SETFL, O_NONBLOCK);
+    fcntl(lease_pipe[1], F_SETFL, O_NONBLOCK);
+    __atomic_store_n(&lease_quit, 0, __ATOMIC_RELEASE);
     if (pthread_create(&lease_thread, NULL, lease_main, NULL)) {
         close(lease_pipe[0]);
         close(lease_pipe[1]);
@@ -311,12 +628,13 @@ static int lease_start(void)
 static void lease_stop(void)
 {
     if (!lease_running) return;
-    ssize_t w = write(lease_pipe[1], "x", 1);
-    (void)w;
+    __atomic_store_n(&lease_quit, 1, __ATOMIC_RELEASE);
+    wake_store_thread('x');
     pthread_join(lease_thread, NULL);
-    close(lease_pipe[0]);
-    close(lease_pipe[1]);
+    int r = lease_pipe[0], w = lease_pipe[1];
     lease_pipe[0] = lease_pipe[1] = -1;
+    close(r);
+    close(w);
     lease_running = 0;
 }
 
@@ -334,16 +652,19 @@ static int pg_open(const char *url)
     max_value = lim && atoll(lim) > 0 ? atoll(lim) : PG_MAX_VALUE;
     free(conninfo);
     conninfo = strdup(url);
+    conn_vals[CONN_URL_SLOT] = conninfo;
+    conn_options_init();
+    __atomic_store_n(&reachable, 1, __ATOMIC_RELEASE);
     if (!conninfo || make_owner()) return -1;
     pg_conn *c = conn();
     if (!c) return -1;
-    PGresult *r = PQexec(c->pg, SCHEMA_SQL);
-    int ok = ok_result(r);
+    PGresult *r = await_result(c->pg, PQsendQuery(c->pg, SCHEMA_SQL), "the job tables");
+    int ok = r && ok_result(r);
     if (!ok) gpd_log(GPD_LOG_ERROR, "cannot initialise the job tables: %s", PQerrorMessage(c->pg));
     PQclear(r);
     if (!ok || lease_start()) return -1;
-    gpd_log(GPD_LOG_INFO, "job store on PostgreSQL, daemon id %s, lease %.1f s", owner,
-            store_lease());
+    gpd_log(GPD_LOG_INFO, "job store on PostgreSQL, daemon id %s, lease %.1f s, at most %d "
+            "connections", owner, store_lease(), store_max_connections());
     return 0;
 }
 
@@ -351,6 +672,7 @@ static void pg_close(void)
 {
     lease_stop();
     pg_thread_done();
+    conn_vals[CONN_URL_SLOT] = NULL;
     free(conninfo);
     conninfo = NULL;
 }
@@ -370,6 +692,9 @@ static json_t *json_val(const PGresult *r, int row, int col)
 }
 
 #define JOB_COLS "id, kind, status, created_at, started_at, finished_at, progress, error, brief"
+/* a purged job's row stays, status 'purged', until store_free_purged deletes it: no read sees
+ * it (store.h, store_purge) */
+#define VISIBLE "status <> 'purged'"
 
 static json_t *job_from_row(const PGresult *r, int row)
 {
@@ -496,7 +821,8 @@ static int pg_fill_briefs(store_brief_fn make)
 static json_t *pg_get_job(const char *id, store_rc *rc)
 {
     const char *v[1] = {id};
-    PGresult *r = run("SELECT " JOB_COLS " FROM jobs WHERE id=$1", 1, v, NULL, NULL, 0);
+    PGresult *r = run("SELECT " JOB_COLS " FROM jobs WHERE id=$1 AND " VISIBLE, 1, v, NULL,
+                      NULL, 0);
     *rc = !r ? STORE_ERROR : PQntuples(r) ? STORE_OK : STORE_NOT_FOUND;
     json_t *j = *rc == STORE_OK ? job_from_row(r, 0) : NULL;
     PQclear(r);
@@ -508,9 +834,9 @@ static store_rc pg_get_text(const char *id, const char *column, char **text, cha
     *text = NULL;
     const char *sql;
     if (!strcmp(column, "spec"))
-        sql = "SELECT status, spec FROM jobs WHERE id=$1";
+        sql = "SELECT status, spec FROM jobs WHERE id=$1 AND " VISIBLE;
     else if (!strcmp(column, "kind"))
-        sql = "SELECT status, kind FROM jobs WHERE id=$1";
+        sql = "SELECT status, kind FROM jobs WHERE id=$1 AND " VISIBLE;
     else
         return STORE_ERROR;
     const char *v[1] = {id};
@@ -531,7 +857,7 @@ static json_t *pg_list(const char *status, int limit, const char *after, store_r
     char after_seq[24] = "-1", lim[16];
     if (after) {
         const char *v[1] = {after};
-        PGresult *q = run("SELECT seq FROM jobs WHERE id=$1", 1, v, NULL, NULL, 0);
+        PGresult *q = run("SELECT seq FROM jobs WHERE id=$1 AND " VISIBLE, 1, v, NULL, NULL, 0);
         if (!q) return NULL;
         int found = PQntuples(q) > 0;
         if (found) snprintf(after_seq, sizeof after_seq, "%s", PQgetvalue(q, 0, 0));
@@ -544,7 +870,8 @@ static json_t *pg_list(const char *status, int limit, const char *after, store_r
     snprintf(lim, sizeof lim, "%d", limit + 1);
     const char *v[3] = {status, after_seq, lim};
     PGresult *r = run("SELECT " JOB_COLS " FROM jobs WHERE ($1::text IS NULL OR status=$1) "
-                      "AND ($2::bigint < 0 OR seq < $2::bigint) ORDER BY seq DESC LIMIT $3::int",
+                      "AND " VISIBLE " AND ($2::bigint < 0 OR seq < $2::bigint) "
+                      "ORDER BY seq DESC LIMIT $3::int",
                       3, v, NULL, NULL, 0);
     if (!r) return NULL;
     json_t *jobs = json_array(), *next = json_null();
@@ -569,6 +896,17 @@ static store_rc pg_counts(long n[STORE_NSTATUS])
     }
     PQclear(r);
     return STORE_OK;
+}
+
+/* A liveness probe's counts: a short bound, and a stall that only asks the store thread to
+ * probe (a server slow for a moment is not taken for gone on one probe's word) */
+static store_rc pg_counts_within(long n[STORE_NSTATUS], double wait_s)
+{
+    if (db_closed()) return STORE_UNREACHABLE;
+    tl_until = gpd_monotonic_s() + wait_s;
+    store_rc rc = pg_counts(n);
+    tl_until = 0;
+    return rc != STORE_OK && tl_stalled ? STORE_UNREACHABLE : rc;
 }
 
 /* ------------------------------------------------------------------ claim */
@@ -825,9 +1163,10 @@ static store_rc pg_succeed(const char *id, const store_text *result, const char 
     snprintf(em, sizeof em, "%s", c ? PQerrorMessage(c->pg) : "no connection");
     rc = end_tx(rc);
     if (rc == STORE_ERROR) {
+        if (tl_stalled) snprintf(em, sizeof em, "the database server does not answer");
         gpd_err_set(why, 500, "%s", em[0] ? em : "the database refused the result");
         gpd_log(GPD_LOG_ERROR, "job %s: cannot store the result: %s", id, why->msg);
-        store_note_write_error("storing a result", why->msg);
+        if (!tl_stalled) store_note_write_error("storing a result", why->msg);
     }
     return rc;
 }
@@ -858,7 +1197,8 @@ static store_rc pg_cancel(const char *id, int *was_running, char status_out[16],
     gpd_now_rfc3339(now, sizeof now);
     if (simple("BEGIN")) return STORE_ERROR;
     const char *v[2] = {id, now};
-    PGresult *q = run("SELECT status, kind FROM jobs WHERE id=$1 FOR UPDATE", 1, v, NULL, NULL, 0);
+    PGresult *q = run("SELECT status, kind FROM jobs WHERE id=$1 AND " VISIBLE " FOR UPDATE",
+                      1, v, NULL, NULL, 0);
     store_rc rc = !q ? STORE_ERROR : PQntuples(q) ? STORE_OK : STORE_NOT_FOUND;
     if (rc == STORE_OK) {
         snprintf(status_out, 16, "%s", PQgetvalue(q, 0, 0));
@@ -892,7 +1232,8 @@ static store_rc pg_purge(const char *id, char status_out[16])
     status_out[0] = '\0';
     if (simple("BEGIN")) return STORE_ERROR;
     const char *v[1] = {id};
-    PGresult *q = run("SELECT status, seq FROM jobs WHERE id=$1 FOR UPDATE", 1, v, NULL, NULL, 0);
+    PGresult *q = run("SELECT status, seq FROM jobs WHERE id=$1 AND " VISIBLE " FOR UPDATE", 1,
+                      v, NULL, NULL, 0);
     store_rc rc = !q ? STORE_ERROR : PQntuples(q) ? STORE_OK : STORE_NOT_FOUND;
     char seq[24] = "";
     if (rc == STORE_OK) {
@@ -901,17 +1242,54 @@ static store_rc pg_purge(const char *id, char status_out[16])
         if (!store_is_finished(status_out)) rc = STORE_CONFLICT;
     }
     PQclear(q);
-    static const char *const del[] = {"DELETE FROM exports WHERE seq=$1::bigint",
-                                      "DELETE FROM value_parts WHERE seq=$1::bigint",
-                                      "DELETE FROM summaries WHERE seq=$1::bigint",
-                                      "DELETE FROM jobs WHERE seq=$1::bigint"};
+    /* out of view, its values queued for store_free_purged: a few small rows (the row itself
+     * keeps the result's first part until then: updating other columns leaves it in place) */
+    static const char *const mark[] = {
+        "INSERT INTO purged(seq) VALUES ($1::bigint) ON CONFLICT DO NOTHING",
+        "UPDATE jobs SET status='purged', lease_until=NULL WHERE seq=$1::bigint",
+        "DELETE FROM summaries WHERE seq=$1::bigint"};
     const char *sv[1] = {seq};
-    for (size_t i = 0; rc == STORE_OK && i < sizeof del / sizeof *del; i++) {
-        PGresult *d = run(del[i], 1, sv, NULL, NULL, 0);
+    for (size_t i = 0; rc == STORE_OK && i < sizeof mark / sizeof *mark; i++) {
+        PGresult *d = run(mark[i], 1, sv, NULL, NULL, 0);
         if (!d) rc = STORE_ERROR;
         PQclear(d);
     }
     return end_tx(rc);
+}
+
+/* The rows of a purged job, deleted one at a time (each its own transaction: a part of a value
+ * is at most STORE_PART bytes, about 0.25 s of TOAST rows a 256 MiB part), the last part
+ * first; the job's row (with its result's first part) last, then it leaves purged. */
+static const char *const FREE_SQL[] = {
+    "DELETE FROM value_parts WHERE (seq, what, part) IN (SELECT seq, what, part FROM "
+    "value_parts WHERE seq=$1::bigint ORDER BY what DESC, part DESC LIMIT 1)",
+    "DELETE FROM exports WHERE seq=$1::bigint",
+    "DELETE FROM jobs WHERE seq=$1::bigint AND status='purged'",
+    "DELETE FROM purged WHERE seq=$1::bigint",
+};
+
+static int pg_free_purged(void)
+{
+    if (simple("BEGIN")) return -1;
+    /* SKIP LOCKED: the daemons' maintenance threads free different jobs */
+    PGresult *q = run("SELECT seq FROM purged ORDER BY seq LIMIT 1 FOR UPDATE SKIP LOCKED", 0,
+                      NULL, NULL, NULL, 0);
+    int failed = !q, found = q && PQntuples(q) == 1;
+    char seq[24] = "";
+    if (found) snprintf(seq, sizeof seq, "%s", PQgetvalue(q, 0, 0));
+    PQclear(q);
+    if (!found) {
+        end_tx(STORE_ERROR); /* nothing written: a rollback */
+        return failed ? -1 : 0;
+    }
+    const char *v[1] = {seq};
+    long n = 0;
+    for (size_t i = 0; n == 0 && i < sizeof FREE_SQL / sizeof *FREE_SQL; i++) {
+        PGresult *d = run(FREE_SQL[i], 1, v, NULL, NULL, 0);
+        n = changed(d);
+        PQclear(d);
+    }
+    return end_tx(n < 0 ? STORE_ERROR : STORE_OK) == STORE_OK ? 1 : -1;
 }
 
 static int pg_purge_finished_before(const char *before, int max)
@@ -936,7 +1314,7 @@ static int pg_purge_finished_before(const char *before, int max)
 
 /* PostgreSQL's autovacuum makes the space of purged rows reusable; giving it back to the file
  * system (VACUUM FULL) takes an exclusive lock and is the operator's call */
-static int pg_reclaim(void)
+static int pg_vacuum_step(void)
 {
     return 0;
 }
@@ -944,8 +1322,8 @@ static int pg_reclaim(void)
 static int pg_count_by_kind(void (*fn)(void *user, const char *kind, const char *status, long n),
                             void *user)
 {
-    PGresult *r = run("SELECT kind, status, count(*) FROM jobs GROUP BY kind, status", 0, NULL,
-                      NULL, NULL, 0);
+    PGresult *r = run("SELECT kind, status, count(*) FROM jobs WHERE " VISIBLE
+                      " GROUP BY kind, status", 0, NULL, NULL, NULL, 0);
     if (!r) return -1;
     for (int i = 0; i < PQntuples(r); i++)
         fn(user, PQgetvalue(r, i, 0), PQgetvalue(r, i, 1), atol(PQgetvalue(r, i, 2)));
@@ -993,7 +1371,7 @@ static void pg_stream_close(store_stream *s)
 {
     pg_stream *ps = (pg_stream *)s;
     if (!ps) return;
-    PQfinish(ps->pg);
+    disconnect(ps->pg);
     store_parts_free(&ps->parts);
     free(ps->buf);
     free(ps);
@@ -1007,12 +1385,18 @@ static int slice(pg_stream *ps, size_t k, uint64_t off, size_t n, unsigned char 
     snprintf(l, sizeof l, "%zu", n);
     snprintf(p, sizeof p, "%zu", k);
     const char *v[5] = {ps->seq, o, l, ps->what, p};
-    PGresult *r = PQexecParams(ps->pg, k ? SLICE_PART : ps->sql, k ? 5 : 3, NULL, v, NULL, NULL,
-                               1);
-    int ok = ok_result(r) && PQntuples(r) == 1 && (size_t)PQgetlength(r, 0, 0) == n;
+    if (!ps->pg) return -1;
+    tl_stalled = 0;
+    PGresult *r = exec_params(ps->pg, k ? SLICE_PART : ps->sql, k ? 5 : 3, v, 1);
+    int ok = r && ok_result(r) && PQntuples(r) == 1 && (size_t)PQgetlength(r, 0, 0) == n;
     if (ok) memcpy(dst, PQgetvalue(r, 0, 0), n);
-    else gpd_log(GPD_LOG_ERROR, "postgresql stream read: %s", PQerrorMessage(ps->pg));
+    else if (!tl_stalled)
+        gpd_log(GPD_LOG_ERROR, "postgresql stream read: %s", PQerrorMessage(ps->pg));
     PQclear(r);
+    if (!ok) { /* the download ends: its connection (and its slot) goes at once */
+        disconnect(ps->pg);
+        ps->pg = NULL;
+    }
     return ok ? 0 : -1;
 }
 
@@ -1021,13 +1405,13 @@ static int slice(pg_stream *ps, size_t k, uint64_t off, size_t n, unsigned char 
 static int read_parts(pg_stream *ps, const char *size_sql)
 {
     const char *v[2] = {ps->seq, ps->what};
-    PGresult *r = PQexecParams(ps->pg, size_sql, 1, NULL, v, NULL, NULL, 0);
+    PGresult *r = exec_params(ps->pg, size_sql, 1, v, 0);
     int ok = r && ok_result(r) && PQntuples(r) == 1 && !PQgetisnull(r, 0, 0) &&
              !store_parts_add(&ps->parts, strtoull(PQgetvalue(r, 0, 0), NULL, 10));
     PQclear(r);
-    r = ok ? PQexecParams(ps->pg, "SELECT octet_length(data) FROM value_parts "
-                                  "WHERE seq=$1::bigint AND what=$2::smallint ORDER BY part",
-                          2, NULL, v, NULL, NULL, 0)
+    r = ok ? exec_params(ps->pg, "SELECT octet_length(data) FROM value_parts "
+                                 "WHERE seq=$1::bigint AND what=$2::smallint ORDER BY part",
+                         2, v, 0)
            : NULL;
     ok = r && ok_result(r);
     for (int i = 0; ok && i < PQntuples(r); i++)
@@ -1040,16 +1424,26 @@ static int read_parts(pg_stream *ps, const char *size_sql)
 static store_rc open_private(const char *sql, const char *size_sql, const char *seq, int what,
                              store_stream **out)
 {
+    if (take_slot(1)) {
+        gpd_log(GPD_LOG_DEBUG, "postgresql: a download refused, %d connections held",
+                __atomic_load_n(&open_conns, __ATOMIC_RELAXED));
+        return STORE_BUSY;
+    }
     pg_stream *ps = calloc(1, sizeof *ps);
-    if (!ps) return STORE_ERROR;
+    PGconn *pg = ps ? connect_raw() : NULL;
+    if (!pg) { /* the slot goes back (disconnect gives it back once connected) */
+        __atomic_sub_fetch(&open_conns, 1, __ATOMIC_ACQ_REL);
+        free(ps);
+        return STORE_ERROR;
+    }
+    ps->pg = pg;
     ps->sql = sql;
     snprintf(ps->seq, sizeof ps->seq, "%s", seq);
     snprintf(ps->what, sizeof ps->what, "%d", what);
-    ps->pg = connect_new();
     ps->buf = malloc(PG_READ_AHEAD);
-    PGresult *b = ps->pg && ps->buf
-                      ? PQexec(ps->pg, "BEGIN ISOLATION LEVEL REPEATABLE READ READ ONLY")
-                      : NULL;
+    PGresult *b = ps->buf ? exec_params(ps->pg, "BEGIN ISOLATION LEVEL REPEATABLE READ READ ONLY",
+                                        0, NULL, 0)
+                          : NULL;
     int ok = b && ok_result(b);
     PQclear(b);
     if (!ok || read_parts(ps, size_sql)) {
@@ -1090,10 +1484,11 @@ static store_rc pg_stream_open(const char *id, int is_pack, size_t small, store_
     /* octet_length of a TOASTed bytea reads its header, not the value */
     PGresult *r = run(is_pack ? "SELECT j.status, j.seq, octet_length(e.pack), EXISTS (SELECT 1 "
                                 "FROM value_parts p WHERE p.seq = j.seq AND p.what = 1) "
-                                "FROM jobs j LEFT JOIN exports e ON e.seq = j.seq WHERE j.id=$1"
+                                "FROM jobs j LEFT JOIN exports e ON e.seq = j.seq "
+                                "WHERE j.id=$1 AND j.status <> 'purged'"
                               : "SELECT status, seq, octet_length(result), EXISTS (SELECT 1 "
                                 "FROM value_parts p WHERE p.seq = jobs.seq AND p.what = 0) "
-                                "FROM jobs WHERE id=$1",
+                                "FROM jobs WHERE id=$1 AND " VISIBLE,
                       1, v, NULL, NULL, 0);
     if (!r) return STORE_ERROR;
     if (!PQntuples(r)) {
@@ -1146,7 +1541,8 @@ static store_rc pg_stored_summary(const char *id, char **text, size_t *len,
 {
     const char *v[1] = {id};
     PGresult *r = run("SELECT j.status, s.summary, s.arrays FROM jobs j "
-                      "LEFT JOIN summaries s ON s.seq = j.seq WHERE j.id=$1",
+                      "LEFT JOIN summaries s ON s.seq = j.seq "
+                      "WHERE j.id=$1 AND j.status <> 'purged'",
                       1, v, NULL, NULL, 0);
     if (!r) return STORE_ERROR;
     store_rc rc = PQntuples(r) ? STORE_OK : STORE_NOT_FOUND;
@@ -1179,6 +1575,7 @@ const store_backend store_pg = {
     .get_text = pg_get_text,
     .list = pg_list,
     .counts = pg_counts,
+    .counts_within = pg_counts_within,
     .claim = pg_claim,
     .progress = pg_progress,
     .succeed = pg_succeed,
@@ -1190,7 +1587,8 @@ const store_backend store_pg = {
     .cancel = pg_cancel,
     .purge = pg_purge,
     .purge_finished_before = pg_purge_finished_before,
-    .reclaim = pg_reclaim,
+    .free_purged = pg_free_purged,
+    .vacuum_step = pg_vacuum_step,
     .count_by_kind = pg_count_by_kind,
     .size = pg_size,
     .stream_open = pg_stream_open,

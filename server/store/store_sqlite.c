@@ -104,7 +104,9 @@ static const char *SCHEMA_SQL =
     /* the summary of a succeeded job's result (store_get_summary), committed with it; a
      * table of its own so that databases written before it need no migration */
     "CREATE TABLE IF NOT EXISTS summaries(seq INTEGER PRIMARY KEY, summary TEXT NOT NULL,"
-    " arrays TEXT);";
+    " arrays TEXT);"
+    /* jobs purged whose values are still to be freed (store.h, store_purge) */
+    "CREATE TABLE IF NOT EXISTS purged(seq INTEGER PRIMARY KEY);";
 
 /* The jobs' brief (kind.h), a column added after the table: a database made before it gets it
  * here, and its jobs their briefs from store_fill_briefs. 0, or -1 (logged). */
@@ -160,9 +162,11 @@ static sqlite3 *conn_open(void)
     sqlite3_wal_hook(db, wal_grown, NULL);
     char *em = NULL;
     /* journal_size_limit: a WAL that a big result grew to hundreds of MB is cut back to this
-     * once a checkpoint has reset it (store_reclaim truncates it to nothing) */
+     * once a checkpoint has reset it (store_checkpoint truncates it to nothing);
+     * secure_delete=FAST: freed pages are not each written again with zeros (store.h) */
     if (sqlite3_exec(db,
                      "PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON; "
+                     "PRAGMA secure_delete=FAST; "
                      "PRAGMA journal_size_limit=" STORE_JOURNAL_LIMIT ";",
                      NULL, NULL, &em) != SQLITE_OK) {
         gpd_log(GPD_LOG_ERROR, "sqlite pragma: %s", em ? em : "?");
@@ -618,6 +622,13 @@ static store_rc sq_counts(long n[STORE_NSTATUS])
     }
     done(st);
     return s == SQLITE_DONE ? STORE_OK : STORE_ERROR;
+}
+
+/* reads do not wait for writers in WAL mode: nothing to bound */
+static store_rc sq_counts_within(long n[STORE_NSTATUS], double wait_s)
+{
+    (void)wait_s;
+    return sq_counts(n);
 }
 
 static store_rc sq_claim(char id[33], char **kind, char **spec_json, int *attempts)
@@ -1314,10 +1325,10 @@ static store_rc sq_purge(const char *id, char status_out[16])
     sqlite3_int64 seq = st ? sqlite3_column_int64(st, 1) : 0;
     done(st);
     if (rc == STORE_OK && !store_is_finished(status_out)) rc = STORE_CONFLICT;
-    /* the result, the pack, their parts and the summary first (keyed by the job's seq), then the row */
-    static const char *const del[] = {"DELETE FROM results WHERE seq=?1",
-                                      "DELETE FROM exports WHERE seq=?1",
-                                      "DELETE FROM value_parts WHERE seq=?1",
+    /* the job out of view and its values queued for store_free_purged: small rows only (the
+     * row of a job stored before the results table holds its result: freed here, which
+     * secure_delete=FAST keeps to the freelist's pages) */
+    static const char *const del[] = {"INSERT OR IGNORE INTO purged(seq) VALUES (?1)",
                                       "DELETE FROM summaries WHERE seq=?1",
                                       "DELETE FROM jobs WHERE seq=?1"};
     for (size_t i = 0; rc == STORE_OK && i < sizeof del / sizeof *del; i++) {
@@ -1379,9 +1390,81 @@ static int sq_purge_finished_before(const char *before, int max)
     return purged;
 }
 
-/* pages freed by one step of the incremental vacuum: 4 MB of 4 KB pages, a few milliseconds
- * of the write lock */
-#define RECLAIM_STEP_SQL "PRAGMA incremental_vacuum(1024)"
+/* The background work (store_free_purged, store_vacuum_step) waits this long for the write
+ * lock: a writer holding it (a worker storing a result) goes first, and the caller tries again
+ * later, instead of queueing behind it for the 5 s of every other write. */
+#define BACKGROUND_BUSY_MS 200
+
+/* Runs sql (a write of its own, ?1 = seq when it has one) on db with the short busy timeout:
+ * the rows it changed, or -1 (logged at debug: a busy database is expected; not a failed
+ * write for /v1/health, the work is tried again). */
+static int background_write(sqlite3 *db, const char *sql, sqlite3_int64 seq)
+{
+    sqlite3_stmt *st = prep(db, sql);
+    if (!st) return -1;
+    if (sqlite3_bind_parameter_count(st) >= 1) sqlite3_bind_int64(st, 1, seq);
+    sqlite3_busy_timeout(db, BACKGROUND_BUSY_MS);
+    int s = sqlite3_step(st);
+    while (s == SQLITE_ROW) s = sqlite3_step(st);
+    sqlite3_busy_timeout(db, 5000);
+    int n = s == SQLITE_DONE ? sqlite3_changes(db) : -1;
+    if (n < 0) gpd_log(GPD_LOG_DEBUG, "sqlite background write: %s", sqlite3_errmsg(db));
+    done(st);
+    return n;
+}
+
+/* The rows of a purged job, freed one at a time (each its own transaction: a part of a value
+ * is at most STORE_PART bytes, freed in milliseconds with secure_delete=FAST), the last part
+ * first; then the job leaves purged. */
+static const char *const FREE_SQL[] = {
+    "DELETE FROM value_parts WHERE rowid = (SELECT rowid FROM value_parts WHERE seq=?1 "
+    "ORDER BY what DESC, part DESC LIMIT 1)",
+    "DELETE FROM exports WHERE seq=?1",
+    "DELETE FROM results WHERE seq=?1",
+    "DELETE FROM purged WHERE seq=?1",
+};
+
+static int sq_free_purged(void)
+{
+    sqlite3 *db = conn();
+    if (!db) return -1;
+    sqlite3_stmt *st = prep(db, "SELECT seq FROM purged ORDER BY seq LIMIT 1");
+    if (!st) return -1;
+    int s = sqlite3_step(st);
+    sqlite3_int64 seq = s == SQLITE_ROW ? sqlite3_column_int64(st, 0) : 0;
+    done(st);
+    if (s == SQLITE_DONE) return 0;
+    if (s != SQLITE_ROW) return -1;
+    for (size_t i = 0; i < sizeof FREE_SQL / sizeof *FREE_SQL; i++) {
+        int n = background_write(db, FREE_SQL[i], seq);
+        if (n != 0) return n < 0 ? -1 : 1;
+    }
+    return 1; /* the last statement found no row: another connection removed it */
+}
+
+static int sq_vacuum_step(void)
+{
+    sqlite3 *db = conn();
+    if (!db) return -1;
+    if (!auto_vacuum || query_long(db, "PRAGMA freelist_count") <= 0) return 0;
+    /* one step of STORE_VACUUM_STEP bytes of pages (2 MB: a few ms of the write lock, a
+     * page moved from the end of the file written once to the WAL) */
+    long page = query_long(db, "PRAGMA page_size");
+    long pages = page > 0 && STORE_VACUUM_STEP / page > 0 ? STORE_VACUUM_STEP / page : 1;
+    char sql[64];
+    snprintf(sql, sizeof sql, "PRAGMA incremental_vacuum(%ld)", pages);
+    sqlite3_busy_timeout(db, BACKGROUND_BUSY_MS);
+    char *em = NULL;
+    int rc = sqlite3_exec(db, sql, NULL, NULL, &em);
+    sqlite3_busy_timeout(db, 5000);
+    if (rc != SQLITE_OK) {
+        gpd_log(GPD_LOG_DEBUG, "sqlite incremental vacuum: %s (tried again later)",
+                em ? em : "?");
+        sqlite3_free(em);
+        return -1;
+    }
+    return query_long(db, "PRAGMA freelist_count") > 0;
+}
 
 /* The connection of a checkpoint that yields to jobs (store_checkpoint(1)), for
  * store_checkpoint_yield; guarded by ckpt_mu, so that it is never interrupted once done. */
@@ -1435,28 +1518,6 @@ static int sq_checkpoint(int may_yield)
 {
     sqlite3 *db = conn();
     return db ? checkpoint_on(db, may_yield) : -1;
-}
-
-static int sq_reclaim(void)
-{
-    sqlite3 *db = conn();
-    if (!db) return -1;
-    if (auto_vacuum) {
-        /* each step is its own write transaction: workers and submits get the lock between */
-        for (int guard = 0; guard < 1000000; guard++) {
-            long free_pages = query_long(db, "PRAGMA freelist_count");
-            if (free_pages <= 0) break;
-            char *em = NULL;
-            if (sqlite3_exec(db, RECLAIM_STEP_SQL,
-                             NULL, NULL, &em) != SQLITE_OK) {
-                gpd_log(GPD_LOG_WARN, "sqlite incremental vacuum: %s (tried again later)",
-                        em ? em : "?");
-                sqlite3_free(em);
-                return 1;
-            }
-        }
-    }
-    return checkpoint_on(db, 0);
 }
 
 static int sq_count_by_kind(void (*fn)(void *user, const char *kind, const char *status, long n),
@@ -1526,6 +1587,7 @@ const store_backend store_sqlite = {
     .get_text = sq_get_text,
     .list = sq_list,
     .counts = sq_counts,
+    .counts_within = sq_counts_within,
     .claim = sq_claim,
     .progress = sq_progress,
     .succeed = sq_succeed,
@@ -1535,7 +1597,8 @@ const store_backend store_sqlite = {
     .cancel = sq_cancel,
     .purge = sq_purge,
     .purge_finished_before = sq_purge_finished_before,
-    .reclaim = sq_reclaim,
+    .free_purged = sq_free_purged,
+    .vacuum_step = sq_vacuum_step,
     .checkpoint = sq_checkpoint,
     .checkpoint_yield = sq_checkpoint_yield,
     .count_by_kind = sq_count_by_kind,

@@ -33,6 +33,15 @@ const gpd_option gpd_options_table[GPD_OPT_COUNT] = {
                        .help = "PostgreSQL: seconds a running job stays claimed without its "
                                "daemon renewing it (every S/3 s); a job whose lease lapsed is "
                                "taken over by another daemon"},
+    [GPD_OPT_DB_CONNECTIONS] = {.flag = "db-connections", .arg = "N",
+                                .env = "GRAINPACK_DB_CONNECTIONS", .kind = GPD_OPT_INT,
+                                .dflt = "32", .min = 1, .max = 100000,
+                                .help = "PostgreSQL: the most database connections this daemon "
+                                        "holds at once: one for each of its threads that uses "
+                                        "the database, the rest for downloads in progress (one "
+                                        "each); a download beyond it gets 503 busy with "
+                                        "Retry-After. The daemons on one server share its "
+                                        "max_connections"},
     [GPD_OPT_WORKERS] = {.flag = "workers", .letter = 'w', .arg = "N",
                          .env = "GRAINPACK_WORKERS", .kind = GPD_OPT_INT,
                          .dflt_fn = default_cpus, .dflt_note = "the number of CPU cores",
@@ -56,15 +65,39 @@ const gpd_option gpd_options_table[GPD_OPT_COUNT] = {
     [GPD_OPT_MAX_CONNECTIONS] = {.flag = "max-connections", .letter = 'c', .arg = "N",
                                  .env = "GRAINPACK_MAX_CONNECTIONS", .kind = GPD_OPT_INT,
                                  .dflt = "1024", .min = 1, .max = 1000000,
-                                 .help = "concurrent connection limit"},
+                                 .help = "concurrent connection limit (lowered at start-up to "
+                                         "what the open-file limit leaves after a reserve "
+                                         "for the database and files)"},
+    [GPD_OPT_MAX_CONNECTIONS_PER_IP] = {.flag = "max-connections-per-ip", .arg = "N",
+                                        .env = "GRAINPACK_MAX_CONNECTIONS_PER_IP",
+                                        .kind = GPD_OPT_INT, .dflt = "256", .min = 0,
+                                        .max = 1000000,
+                                        .help = "connections one client address may hold at "
+                                                "once (0 = no limit); more are closed as they "
+                                                "come. Behind a reverse proxy every client has "
+                                                "the proxy's address: raise it, or 0"},
     [GPD_OPT_TIMEOUT] = {.flag = "timeout", .letter = 'T', .arg = "S",
                          .env = "GRAINPACK_TIMEOUT", .kind = GPD_OPT_INT, .dflt = "30",
                          .min = 1, .max = 86400,
                          .help = "idle timeout per connection, seconds"},
+    [GPD_OPT_HEADER_TIMEOUT] = {.flag = "header-timeout", .arg = "S",
+                                .env = "GRAINPACK_HEADER_TIMEOUT", .kind = GPD_OPT_INT,
+                                .dflt = "10", .min = 1, .max = 86400,
+                                .help = "seconds a request's line and headers may take from "
+                                        "the connection's start (a further request on a "
+                                        "kept-alive connection: from the previous answer, at "
+                                        "least --timeout); a slower connection is closed"},
     [GPD_OPT_MAX_BODY] = {.flag = "max-body", .letter = 'b', .arg = "BYTES",
-                          .env = "GRAINPACK_MAX_BODY", .kind = GPD_OPT_INT, .dflt = "1048576",
-                          .min = 1024, .max = 1L << 30,
-                          .help = "request body limit, 413 above"},
+                          .env = "GRAINPACK_MAX_BODY", .kind = GPD_OPT_INT,
+                          .dflt = "134217728", .min = 1024, .max = 1L << 30,
+                          .help = "body limit of POST /v1/jobs and POST /v1/shapes/analyze "
+                                  "(the default takes 10,000 outlines of 200 points), 413 "
+                                  "above; other requests take no body (64 KiB at most)"},
+    [GPD_OPT_MAX_PENDING] = {.flag = "max-pending", .arg = "N", .env = "GRAINPACK_MAX_PENDING",
+                             .kind = GPD_OPT_INT, .dflt = "16", .min = 1, .max = 100000,
+                             .help = "bodies waiting to be checked, per lane (submits; shape "
+                                     "analyses, which never hold submits up): one more gets "
+                                     "503 busy with Retry-After"},
     [GPD_OPT_MAX_RESULT_MB] = {.flag = "max-result-mb", .letter = 'R', .arg = "MB",
                                .env = "GRAINPACK_MAX_RESULT_MB", .kind = GPD_OPT_INT,
                                .dflt = "8192", .min = 1, .max = 1L << 20,

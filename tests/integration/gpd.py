@@ -114,8 +114,9 @@ class PgServer:
     """A PostgreSQL server of the tests' own: start(), url(db), create_db(name), psql(sql),
     stop() (also at exit)."""
 
-    def __init__(self, durable=False):
+    def __init__(self, durable=False, max_connections=400):
         self.durable = durable  # fsync on (benchmarks next to SQLite's synchronous=FULL)
+        self.max_connections = max_connections  # the clients the server serves at once
         self.bindir = pg_bindir()
         self.dir = tempfile.mkdtemp(prefix="gpd-pg-")
         self.data = os.path.join(self.dir, "data")
@@ -143,8 +144,8 @@ class PgServer:
             raise RuntimeError("initdb failed:\n" + r.stdout + r.stderr)
         for attempt in range(5):  # the free port may be taken between its choice and the bind
             self.port = free_port()
-            opts = ("-c listen_addresses=127.0.0.1 -p %d -k %s -c max_connections=400"
-                    % (self.port, self.dir))
+            opts = ("-c listen_addresses=127.0.0.1 -p %d -k %s -c max_connections=%d"
+                    % (self.port, self.dir, self.max_connections))
             if not self.durable:  # tests: the server's data is thrown away anyway
                 opts += " -c fsync=off -c synchronous_commit=off -c full_page_writes=off"
             r = self._cmd(["pg_ctl", "-D", self.data, "-o", opts, "-l",

@@ -88,7 +88,7 @@ def raw_http(d, head, body_chunks=()):
 
 
 def test_body_limit(env):
-    d = env.daemon(workers=1)
+    d = env.daemon(workers=1, extra=["--max-body", "1048576"])
     # announced 10 MB body (curl does this with Expect: 100-continue): refused before reading
     head = (b"POST /v1/jobs HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
             b"Content-Length: %d\r\nExpect: 100-continue\r\n\r\n" % TEN_MB)

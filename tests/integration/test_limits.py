@@ -224,9 +224,12 @@ def check_in_parts(env, d, spec, limit, want, path):
     assert got[0] == want[0], "the result read from parts differs"
     for k, what in enumerate(("csv", "vtk", "svg"), start=2):
         assert got[k] == want[k], "the %s from parts differs" % what
-    # a purge removes every part
+    # a purge removes every part (the maintenance thread frees them, a part a transaction)
     st, _, b = d.request("DELETE", "/v1/jobs/%s?purge=1" % jid)
     assert st == 204, (st, b)
+    deadline = time.time() + 30
+    while env.query_int("SELECT count(*) FROM value_parts", path) and time.time() < deadline:
+        time.sleep(0.1)
     assert env.query_int("SELECT count(*) FROM value_parts", path) == 0
     assert d.stop() == 0, d.read_log()
 

@@ -7,8 +7,8 @@ Fourier spectrum, its per-mode spread and the mean descriptors, answered at once
   and its own seed) analyse back to the job's spectrum; a PGM image rasterised here from a known
   spectrum, sent as {"image": ...}, is traced by the daemon and analyses back to it (as P5 with
   light grains and as P2 with dark ones, and at another pixel size: the same answer);
-- hard cases, each with a clear answer: 9 / 10 / 10,000 / 10,001 outlines, more than a million
-  vertices, an outline not star-shaped from any point (422 at its index, as a job submit), one
+- hard cases, each with a clear answer: 9 / 10 / 10,000 / 10,001 outlines, more than two
+  million vertices, an outline not star-shaped from any point (422 at its index, as a job submit), one
   not star-shaped from its centroid (analysed about its kernel, reported), a clockwise outline
   (reported reversed, the same spectrum as its counter-clockwise twin), duplicate points (the
   same spectrum), a triangle, three points on a line, two points, malformed JSON, other methods,
@@ -28,7 +28,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gpd  # noqa: E402
 
 PATH = "/v1/shapes/analyze"
-BIG_BODY = ["--max-body", "64000000"]  # 10,000 outlines and the 1M-vertex case are ~10-20 MB
 
 
 # ------------------------------------------------------------------ outlines made here
@@ -114,7 +113,7 @@ def fmt_errs(errs):
 # ------------------------------------------------------------------ round trip
 
 def test_round_trip_1000(env):
-    d = env.daemon(workers=1, extra=BIG_BODY)
+    d = env.daemon(workers=1)
     rng = random.Random(20261)
     D = spectrum(0.1, 0.05, 0.02)
     outl = [outline(rng, D, spread=0.2) for _ in range(1000)]
@@ -161,7 +160,7 @@ def test_specimen_round_trip(env):
     delta_2..delta_7 and scales it to its cell, none of which changes an amplitude D_n (a ratio
     to r0, whatever the phase); so the grains analyse back to the job's D2, D3, D8 -- about the
     centroid rather than the generator's centre, which moves D_n only at second order."""
-    d = env.daemon(workers=1, extra=BIG_BODY)
+    d = env.daemon(workers=1)
     spec = specimen_spec(4611)
     D = spectrum(0.12, 0.06, 0.025)
     contours = specimen_contours(d, spec)
@@ -236,7 +235,7 @@ def b64(data):
 
 
 def test_image_round_trip(env):
-    d = env.daemon(workers=1, extra=BIG_BODY)
+    d = env.daemon(workers=1)
     rng = random.Random(777)
     D = spectrum(0.1, 0.05, 0.02)
     w, h, img = raster(rng, D)
@@ -266,7 +265,7 @@ def test_image_round_trip(env):
 
 
 def test_image_errors(env):
-    d = env.daemon(workers=1, extra=BIG_BODY)
+    d = env.daemon(workers=1)
     cases = [
         ({"image": {"pgm": "not base64!"}}, 422, "invalid_spec", "/image/pgm"),
         ({"image": {"pgm": b64(b"GIF89a....")}}, 422, "invalid_spec", "/image/pgm"),
@@ -305,7 +304,7 @@ def set_of(n, seed, np_=128, digits=6):
 
 
 def test_counts(env):
-    d = env.daemon(workers=2, extra=BIG_BODY)
+    d = env.daemon(workers=2)
     st, _, j = analyze(d, {"outlines": set_of(9, 1)})
     gpd.check_error_body(st, j, "invalid_spec", "/outlines")
     assert st == 422 and "at least 10" in j["error"]["message"], j
@@ -340,9 +339,9 @@ def test_counts(env):
     st, _, j = analyze(d, {"outlines": many + many[:1]})
     gpd.check_error_body(st, j, "invalid_spec", "/outlines")
     assert st == 422 and "at most 10000" in j["error"]["message"], j
-    # over a million vertices in all: too_large, as at a submit
-    fat = [[[round(math.cos(2 * math.pi * k / 101), 3), round(math.sin(2 * math.pi * k / 101), 3)]
-            for k in range(101)]] * 10000
+    # over two million vertices in all: too_large, as at a submit
+    fat = [[[round(math.cos(2 * math.pi * k / 201), 3), round(math.sin(2 * math.pi * k / 201), 3)]
+            for k in range(201)]] * 10000
     st, _, j = analyze(d, {"outlines": fat})
     gpd.check_error_body(st, j, "too_large", "/outlines")
     assert st == 422, (st, j)
@@ -354,7 +353,7 @@ def with_outline(base, i, o):
 
 
 def test_outline_cases(env):
-    d = env.daemon(workers=2, extra=BIG_BODY)
+    d = env.daemon(workers=2)
     base = set_of(12, 11)
     st, _, ref = analyze(d, {"outlines": base})
     assert st == 200, (st, ref)
@@ -431,9 +430,11 @@ def test_bad_requests(env):
         st, h, body = d.request(method, PATH)
         assert st == 405 and h["Allow"] == "POST", (method, st)
         gpd.check_error_body(st, json.loads(body), "method_not_allowed")
-    # the daemon's body limit (--max-body) holds here too: an announced 2 MB body is refused
+    # the daemon's body limit (--max-body, 128 MiB by default) holds here too: an announced
+    # larger body is refused before it is sent
     head = (b"POST %s HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-            b"Content-Length: %d\r\nExpect: 100-continue\r\n\r\n" % (PATH.encode(), 2 << 20))
+            b"Content-Length: %d\r\nExpect: 100-continue\r\n\r\n" % (PATH.encode(),
+                                                                         (128 << 20) + 1))
     st, _, body = d.raw(head)
     assert st == 413, st
     gpd.check_error_body(st, json.loads(body), "payload_too_large")

@@ -143,14 +143,14 @@ static void test_spread_and_forms_refused(void)
     BAD(shape_text("{\"spectrum\": [1, 0, -0.1]}"), "/shape/spectrum/2", "got -0.1");
 }
 
-/* 101 outlines of 10,000 points: 1,010,000 vertices, over the limit */
+/* 201 outlines of 10,000 points: 2,010,000 vertices, over the limit */
 static void test_too_many_vertices(void)
 {
     json_t *o = json_array();
-    for (size_t i = 0; i < 101; i++)
+    for (size_t i = 0; i < 201; i++)
         json_array_append_new(o, blob(10000, 0, 0, 1, 0.1));
     expect(spec_with_shape(json_pack("{s:o}", "outlines", o)), "too_large", "/shape/outlines",
-           "1010000 vertices in all, over the limit of 1000000", __LINE__);
+           "2010000 vertices in all, over the limit of 2000000", __LINE__);
 }
 
 /* the effective spec and what the reader makes of it; steals spec */

@@ -114,8 +114,11 @@ static void test_defaults(void)
     CHECK(o.v[GPD_OPT_LOG_LEVEL].n == GPD_LOG_INFO);
     CHECK(o.v[GPD_OPT_HTTP_THREADS].n == 4);
     CHECK(o.v[GPD_OPT_MAX_CONNECTIONS].n == 1024);
+    CHECK(o.v[GPD_OPT_MAX_CONNECTIONS_PER_IP].n == 256);
     CHECK(o.v[GPD_OPT_TIMEOUT].n == 30);
-    CHECK(o.v[GPD_OPT_MAX_BODY].n == 1048576);
+    CHECK(o.v[GPD_OPT_HEADER_TIMEOUT].n == 10);
+    CHECK(o.v[GPD_OPT_MAX_BODY].n == 134217728);
+    CHECK(o.v[GPD_OPT_MAX_PENDING].n == 16);
     CHECK(o.v[GPD_OPT_MAX_RESULT_MB].n == 8192);
     CHECK(o.v[GPD_OPT_JOB_TIMEOUT].n == 3600);
     CHECK(o.v[GPD_OPT_RETAIN_DAYS].x == 0.0);

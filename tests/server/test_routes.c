@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "gp_test.h"
+#include "http/offload.h"
 #include "http/routes.h"
 
 #define ID "0123456789abcdef0123456789abcdef"
@@ -234,11 +235,14 @@ static void check_table(const gpd_route *rt, size_t n)
         const gpd_route *r = gpd_route_match(allow[k].path, NULL, 0);
         CHECK(r && !strcmp(gpd_route_allow(r), allow[k].allow));
     }
-    /* offloaded: the submit and the shape analysis */
+    /* offloaded: the submit and the shape analysis, each in its own lane (a submit never
+     * waits behind an analysis) */
     const gpd_route *jobs = gpd_route_match("/v1/jobs", NULL, 0);
     const gpd_route *shapes = gpd_route_match("/v1/shapes/analyze", NULL, 0);
     CHECK(jobs && jobs->op[GPD_ROUTE_POST].offload && !jobs->op[GPD_ROUTE_GET].offload);
     CHECK(shapes && shapes->op[GPD_ROUTE_POST].offload);
+    CHECK(jobs && jobs->op[GPD_ROUTE_POST].lane == GPD_LANE_SPEC);
+    CHECK(shapes && shapes->op[GPD_ROUTE_POST].lane == GPD_LANE_ANALYSIS);
     /* methods */
     CHECK(gpd_route_method_of("GET") == GPD_ROUTE_GET);
     CHECK(gpd_route_method_of("HEAD") == GPD_ROUTE_GET);

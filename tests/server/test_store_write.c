@@ -429,7 +429,18 @@ static void test_store_legacy_and_purge(const char *want, size_t wlen)
     CHECK(store_succeed(nid, &t, "{}", NULL, NULL, 0, NULL) == STORE_OK);
     CHECK(sql_long("SELECT count(*) FROM results", NULL) == rows + 1);
     CHECK(store_purge(nid, status) == STORE_OK);
+    /* out of view at once; its result freed by store_free_purged, a row a call */
+    store_rc rc;
+    CHECK(store_get_job(nid, &rc) == NULL && rc == STORE_NOT_FOUND);
+    CHECK(store_purge(nid, status) == STORE_NOT_FOUND);
+    CHECK(sql_long("SELECT count(*) FROM results", NULL) == rows + 1);
+    CHECK(sql_long("SELECT count(*) FROM purged", NULL) == 2); /* and the older job's */
+    int steps = 0;
+    while (store_free_purged() > 0) steps++;
+    /* the older job's entry (its row held its result); the new job's result row, its entry */
+    CHECK(steps == 3);
     CHECK(sql_long("SELECT count(*) FROM results", NULL) == rows);
+    CHECK(sql_long("SELECT count(*) FROM purged", NULL) == 0);
 }
 
 /* Bytes [off, off + n) of id's value `what` through a stream of its own (small: 0). */
@@ -491,6 +502,8 @@ static void test_store_parts(const char *want, size_t wlen)
     /* the snapshot: a stream open before the purge reads every part after it */
     CHECK(store_stream_open(id, "result", 0, &s, &text, &tlen, st) == STORE_OK && s);
     CHECK(store_purge(id, st) == STORE_OK);
+    while (store_free_purged() > 0) {
+    }
     CHECK(sql_long("SELECT count(*) FROM value_parts", NULL) == 0);
     char *again = malloc(wlen);
     CHECK(s && again && store_stream_size(s) == wlen && store_stream_read(s, 0, again, wlen) == 0 &&

@@ -34,7 +34,7 @@ static const char *const g_descriptors[] = {"elongation", "roundness", "circular
  * index) and the run's analysis are linear in the vertices (~0.1 s per million to check), the
  * stored spec is ~20 bytes a vertex, and a million vertices -- 10,000 outlines of 100 points,
  * or 1,000 traced at 1,000 -- is more than a mean spectrum and its spread need. */
-#define OUTLINE_VERTICES_MAX 1000000
+#define OUTLINE_VERTICES_MAX 2000000
 
 /* o[key] is the string value */
 static int str_is(const json_t *o, const char *key, const char *value)
