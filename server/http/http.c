@@ -212,8 +212,16 @@ static enum MHD_Result send_error_hdr(struct MHD_Connection *c, req *r, unsigned
 #define send_error_allow(c, r, status, code, pointer, allow, ...) \
     send_error_hdr(c, r, status, code, pointer, MHD_HTTP_HEADER_ALLOW, allow, __VA_ARGS__)
 
+/* A store failure: 503 while the database does not answer (it recovers by itself), else 500 */
 static enum MHD_Result send_store_error(struct MHD_Connection *c, req *r)
 {
+    if (!store_reachable()) {
+        char retry[16];
+        snprintf(retry, sizeof retry, "%d", STORE_BUSY_RETRY_S);
+        return send_error_hdr(c, r, 503, "unavailable", NULL, "Retry-After", retry,
+                              "the job database does not answer (GET /v1/health says "
+                              "\"unreachable\"); try again in %d s", STORE_BUSY_RETRY_S);
+    }
     return send_error(c, r, 500, "internal", NULL, "job store error (see the daemon log)");
 }
 

@@ -133,6 +133,8 @@ store_rc store_counts_within(double wait_s, long n[STORE_NSTATUS])
     return be->counts_within(n, wait_s);
 }
 
+int store_reachable(void) { return !be || !be->reachable || be->reachable(); }
+
 store_rc store_claim(char id[33], char **kind, char **spec_json, int *attempts)
 {
     return be->claim(id, kind, spec_json, attempts);

@@ -160,6 +160,11 @@ double store_lease(void);
  * value) gets one only while fewer are open, else STORE_BUSY. SQLite: no limit. */
 #define STORE_MAX_CONNECTIONS_DEFAULT 32
 void store_set_max_connections(int n);
+/* 0 when the database is known not to answer (PostgreSQL stalled or gone: store_rc's
+ * failures then mean "try again later", not a fault), or this thread's last call got no
+ * answer; 1 otherwise (SQLite: always). */
+int store_reachable(void);
+
 /* The seconds a client should wait before trying a download again after STORE_BUSY. */
 #define STORE_BUSY_RETRY_S 5
 /* fn(id) is called (from the store's own thread) when another daemon cancelled job id, which

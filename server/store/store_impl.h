@@ -42,6 +42,9 @@ typedef struct store_backend {
     store_rc (*counts)(long n[STORE_NSTATUS]);
     /* store_counts_within: the same, waiting at most wait_s for the database */
     store_rc (*counts_within)(long n[STORE_NSTATUS], double wait_s);
+    /* store_reachable: 0 when the database is known not to answer, or this thread's last
+     * call got no answer (NULL: always reachable) */
+    int (*reachable)(void);
     store_rc (*claim)(char id[33], char **kind, char **spec_json, int *attempts);
     store_rc (*progress)(const char *id, const char *progress_json);
     /* store_succeed after the shared part: summary (may be NULL) of slen bytes and its arrays'

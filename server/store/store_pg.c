@@ -900,6 +900,12 @@ static store_rc pg_counts(long n[STORE_NSTATUS])
 
 /* A liveness probe's counts: a short bound, and a stall that only asks the store thread to
  * probe (a server slow for a moment is not taken for gone on one probe's word) */
+/* store_reachable: the server not marked unreachable, and this thread's last call answered */
+static int pg_reachable(void)
+{
+    return __atomic_load_n(&reachable, __ATOMIC_ACQUIRE) && !tl_stalled;
+}
+
 static store_rc pg_counts_within(long n[STORE_NSTATUS], double wait_s)
 {
     if (db_closed()) return STORE_UNREACHABLE;
@@ -1576,6 +1582,7 @@ const store_backend store_pg = {
     .list = pg_list,
     .counts = pg_counts,
     .counts_within = pg_counts_within,
+    .reachable = pg_reachable,
     .claim = pg_claim,
     .progress = pg_progress,
     .succeed = pg_succeed,
