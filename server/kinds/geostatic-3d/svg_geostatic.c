@@ -182,7 +182,8 @@ int svg_geostatic_profile(gp_svg *g, const gp_svg_input *in, const gp_svg_option
     legend_item it[5] = {{lv, "marker", C_V}, {lh1, "marker", C_H1}, {lh2, "marker", C_H2},
                          {GAMMA "z: the weight above / area", "dash", C_W},
                          {"K0 " GAMMA "z, K0 = 1 " MINUS " sin " PHI PRIME, "dash", C_K0}};
-    svg_plot_legend(s, f.x0 + 10, f.y0 + f.h - 14 - 18.0 * 5, it, 5);
+    /* top right: the stresses grow with depth, so the curves keep to the left up there */
+    svg_plot_legend(s, f.x0 + f.w - svg_plot_legend_w(it, 5) - 10, f.y0 + 8, it, 5);
     svg_plot_doc_end(s);
     free(k0w);
     profile_free(&p);
