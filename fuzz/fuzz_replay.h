@@ -118,4 +118,21 @@ static void gp_fuzz_path_from(const char *src, const char *rel, char *path, size
     snprintf(path, n, "%.*s/%s", slash ? (int)(slash - src) : 1, slash ? src : ".", rel);
 }
 
+/* One target's saved inputs, as each regression ctest runs them: the regressions (fn's user
+ * points to 0: their names promise nothing), then the seeds (to 1: ok-* and bad-* promise a
+ * verdict), both folders relative to from_file's (the test's __FILE__); prints the counts. 0,
+ * or -1 when a folder could not be read or there is no seed. */
+static int gp_fuzz_replay_target(const char *from_file, const char *regressions_rel,
+                                 const char *seeds_rel, gp_fuzz_replay_fn fn)
+{
+    char dir[1024];
+    int names_promise_nothing = 0, names_promise = 1;
+    gp_fuzz_path_from(from_file, regressions_rel, dir, sizeof dir);
+    int nreg = gp_fuzz_replay_dir(dir, fn, &names_promise_nothing);
+    gp_fuzz_path_from(from_file, seeds_rel, dir, sizeof dir);
+    int nseed = gp_fuzz_replay_dir(dir, fn, &names_promise);
+    printf("replayed %d regression inputs and %d seeds\n", nreg, nseed);
+    return nreg >= 0 && nseed > 0 ? 0 : -1;
+}
+
 #endif /* GP_FUZZ_REPLAY_H */

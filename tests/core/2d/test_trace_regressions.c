@@ -28,21 +28,9 @@ static void replay_one(const char *name, const unsigned char *buf, size_t len, v
     }
 }
 
-/* every regular file of dir (relative to tests/core/2d/); returns how many */
-static int replay(const char *rel, int check_names)
-{
-    char dir[1024];
-    gp_fuzz_path_from(__FILE__, rel, dir, sizeof dir);
-    int n = gp_fuzz_replay_dir(dir, replay_one, &check_names);
-    CHECK(n >= 0);
-    return n;
-}
-
 int main(void)
 {
-    int nreg = replay("../../../fuzz/regressions/pgm", 0);
-    int nseed = replay("../../../fuzz/corpus/pgm", 1);
-    printf("replayed %d regression inputs and %d seeds\n", nreg, nseed);
-    CHECK(nseed > 0);
+    CHECK(gp_fuzz_replay_target(__FILE__, "../../../fuzz/regressions/pgm",
+                                "../../../fuzz/corpus/pgm", replay_one) == 0);
     return gp_test_summary();
 }
