@@ -812,7 +812,10 @@ static int export_open(struct MHD_Connection *c, req *r, const char *id, const g
     gp_export_source src = {v.read, v.user, v.size};
     gp_error err;
     if (gp_export_open(f, &src, &d->e, &err) == GP_OK) return 0;
-    *ret = send_error(c, r, 500, "internal", NULL, "cannot export: %s", err.message);
+    if (!store_reachable()) /* the pack's stream broke with the server */
+        *ret = send_store_error(c, r);
+    else
+        *ret = send_error(c, r, 500, "internal", NULL, "cannot export: %s", err.message);
     return -1;
 }
 
@@ -1301,7 +1304,10 @@ static void mhd_log(void *cls, const char *fmt, va_list ap)
     vsnprintf(msg, sizeof msg, fmt, ap);
     size_t n = strlen(msg);
     while (n && (msg[n - 1] == '\n' || msg[n - 1] == '\r')) msg[--n] = '\0';
-    gpd_log(GPD_LOG_WARN, "mhd: %s", msg);
+    /* a client that hung up or timed out is routine (a slow client closed at
+     * --header-timeout, a poller gone): one line each at warn would fill the log */
+    int routine = strstr(msg, "closed") || strstr(msg, "timed out") || strstr(msg, "timeout");
+    gpd_log(routine ? GPD_LOG_DEBUG : GPD_LOG_WARN, "mhd: %s", msg);
 }
 
 /* ------------------------------------------------------------------ lifecycle */

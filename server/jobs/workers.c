@@ -20,6 +20,8 @@
 
 #define PROGRESS_MIN_INTERVAL_S 0.25 /* <= 4 Hz per job */
 #define STORE_RETRY_PAUSE_S 0.5      /* before the one retry of a failed final write */
+#define STORE_OUTAGE_WAIT_S 600       /* a result's wait for a database that does not answer */
+#define STORE_OUTAGE_PAUSE_S 1.0      /* between its tries */
 
 /* Why a slot's cancel flag was raised: the first reason wins (compare-and-swap), so that a
  * job that overran its time limit fails with "timeout" even when a shutdown follows, and one
@@ -379,6 +381,28 @@ static void finish_not_ok(run_ctx *ctx, gp_status st, const gp_error *err, const
     finish_failed(ctx->id, ctx->kind->name, ctx->t0, gp_status_name(st), msg);
 }
 
+/* store_result's write while the database does not answer (a restart, a network cut): tried
+ * again every STORE_OUTAGE_PAUSE_S for STORE_OUTAGE_WAIT_S at most, so that a finished job
+ * outlasts an outage instead of failing for the database's sake; the daemon stopping meanwhile
+ * leaves it running in the database, where the restart rule requeues it. rc: the last try's. */
+static store_rc store_result_outlasting(run_ctx *ctx, store_rc rc, const store_text *text,
+                                        const char *prog, const char *brief, const void *pack,
+                                        size_t pack_len, gpd_err *why)
+{
+    if (rc != STORE_ERROR || store_reachable()) return rc;
+    gpd_log(GPD_LOG_WARN, "job %s: the database does not answer; its result waits for it (at "
+                          "most %d s)",
+            ctx->id, STORE_OUTAGE_WAIT_S);
+    double until = gpd_monotonic_s() + STORE_OUTAGE_WAIT_S;
+    while (rc == STORE_ERROR && !store_reachable() && gpd_monotonic_s() < until &&
+           !__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
+        gpd_sleep_s(STORE_OUTAGE_PAUSE_S);
+        rc = store_succeed(ctx->id, text, prog, brief, pack, pack_len, why);
+    }
+    if (rc == STORE_OK) gpd_log(GPD_LOG_WARN, "job %s: its result stored after the outage", ctx->id);
+    return rc;
+}
+
 /* The result text (in memory or in its temporary file), the "done" progress and the pack
  * committed with status succeeded; a write the database refuses is tried once more, and a
  * result it can never take fails the job. timings: the result's "timings" (may be NULL),
@@ -390,11 +414,12 @@ static void store_result(run_ctx *ctx, const store_text *text, const char *prog,
     gpd_err why;
     store_rc rc = store_succeed(ctx->id, text, prog, brief, pack, pack_len, &why);
     if (rc == STORE_ERROR) { /* maybe passing (busy, I/O): once more after a pause */
-        gpd_log(GPD_LOG_WARN, "job %s: storing the result failed (%s); retrying once", ctx->id,
+        gpd_log(GPD_LOG_WARN, "job %s: storing the result failed (%s); retrying", ctx->id,
                 why.msg);
         gpd_sleep_s(STORE_RETRY_PAUSE_S);
         rc = store_succeed(ctx->id, text, prog, brief, pack, pack_len, &why);
     }
+    rc = store_result_outlasting(ctx, rc, text, prog, brief, pack, pack_len, &why);
     char msg[600];
     if (rc == STORE_OK) {
         double run_s = gpd_monotonic_s() - ctx->t0;
@@ -405,8 +430,14 @@ static void store_result(run_ctx *ctx, const store_text *text, const char *prog,
     } else if (rc == STORE_TOOBIG) {
         snprintf(msg, sizeof msg, "the result cannot be stored: %s", why.msg);
         finish_failed(ctx->id, ctx->kind->name, ctx->t0, "too_large", msg);
+    } else if (rc == STORE_ERROR && !store_reachable() &&
+               __atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
+        gpd_log(GPD_LOG_ERROR, "job %s: its result is not stored (the database does not answer) "
+                               "and the daemon stops: it stays running in the database and is "
+                               "requeued at the next start",
+                ctx->id);
     } else if (rc == STORE_ERROR) {
-        snprintf(msg, sizeof msg, "the result could not be stored (tried twice): %s", why.msg);
+        snprintf(msg, sizeof msg, "the result could not be stored: %s", why.msg);
         finish_failed(ctx->id, ctx->kind->name, ctx->t0, "store_error", msg);
     }
     /* STORE_CONFLICT: cancelled by a DELETE meanwhile */
@@ -583,6 +614,7 @@ static void run_job(slot *s, const char *id, const char *kind, const char *spec_
 static void *worker_main(void *arg)
 {
     slot *s = arg;
+    int claim_failing = 0;
     while (!__atomic_load_n(&stopping, __ATOMIC_RELAXED)) {
         pthread_mutex_lock(&wake_mu);
         unsigned long gen = wake_gen;
@@ -625,7 +657,15 @@ static void *worker_main(void *arg)
             __atomic_sub_fetch(&busy, 1, __ATOMIC_RELAXED);
             continue;
         }
-        if (rc == STORE_ERROR) gpd_log(GPD_LOG_WARN, "worker %d: claim failed", s->index);
+        if ((rc == STORE_ERROR) != claim_failing) { /* said once when it starts and ends */
+            claim_failing = rc == STORE_ERROR;
+            if (claim_failing)
+                gpd_log(GPD_LOG_WARN, "worker %d: cannot claim a job (the database failed); "
+                                      "trying every second",
+                        s->index);
+            else
+                gpd_log(GPD_LOG_WARN, "worker %d: claims again", s->index);
+        }
         /* idle: wait for a notification or poll again after a second */
         struct timespec dl;
         clock_gettime(CLOCK_MONOTONIC, &dl);

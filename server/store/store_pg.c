@@ -207,6 +207,15 @@ static void disconnect(PGconn *pg)
     __atomic_sub_fetch(&open_conns, 1, __ATOMIC_ACQ_REL);
 }
 
+/* libpq's notices (a server's goodbye among them) go to the log, not to stderr */
+static void notice_to_log(void *arg, const char *msg)
+{
+    (void)arg;
+    size_t n = strlen(msg);
+    while (n && msg[n - 1] == '\n') n--;
+    gpd_log(GPD_LOG_DEBUG, "postgresql notice: %.*s", (int)n, msg);
+}
+
 /* A new connection to the server, made without blocking past the call's bound (NULL, logged,
  * when it fails; at once while the server is marked unreachable). Its slot is taken by the
  * caller (take_slot) and given back by disconnect. */
@@ -230,12 +239,17 @@ static PGconn *connect_raw(void)
         st = PQconnectPoll(pg);
     }
     if (st != PGRES_POLLING_OK || PQsetnonblocking(pg, 1)) {
-        gpd_log(tl_until > 0 ? GPD_LOG_DEBUG : GPD_LOG_ERROR, "postgresql connect: %s",
+        /* while the server is marked down its probe fails every PG_PROBE_EVERY_S: mark_down
+         * said it once */
+        int quiet = tl_until > 0 || !__atomic_load_n(&reachable, __ATOMIC_ACQUIRE);
+        gpd_log(quiet ? GPD_LOG_DEBUG : GPD_LOG_ERROR, "postgresql connect: %s",
                 pg ? PQerrorMessage(pg) : "out of memory");
+        if (!tl_probing) wake_store_thread('p'); /* refused: is the server gone? */
         tl_stalled = 1; /* no server to talk to: unreachable for /v1/health */
         PQfinish(pg);
         return NULL;
     }
+    PQsetNoticeProcessor(pg, notice_to_log, NULL);
     return pg;
 }
 
@@ -259,7 +273,7 @@ static int ok_result(const PGresult *r)
  * renewed whenever the server is heard). The result (of several statements: the first
  * failed one, else the last), or NULL: nothing sent, or no answer (stalled()); the connection
  * is then unusable (a command is still in progress on it). */
-static PGresult *await_result(PGconn *pg, int sent, const char *what)
+static PGresult *await_answer(PGconn *pg, int sent, const char *what)
 {
     if (!sent) return NULL;
     double wait = call_wait(), deadline = gpd_monotonic_s() + wait;
@@ -300,6 +314,19 @@ static PGresult *await_result(PGconn *pg, int sent, const char *what)
     return res;
 }
 
+/* await_answer, and a connection the server closed under the call (a restart, a crash)
+ * counts as a server that did not answer: the caller's thread says unreachable (503 and
+ * Retry-After, not 500) and the store thread probes the server. */
+static PGresult *await_result(PGconn *pg, int sent, const char *what)
+{
+    PGresult *r = await_answer(pg, sent, what);
+    if ((!r || !ok_result(r)) && PQstatus(pg) == CONNECTION_BAD) {
+        tl_stalled = 1;
+        if (!tl_probing) wake_store_thread('p');
+    }
+    return r;
+}
+
 /* The text of one statement with parameters on pg (not prepared: the store thread's and
  * downloads' own connections), as await_result. */
 static PGresult *exec_params(PGconn *pg, const char *sql, int n, const char *const *vals,
@@ -330,14 +357,34 @@ static void close_handle(void *pg) { disconnect(pg); }
 static void *open_handle(void) { return connect_new(0); }
 static store_tls tls = {open_handle, close_handle, sizeof(pg_conn), conn_destroy, 0, 0};
 
-/* This thread's connection; NULL (at once) while the server is marked unreachable. */
+/* An idle connection with something to read: nothing was asked on it, so it is the server's
+ * goodbye (a restart, pg_terminate_backend) or the end of the stream; the thread's
+ * connections do not LISTEN, so no notification comes this way. */
+static int closed_by_server(PGconn *pg)
+{
+    if (PQstatus(pg) != CONNECTION_OK) return 1;
+    if (PQtransactionStatus(pg) != PQTRANS_IDLE) return 0; /* mid-transaction: never replaced */
+    struct pollfd p = {PQsocket(pg), POLLIN, 0};
+    return p.fd < 0 || poll(&p, 1, 0) != 0;
+}
+
+/* This thread's connection; NULL (at once) while the server is marked unreachable. One the
+ * server has closed while it was idle is replaced before anything is sent on it, so that a
+ * server restarted between two calls costs a new connection, not a failed call. */
 static pg_conn *conn(void)
 {
     if (db_closed()) {
         tl_stalled = 1;
         return NULL;
     }
-    return store_tls_get(&tls);
+    pg_conn *c = store_tls_get(&tls);
+    if (c && closed_by_server(c->pg)) {
+        gpd_log(GPD_LOG_DEBUG, "postgresql: an idle connection was closed by the server; a new "
+                               "one");
+        store_tls_drop(&tls);
+        c = store_tls_get(&tls);
+    }
+    return c;
 }
 
 /* After a failure: a connection that broke, or that still has a command in progress (a call
@@ -564,7 +611,10 @@ static void lease_turn(PGconn **pg, int asked, double *next_renew, double *next_
     int up = __atomic_load_n(&reachable, __ATOMIC_ACQUIRE);
     if (!up && now < *next_probe) return;
     if (!up) *next_probe = now + PG_PROBE_EVERY_S;
-    if (!*pg && !(*pg = listener_open())) return;
+    if (!*pg && !(*pg = listener_open())) {
+        if (up) mark_down("no connection can be made");
+        return;
+    }
     if (up && !asked && now < *next_renew) return;
     if (renew(*pg) == 0) {
         mark_up();

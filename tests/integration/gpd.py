@@ -144,16 +144,32 @@ class PgServer:
             raise RuntimeError("initdb failed:\n" + r.stdout + r.stderr)
         for attempt in range(5):  # the free port may be taken between its choice and the bind
             self.port = free_port()
-            opts = ("-c listen_addresses=127.0.0.1 -p %d -k %s -c max_connections=%d"
-                    % (self.port, self.dir, self.max_connections))
-            if not self.durable:  # tests: the server's data is thrown away anyway
-                opts += " -c fsync=off -c synchronous_commit=off -c full_page_writes=off"
-            r = self._cmd(["pg_ctl", "-D", self.data, "-o", opts, "-l",
-                           os.path.join(self.dir, "server.log"), "-w", "-t", "60", "start"])
+            r = self._pg_ctl_start()
             if r.returncode == 0:
                 atexit.register(self.stop)
                 return self
         raise RuntimeError("pg_ctl start failed:\n" + r.stdout + r.stderr + self.log())
+
+    def _pg_ctl_start(self):
+        opts = ("-c listen_addresses=127.0.0.1 -p %d -k %s -c max_connections=%d"
+                % (self.port, self.dir, self.max_connections))
+        if not self.durable:  # tests: the server's data is thrown away anyway
+            opts += " -c fsync=off -c synchronous_commit=off -c full_page_writes=off"
+        return self._cmd(["pg_ctl", "-D", self.data, "-o", opts, "-l",
+                          os.path.join(self.dir, "server.log"), "-w", "-t", "60", "start"])
+
+    def halt(self):
+        """Stops the server as an administrator's restart does (pg_ctl -m fast: every
+        connection closed by the server), keeping its data and port for resume()."""
+        r = self._cmd(["pg_ctl", "-D", self.data, "-m", "fast", "-w", "stop"], timeout=60)
+        if r.returncode:
+            raise RuntimeError("pg_ctl stop failed:\n" + r.stdout + r.stderr)
+
+    def resume(self):
+        """Starts the server halt() stopped, on the same port."""
+        r = self._pg_ctl_start()
+        if r.returncode:
+            raise RuntimeError("pg_ctl start failed:\n" + r.stdout + r.stderr + self.log())
 
     def log(self):
         try:

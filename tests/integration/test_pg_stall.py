@@ -8,6 +8,10 @@ second; a request that needs the database answers (an error) instead of hanging.
 server is continued (SIGCONT): without a restart, the daemon's health is "ok" again within
 seconds, and a submit, its job, its download and the list work as before.
 
+test_restarted_server: the server stopped as a restart does (pg_ctl -m fast, every connection
+closed) while a job runs, and started again once the job's run is over: the job succeeds, its
+result stored after the outage, and no request after the restart answers 500.
+
 Always on PostgreSQL (whatever GP_TEST_DB says): the test starts its own server (gpd.PgServer).
 """
 import json
@@ -25,6 +29,7 @@ DB_ROUTE_LIMIT_S = 12.0 * gpd.TIME_SCALE  # a route that needs the database: an 
 RECOVER_S = 15.0                      # health "ok" again after SIGCONT
 TINY = dict(gpd.SMALL_2D, particles=20, contour_points=16, outputs=["grains"])
 RESULT_3D = dict(gpd.SMALL_3D, tiling=[4, 4, 4], outputs=["spheres"])  # streamed (> 256 KB)
+LONG_2D = dict(gpd.SMALL_2D, particles=40000, outputs=["grains"])  # runs about 3 s
 
 
 def server_pids():
@@ -116,5 +121,56 @@ def test_stalled_server(env):
     assert d.stop() == 0, d.read_log()
 
 
+def log_has(d, needle, timeout):
+    deadline = time.time() + timeout
+    while needle not in d.read_log():
+        if time.time() > deadline:
+            return False
+        time.sleep(0.1)
+    return True
+
+
+def test_restarted_server(env):
+    """A server restarted (pg_ctl -m fast) while a job runs: requests meanwhile answer 503 with
+    Retry-After; the job, which finishes during the outage, stores its result once the server
+    is back instead of failing store_error; and the connections the restart closed, idle in
+    the daemon's threads, are replaced before use: no request after it answers 500."""
+    d = env.daemon(workers=1, extra=["--log-level", "info"])
+    for _ in range(40):  # every HTTP thread holds a connection of its own
+        assert d.request("GET", "/v1/jobs?limit=1")[0] == 200
+    jid = d.submit(LONG_2D)
+    assert d.wait(jid, states=("running",) + gpd.FINAL, timeout=60)["status"] == "running"
+    pg = gpd.pg_server()
+    pg.halt()
+    t_halt = time.time()
+    try:
+        st, h, dt, b = timed(d, "/v1/health", timeout=10)
+        assert st == 503 and dt <= LIMIT_S and json.loads(b)["database"] == "unreachable", (st,
+                                                                                        dt, b)
+        st, h, b = d.request("POST", "/v1/jobs", body=TINY)
+        assert st == 503 and h.get("Retry-After"), (st, b)
+        gpd.check_error_body(st, json.loads(b), "unavailable")
+        # the job's run ends while the server is down: its result waits
+        waited = log_has(d, "its result waits for it", 180 * gpd.TIME_SCALE)
+        assert waited, d.read_log()[-3000:]
+        time.sleep(1.0)
+    finally:
+        pg.resume()
+    down_s = time.time() - t_halt
+    assert log_has(d, "its result stored after the outage", RECOVER_S), d.read_log()[-3000:]
+    codes = [d.request("GET", "/v1/jobs/" + jid)[0] for _ in range(40)]
+    codes += [d.request("GET", "/v1/jobs?limit=1")[0] for _ in range(40)]
+    assert set(codes) == {200}, sorted(set(codes))
+    j = d.job(jid)
+    assert j["status"] == "succeeded", j
+    st, _, result = d.request("GET", "/v1/jobs/%s/result" % jid)
+    assert st == 200 and json.loads(result)["stats"], st
+    k = d.submit(TINY)
+    assert d.wait(k, timeout=120)["status"] == "succeeded"
+    print("  server down %.1f s under a running job: 503 meanwhile; after it the job succeeded "
+          "(its result stored after the outage) and 80 requests all 200" % down_s)
+    assert d.stop() == 0, d.read_log()
+
+
 if __name__ == "__main__":
-    gpd.main([test_stalled_server])
+    gpd.main([test_stalled_server, test_restarted_server])
