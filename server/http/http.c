@@ -463,12 +463,20 @@ static enum MHD_Result h_submit(struct MHD_Connection *c, req *r, const char *no
     return send_json_hdr(c, r, 201, job, MHD_HTTP_HEADER_LOCATION, loc);
 }
 
-/* POST /v1/shapes/analyze: outlines or an image -> their spectrum, at once (shapes.h) */
+static int client_gone(void *arg);
+
+/* POST /v1/shapes/analyze: outlines or an image -> their spectrum, at once (shapes.h); an
+ * analysis whose client leaves stops there (its connection is then closed unanswered) */
 static enum MHD_Result h_shapes(struct MHD_Connection *c, req *r, const char *id)
 {
     (void)id;
     int status = 500;
-    json_t *j = gpd_shapes_analyze(r->body, r->len, &status);
+    gpd_shapes_client who = {r->offloaded ? client_gone : NULL, r};
+    json_t *j = gpd_shapes_analyze(r->body, r->len, &who, &status);
+    if (status == SHAPES_CLIENT_GONE) {
+        gpd_log(GPD_LOG_DEBUG, "http %s %s: stopped, its client has gone", r->method, r->url);
+        return MHD_NO;
+    }
     return send_json(c, r, (unsigned)status, j);
 }
 

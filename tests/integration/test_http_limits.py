@@ -134,13 +134,19 @@ def test_submit_not_behind_analyses(env):
     deadline = time.time() + 120 * S
     while log_count(d, "dropped, its client has gone") < 10 and time.time() < deadline:
         time.sleep(0.2)
+    while log_count(d, "its client has gone") < 12 and time.time() < deadline:
+        time.sleep(0.2)
     dropped = log_count(d, "dropped, its client has gone")
+    stopped = log_count(d, "stopped, its client has gone")
     run = log_count(d, "http POST /v1/shapes/analyze 200")
     print("  12 analyses of %d KB posted and given up after 1 s (%.1f s); a submit behind them: "
-          "201 in %.0f ms; /v1/health %.0f ms; analyses dropped unrun %d, run %d" % (
-              len(bodies[0]) // 1024, sent, 1e3 * submit_s, ms, dropped, run))
+          "201 in %.0f ms; /v1/health %.0f ms; analyses dropped unrun %d, stopped running %d, "
+          "run to the end %d" % (len(bodies[0]) // 1024, sent, 1e3 * submit_s, ms, dropped,
+                                 stopped, run))
     assert submit_s < 1.0 * S, submit_s
     assert dropped >= 8, d.read_log()[-3000:]
+    # the ones running when their clients left stop there: none is computed to the end
+    assert dropped + stopped == 12 and run == 0, d.read_log()[-3000:]
     assert d.wait(j["id"], timeout=60)["status"] == "succeeded"
     assert d.stop() == 0, d.read_log()
 

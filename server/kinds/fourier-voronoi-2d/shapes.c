@@ -24,10 +24,12 @@
  * 10,000 outlines at 256), 625 at 1024, 39 at 4096: about 10 s at most. */
 #define SHAPES_WORK_MAX 40000.0
 
-/* what the request is answered with: the answer or the error object, and its status */
+/* what the request is answered with: the answer or the error object, and its status; the
+ * client it goes to */
 typedef struct answer {
     json_t *j;
     int status;
+    const gpd_shapes_client *client;
 } answer;
 
 /* ------------------------------------------------------------------ errors */
@@ -72,6 +74,15 @@ static int fail(answer *a, int status, const char *code, const char *pointer, co
 }
 
 static int oom(answer *a) { return fail(a, 500, "internal", NULL, "out of memory"); }
+
+/* the client left during the analysis: no answer */
+static int gone(answer *a)
+{
+    json_decref(a->j);
+    a->j = NULL;
+    a->status = SHAPES_CLIENT_GONE;
+    return -1;
+}
 
 /* A problem of the wrapped spec (read_spec) as one of the body: the spec's pointer with
  * "/shape" dropped (/shape/outlines/3 -> /outlines/3), also where the message starts with it
@@ -288,6 +299,14 @@ static int too_few(const gp_outline_set_result *res, const char *base, answer *a
 
 /* The set analysed at np rays and np / 2 modes (a job's: gp_specimen2d.c) with descriptors;
  * the answer or the error into a. tr: the traced image the outlines come from, or NULL. */
+/* gp_outline_params.progress: a non-zero return (the client has gone) stops the analysis */
+static int client_left(void *user, const gp_progress *p)
+{
+    (void)p;
+    const gpd_shapes_client *c = user;
+    return c && c->gone && c->gone(c->arg);
+}
+
 static int run_analysis(const gp_outline_points *pts, size_t n, size_t np, const char *base,
                         const gp_trace_result *tr, answer *a)
 {
@@ -303,11 +322,14 @@ static int run_analysis(const gp_outline_points *pts, size_t n, size_t np, const
     op.nmodes = np / 2;
     op.descriptors = 1;
     op.min_outlines = GP_SHAPE_OUTLINES_MIN;
+    op.progress = client_left;
+    op.progress_user = (void *)a->client;
     gp_outline_set_result res;
     gp_error e;
     gp_status st = gp_outline_set_analyze(pts, n, &op, NULL, &res, &e);
     int rc;
-    if (st == GP_OK) rc = answer_json(&res, np, tr, a);
+    if (st == GP_ERR_CANCELLED) rc = gone(a);
+    else if (st == GP_OK) rc = answer_json(&res, np, tr, a);
     else if (st == GP_ERR_INFEASIBLE) rc = too_few(&res, base, a);
     else if (st == GP_ERR_NOMEM) rc = oom(a);
     else rc = fail(a, 500, "internal", NULL, "the analysis failed: %s", e.message);
@@ -566,9 +588,10 @@ static json_t *parse_body(const char *body, size_t len, answer *a)
     return NULL;
 }
 
-json_t *gpd_shapes_analyze(const char *body, size_t len, int *status)
+json_t *gpd_shapes_analyze(const char *body, size_t len, const gpd_shapes_client *client,
+                           int *status)
 {
-    answer a = {NULL, 500};
+    answer a = {NULL, 500, client};
     json_t *doc = parse_body(body, len, &a);
     const json_t *outl = NULL, *img = NULL, *cp = NULL;
     if (doc && body_members(doc, &outl, &img, &cp, &a) == 0) {
@@ -580,6 +603,6 @@ json_t *gpd_shapes_analyze(const char *body, size_t len, int *status)
         gp_spec2d_free(&s);
     }
     json_decref(doc);
-    *status = a.j ? a.status : 500;
+    *status = a.j || a.status == SHAPES_CLIENT_GONE ? a.status : 500;
     return a.j;
 }

@@ -57,9 +57,20 @@
 /* an image's width and height at most (pixels): 16.7 Mpixel, ~190 MB of scratch at worst */
 #define SHAPES_IMAGE_SIDE_MAX 4096
 
+/* A request whose client may leave: gone(arg) says it has (may be NULL: never). */
+typedef struct gpd_shapes_client {
+    int (*gone)(void *arg);
+    void *arg;
+} gpd_shapes_client;
+
+/* *status of an analysis stopped because its client left: nobody reads the answer (NULL) */
+#define SHAPES_CLIENT_GONE 0
+
 /* The answer to a POST /v1/shapes/analyze of body (len bytes, need not be NUL-terminated):
  * the answer or the error object, with its HTTP status in *status; NULL when out of memory
- * (*status 500). The caller owns the result. */
-json_t *gpd_shapes_analyze(const char *body, size_t len, int *status);
+ * (*status 500). The analysis asks client->gone every GP_OUTLINE_REPORT_EVERY outlines and
+ * stops when it says so (NULL, *status SHAPES_CLIENT_GONE). The caller owns the result. */
+json_t *gpd_shapes_analyze(const char *body, size_t len, const gpd_shapes_client *client,
+                           int *status);
 
 #endif /* GPD_SHAPES_H */
