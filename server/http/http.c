@@ -757,6 +757,7 @@ static enum MHD_Result h_svg(struct MHD_Connection *c, req *r, const char *id,
     if (jr == SVG_JOB_NOT_FOUND) return not_found(c, r, id);
     if (jr == SVG_JOB_NOT_READY) return not_ready(c, r, id, now);
     if (jr == SVG_JOB_STORE_ERROR) return send_store_error(c, r);
+    if (jr == SVG_JOB_BUSY) return send_busy(c, r);
     if (jr != SVG_JOB_OK) {
         int status = err.status < 400 || err.status > 599 ? 500 : err.status;
         return send_error(c, r, (unsigned)status,

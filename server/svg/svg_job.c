@@ -16,6 +16,7 @@
  * when small, else a blob stream; opened once, when first needed. */
 typedef struct job_value {
     int tried, failed;
+    store_rc rc; /* the store's answer to the opening */
     store_stream *stream;
     char *mem;
     size_t len;
@@ -36,9 +37,21 @@ static void value_open(svg_job *j, const char *what, int need, job_value *v)
     if (v->tried) return;
     v->tried = 1;
     char st[16];
-    v->failed = store_stream_open(j->id, what, SVG_JOB_SMALL, &v->stream, &v->mem, &v->len, st) !=
-                    STORE_OK ||
-                (need && !v->stream && !v->mem);
+    v->rc = store_stream_open(j->id, what, SVG_JOB_SMALL, &v->stream, &v->mem, &v->len, st);
+    v->failed = v->rc != STORE_OK || (need && !v->stream && !v->mem);
+}
+
+/* A view that could not open: for want of a database connection (busy) or of the database
+ * (store error) when opening one of the job's values is why, else the view's own error */
+static svg_job_rc view_failed(const svg_job *j)
+{
+    const job_value *v[2] = {&j->pack, &j->result};
+    for (int i = 0; i < 2; i++)
+        if (v[i]->rc == STORE_BUSY) return SVG_JOB_BUSY;
+    for (int i = 0; i < 2; i++)
+        if (v[i]->tried && v[i]->rc != STORE_OK && v[i]->rc != STORE_NOT_FOUND)
+            return SVG_JOB_STORE_ERROR;
+    return SVG_JOB_VIEW_ERROR;
 }
 
 /* the value's bytes, for either reader (json_scan.h, gp_export.h) */
@@ -138,8 +151,9 @@ svg_job_rc svg_job_open(const char *id, const char *kind, const char *view,
     gp_svg_input in = {kind, j->summary, job_items, j};
     j->svg = gp_svg_open(&in, view, opt, err);
     if (!j->svg) {
+        svg_job_rc rc = view_failed(j);
         svg_job_close(j);
-        return SVG_JOB_VIEW_ERROR;
+        return rc;
     }
     *out = j;
     return SVG_JOB_OK;

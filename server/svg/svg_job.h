@@ -25,6 +25,7 @@ typedef enum {
     SVG_JOB_NOT_FOUND,   /* unknown job */
     SVG_JOB_NOT_READY,   /* the job has not succeeded (its status in status) */
     SVG_JOB_STORE_ERROR, /* the database failed */
+    SVG_JOB_BUSY,        /* no database connection for the job's values (store.h STORE_BUSY) */
     SVG_JOB_VIEW_ERROR   /* the view cannot be drawn: err (400, 409, 500 and the message) */
 } svg_job_rc;
 

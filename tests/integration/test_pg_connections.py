@@ -111,6 +111,10 @@ def test_slow_readers_leave_second_daemon(env):
         assert st == 503, (st, e)
         gpd.check_error_body(st, e, "busy")
         assert int(h["Retry-After"]) >= 1, dict(h)
+        # a picture whose items are read from the stored result (streamed): busy too, not 500
+        st, h, e = a.json("GET", "/v1/jobs/%s/svg?view=cells" % jid)
+        assert st == 503 and int(h["Retry-After"]) >= 1, (st, e)
+        gpd.check_error_body(st, e, "busy")
         assert a.json("GET", "/v1/health")[0] == 200
     finally:
         for s in readers:
