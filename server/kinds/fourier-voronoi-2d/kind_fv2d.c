@@ -681,8 +681,6 @@ static const char example[] =
     " \"orientation\": {\"mean_deg\": 0, \"anisotropy\": 1.0},"
     " \"shape\": {\"D2\": 0.1, \"D3\": 0.05, \"D8\": 0.02, \"alpha\": -2, \"beta\": -2},"
     " \"solid_fraction\": 0.65,"
-    " \"imc\": {\"error\": \"E3\", \"threshold\": 0.002, \"max_steps\": 1000000,"
-    " \"init\": \"uniform\"},"
     " \"contour_points\": 128, \"outputs\": [\"grains\", \"odec\", \"descriptors\", \"cells\"]}";
 
 /* the phases of its "timings" (gpd_result_2d; "shape" only in some) */
