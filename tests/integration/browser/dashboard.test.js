@@ -54,6 +54,8 @@ const KINDS = {
     quick: { '#q-particles': 300, '#q-seed': 42 },
     // checked against GET /v1/jobs/{id}/spec: the form's values reached the daemon
     expectSpec: { particles: 300, seed: 42 },
+    // the example a new user runs first meets its laws: no warning
+    noWarnings: true,
   },
   'spheres-3d': {
     short: '3d', main: 'porosity', views: ['section', 'psd'],
@@ -384,6 +386,10 @@ async function runKind(kind) {
   await openJob(id);
   step = kind + ' summary';
   const result = await apiJson('/v1/jobs/' + id + '/result');
+  if (conf.noWarnings) {
+    check(Array.isArray(result.warnings) && result.warnings.length === 0,
+      'the example spec of ' + kind + ' gave warnings: ' + JSON.stringify(result.warnings));
+  }
   await checkSummary(id, conf, result.stats);
   step = kind + ' views';
   const views = await checkViews(id, kind, conf);
