@@ -1315,7 +1315,8 @@ static void mhd_log(void *cls, const char *fmt, va_list ap)
     while (n && (msg[n - 1] == '\n' || msg[n - 1] == '\r')) msg[--n] = '\0';
     /* a client that hung up or timed out is routine (a slow client closed at
      * --header-timeout, a poller gone): one line each at warn would fill the log */
-    int routine = strstr(msg, "closed") || strstr(msg, "timed out") || strstr(msg, "timeout");
+    int routine = strstr(msg, "closed") || strstr(msg, "disconnected") || strstr(msg, "timed out") ||
+                  strstr(msg, "timeout");
     gpd_log(routine ? GPD_LOG_DEBUG : GPD_LOG_WARN, "mhd: %s", msg);
 }
 
