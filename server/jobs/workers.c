@@ -414,11 +414,12 @@ static void store_result(run_ctx *ctx, const store_text *text, const char *prog,
     gpd_err why;
     store_rc rc = store_succeed(ctx->id, text, prog, brief, pack, pack_len, &why);
     if (rc == STORE_ERROR) { /* maybe passing (busy, I/O): once more after a pause */
-        gpd_log(GPD_LOG_WARN, "job %s: storing the result failed (%s); retrying", ctx->id,
+        gpd_log(GPD_LOG_WARN, "job %s: storing the result failed (%s); retrying once", ctx->id,
                 why.msg);
         gpd_sleep_s(STORE_RETRY_PAUSE_S);
         rc = store_succeed(ctx->id, text, prog, brief, pack, pack_len, &why);
     }
+    int away = rc == STORE_ERROR && !store_reachable();
     rc = store_result_outlasting(ctx, rc, text, prog, brief, pack, pack_len, &why);
     char msg[600];
     if (rc == STORE_OK) {
@@ -437,7 +438,8 @@ static void store_result(run_ctx *ctx, const store_text *text, const char *prog,
                                "requeued at the next start",
                 ctx->id);
     } else if (rc == STORE_ERROR) {
-        snprintf(msg, sizeof msg, "the result could not be stored: %s", why.msg);
+        snprintf(msg, sizeof msg, "the result could not be stored (%s): %s",
+                 away ? "the database did not answer within the wait" : "tried twice", why.msg);
         finish_failed(ctx->id, ctx->kind->name, ctx->t0, "store_error", msg);
     }
     /* STORE_CONFLICT: cancelled by a DELETE meanwhile */
