@@ -21,9 +21,13 @@
  * disc count and the four mean descriptors, and 32-bit hashes of the grains' contours, discs
  * and descriptors, so that two builds can be compared bit for bit in one line.
  *
- * Usage: bench_specimen2d [quick|fill|phases [N [THREADS]]]   ("quick" skips the 10,000-grain
- * row, "fill" prints only the second table, "phases" only the third: N grains (10,000) on
- * THREADS threads (2), the 10,000-grain row's spec)
+ * A fourth form runs one law of grains at N grains with the default imc.max_steps for N: the
+ * steps of its two IMC runs, and the grain areas' fit before and after the cells' resize.
+ *
+ * Usage: bench_specimen2d [quick|fill|phases [N [THREADS]]|grainlaw N [THREADS [MAX_STEPS]]]
+ * ("quick" skips the 10,000-grain row, "fill" prints only the second table, "phases" only the
+ * third: N grains (10,000) on THREADS threads (2), the 10,000-grain row's spec; "grainlaw" the
+ * fourth, MAX_STEPS instead of the default)
  */
 #include <math.h>
 #include <stdint.h>
@@ -331,8 +335,48 @@ static void phases_table(size_t n, int threads)
     gp_specimen2d_destroy(sp);
 }
 
+/* ------------------------------------------------------------------ a law of grains */
+
+/* One law of grains (COV 0.5, outputs grains) at N grains with the default imc.max_steps for N
+ * (or max_steps): the steps of each IMC run against that budget, whether the cells were
+ * resized for their grains, and the grain areas' miss before (pass A's grains matched to the
+ * law: KS by number or by mass, the larger) and after (the specimen's KS by number). */
+static void grain_law_row(size_t n, int threads, long max_steps)
+{
+    row r = {"grain law", n, 0.5, 1.0, 0.1, 0.05, 0.02, threads, GP_OUT2_GRAINS, GP_IMC_AD, 1};
+    gp_spec2d s;
+    setup(&r, &s);
+    s.imc_max_steps = max_steps > 0 ? max_steps : gp_spec2d_default_max_steps(n);
+    s.imc_max_steps_default = max_steps <= 0;
+    gp_specimen2d *sp = NULL;
+    gp_error e;
+    if (gp_specimen2d_build(&s, NULL, NULL, NULL, &sp, &e) != GP_OK) {
+        printf("failed: %s\n", e.message);
+        return;
+    }
+    double crit = sp->fit.grain_area.ks_critical;
+    long second = sp->imc_steps_resize;
+    printf("A law of grains (COV 0.5, seed 2012, outputs grains): IMC steps of each run against "
+           "max_steps, the power kappa the cells were drawn together by (1: not resized), grain-area "
+           "miss before the resize and KS after, over the 5 %% critical value\n\n");
+    printf("| grains | th | max_steps | run 1 | run 2 | stop | AD error | kappa | blocked | before/crit | "
+           "after/crit | IMC s | fill s | total s |\n");
+    printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    printf("| %zu | %d | %ld%s | %ld | %ld | %s | %.4f | %.3f | %d | %.2f | %.2f | %.1f | %.1f | %.1f |\n",
+           sp->ngrains, threads, s.imc_max_steps, s.imc_max_steps_default ? " (default)" : "",
+           sp->imc_steps - second, second, sp->imc_stop_reason, sp->imc_error, sp->cell_law_power,
+           sp->cells_resize_blocked, sp->grain_law_miss / crit, sp->fit.grain_area.ks / crit,
+           sp->t_imc, sp->t_fill, sp->t_total);
+    gp_specimen2d_destroy(sp);
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 2 && strcmp(argv[1], "grainlaw") == 0) {
+        grain_law_row((size_t)strtoul(argv[2], NULL, 10), argc > 3 ? atoi(argv[3]) : 2,
+                      argc > 4 ? atol(argv[4]) : 0);
+        return 0;
+    }
     if (argc > 1 && strcmp(argv[1], "phases") == 0) {
         phases_table(argc > 2 ? (size_t)strtoul(argv[2], NULL, 10) : 10000,
                      argc > 3 ? atoi(argv[3]) : 2);

@@ -93,15 +93,19 @@ int gp_spec_validate(const json_t *spec, gp_spec_problem *p);
  * 2D defaults that depend on other fields: with size.law "sieve" the copy has no particles
  * (the count is derived: gp_spec2d_cell_count) and no size.cov, and size.of is "grains";
  * without it there is no size.sieve_units; imc.threshold, when absent, is
- * gp_imc_default_threshold() of imc.error. The copy is itself a valid spec whose effective
- * spec is the same copy. Its objects are new; its arrays (and scalars) are shared with spec,
- * read-only: change neither in place while the other is in use. */
+ * gp_imc_default_threshold() of imc.error; imc.max_steps, when absent, stays absent (its
+ * default depends on the cell count: gp_spec2d_read resolves it). The copy is itself a valid
+ * spec whose effective spec is the same copy. Its objects are new; its arrays (and scalars)
+ * are shared with spec, read-only: change neither in place while the other is in use. */
 json_t *gp_spec_with_defaults(const json_t *spec, gp_spec_problem *p);
 
 /* Parses an effective spec of the 2D kind -- one that gp_spec_with_defaults() returned (or
  * its JSON text read back) -- into *out, WITHOUT validating it again: the input must come from
  * gp_spec_with_defaults. out->threads is 0 (the caller picks); out->particles
- * is 0 with a sieve law, whose sieve_d are in metres, converted from size.sieve_units. The
+ * is 0 with a sieve law, whose sieve_d are in metres, converted from size.sieve_units.
+ * imc.max_steps absent: out->imc_max_steps_default is 1 and out->imc_max_steps the default
+ * for the cell count (gp_spec2d_default_max_steps, clipped to what the work budget leaves
+ * after the grains, never below GP_IMC_DEFAULT_STEPS_MIN); the work bounds count it. The
  * shape: shape_form and its fields (D2 .. beta; spectrum; desc_given and desc_target; outlines
  * as given, vertices in their order), spread and spread_given (absent: 0 and 0). A cheap
  * guard only: another kind is refused with invalid_spec at /kind, a field missing or of the
@@ -125,11 +129,11 @@ void gp_spec3d_free(gp_spec3d *s);
 /* What a job of a valid effective spec will cost, estimated from its numbers whatever their
  * spelling (1e6 is the integer 1000000), in one place per kind:
  *   2D: cells = particles, or the count a sieve law derives; the IMC at its cap
- *     (imc.max_steps moves, each costing a little more on more cells), the filling, ODEC and
- *     descriptors per grain in proportion to contour_points, the shape's own work (target
- *     descriptors: the fit and the calibration's fills; outlines: one description each); the
- *     result as server/http/http.c has always estimated it (bytes per grain by outputs and
- *     contour_points);
+ *     (imc.max_steps moves or their default, each costing a little more on more cells), the
+ *     filling, ODEC and descriptors per grain in proportion to contour_points, the shape's own
+ *     work (target descriptors: the fit and the calibration's fills; outlines: one description
+ *     each); the result as server/http/http.c has always estimated it (bytes per grain by
+ *     outputs and contour_points);
  *   3D: the sample's spheres (gp_sieve_expected_count, the count the DEM draws), its
  *     time step (gp_dem3d.h: 0.3 sqrt(m / 2 E R) at the density-scaling radius of
  *     gp_specimen3d.c) and the steps its protocol needs (durations are multiples of

@@ -63,12 +63,18 @@ void gp_spec2d_defaults(gp_spec2d *s)
     s->solid_fraction = 0.65;
     s->imc_error = GP_IMC_AD;
     s->imc_threshold = gp_imc_default_threshold(GP_IMC_ERROR_AD);
-    s->imc_max_steps = 1000000;
+    s->imc_max_steps = gp_spec2d_default_max_steps(s->particles);
     s->imc_init = GP_INIT_UNIFORM;
     s->imc_classes = 0;
     s->contour_points = 128;
     s->outputs = GP_OUT2_GRAINS;
     s->threads = 1;
+}
+
+long gp_spec2d_default_max_steps(size_t cells)
+{
+    double k = (double)GP_IMC_DEFAULT_STEPS_PER_CELL * (double)cells;
+    return k > (double)GP_IMC_DEFAULT_STEPS_MIN ? (long)k : GP_IMC_DEFAULT_STEPS_MIN;
 }
 
 static double rng_u01(void *state) { return gp_rng_uniform((gp_rng *)state); }
@@ -898,6 +904,7 @@ static gp_status run_imc(build_ctx *b, const gp_vec2 *seeds, gp_error *err)
         out->container_area = gp_voronoi_container_area(b->vor);
         out->imc_error = rep.error;
         out->imc_steps += rep.steps;
+        out->imc_runs++;
         out->imc_stop_reason = gp_imc_stop_name(rep.stop_reason);
         out->imc_error_floor = rep.floor;
         out->imc_threshold = spec->imc_threshold;
@@ -1425,6 +1432,7 @@ static gp_status resize_cells(build_ctx *b, fill_job *job, gp_error *err)
         for (size_t i = 0; i < b->n; i++)
             z.work[i] = b->out->grains[i].area;
         now = matched_miss(z.work, z.q, b->n, b->grain_law);
+        b->out->grain_law_miss = now;
         if (now > GRAIN_LAW_KS_GOAL * gp_fit_ks_critical(b->n))
             st = best_power(b, &z, &kappa, &pred, err);
     }
@@ -1452,7 +1460,9 @@ static gp_status resize_cells(build_ctx *b, fill_job *job, gp_error *err)
     grains_reset(b->out);
     gp_voronoi_destroy(b->vor);
     b->vor = NULL;
+    long first = b->out->imc_steps;
     st = run_imc(b, seeds, err);
+    b->out->imc_steps_resize = b->out->imc_steps - first;
     free(seeds);
     if (st == GP_OK)
         st = job_setup(b, job, err);
@@ -1621,8 +1631,8 @@ static void collect_warnings(build_ctx *b)
     warn_fit_area(out, "grain", &out->fit.grain_area);
     if (out->cells_resize_blocked)
         warn(out, "grain areas: the cells were not resized for their grains: the first IMC run "
-                  "used all of imc.max_steps (%ld); a larger max_steps lets them be",
-             spec->imc_max_steps);
+                  "used all of imc.max_steps (%ld%s); a larger max_steps lets them be",
+             spec->imc_max_steps, spec->imc_max_steps_default ? ", the default" : "");
     warn_fit_orient(out, "cell", &out->fit.cell_orientation);
     warn_fit_orient(out, "grain", &out->fit.grain_orientation);
     if (out->fit.passing.n > 0 && out->fit.passing.max_error_pp > 3.0)

@@ -135,7 +135,10 @@ typedef struct gp_spec2d {
     double solid_fraction;
     gp_imc_error_kind imc_error;
     double imc_threshold;
-    long imc_max_steps;
+    long imc_max_steps;         /* the budget of both IMC runs of a grain law together */
+    int imc_max_steps_default;  /* imc_max_steps is the API's default for the cell count (the
+                                 * spec left it out; set by the service's parser, which
+                                 * resolves it), not the user's: the warnings say so */
     gp_init_kind imc_init;
     int imc_classes;            /* histogram classes; 0 = automatic (see gp_imc.h) */
     size_t contour_points;
@@ -145,8 +148,19 @@ typedef struct gp_spec2d {
 
 /* Fills a spec with the API defaults (unit square, 100 particles, lognormal cov 0.5 on cells,
  * isotropic, D2 0.1, D3 0.05, D8 0.02, alpha = beta = -2, F_S 0.65, AD with its default
- * threshold (gp_imc_default_threshold), 1e6 steps, uniform, 128 points, outputs grains). */
+ * threshold (gp_imc_default_threshold), 1e6 steps (the default for its 100 cells), uniform,
+ * 128 points, outputs grains). */
 void gp_spec2d_defaults(gp_spec2d *spec);
+
+/* The default imc.max_steps for N cells: max(GP_IMC_DEFAULT_STEPS_MIN,
+ * GP_IMC_DEFAULT_STEPS_PER_CELL x N), so that both IMC runs of a grain law (the cells' law,
+ * then the cells resized for their grains) reach their threshold before it at any N up to
+ * 10^6 (docs/method-2d.md, "Stopping"). A function of N alone: the same spec gives the same
+ * budget on any machine and thread count. The service clips it to its work budget
+ * (schema/kinds/fourier-voronoi-2d/gp_spec2d.c), never below the minimum. */
+#define GP_IMC_DEFAULT_STEPS_MIN 1000000L
+#define GP_IMC_DEFAULT_STEPS_PER_CELL 12
+long gp_spec2d_default_max_steps(size_t cells);
 
 /* The container's area (polygon minus holes, or the circle's polygon as the tessellation uses
  * it) and the number of cells the spec asks for: `particles`, or for a sieve law
@@ -257,6 +271,12 @@ typedef struct gp_specimen2d {
                                  * both runs */
     int cells_resize_blocked;   /* a grain law would have resized its cells, but the first IMC
                                  * run used all of imc_max_steps (warned) */
+    int imc_runs;               /* IMC runs made: 1, or 2 when the cells of a grain law were
+                                 * resized for their grains */
+    long imc_steps_resize;      /* of imc_steps, those of the second run (0 without one) */
+    double grain_law_miss;      /* a grain law: how far pass A's grains, matched to the law's
+                                 * quantiles, missed it (the KS distance by number or by mass,
+                                 * the larger), which decided the resize; 0 otherwise */
     const char *imc_error_kind; /* "AD", "E1", "E2", "E3" */
     gp_fit2d fit;               /* measured on the cells and grains themselves */
     char **warnings;            /* nwarnings one-line messages: a target not reached, and how

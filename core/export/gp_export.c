@@ -201,8 +201,9 @@ static void put_f64(unsigned char **w, double v)
     *w += 8;
 }
 
-gp_status gp_export_pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, double density,
-                            void **pack, size_t *len, gp_error *err)
+/* A 2D pack: with its grains' ODEC discs (an export pack), or without (view: a view pack) */
+static gp_status pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, double density, int view,
+                         void **pack, size_t *len, gp_error *err)
 {
     *pack = NULL;
     *len = 0;
@@ -212,11 +213,11 @@ gp_status gp_export_pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, doubl
     uint64_t npts = 0, ndisc = 0;
     for (size_t g = 0; g < s->ngrains; g++) {
         const gp_grain2d *gr = &s->grains[g];
-        if (!gr->discs || gr->ndiscs == 0)
+        if (!view && (!gr->discs || gr->ndiscs == 0))
             return gp_error_set(err, GP_ERR_INVALID,
                                 "grain %zu has no ODEC discs (outputs must include \"odec\")", g);
         npts += gr->ncontour;
-        ndisc += gr->ndiscs;
+        ndisc += view ? 0 : gr->ndiscs;
     }
     double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
     if (spec->container == GP_CONTAINER_CIRCLE) {
@@ -241,7 +242,7 @@ gp_status gp_export_pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, doubl
     pack_header h;
     header_init(&h, 2, density);
     int with_desc = (spec->outputs & GP_OUT2_DESCRIPTORS) != 0;
-    h.flags = with_desc ? GP_EXPORT_HAS_DESCRIPTORS : 0;
+    h.flags = (with_desc ? GP_EXPORT_HAS_DESCRIPTORS : 0) | (view ? GP_EXPORT_VIEW_ONLY : 0);
     h.nitems = s->ngrains;
     h.npoints = npts;
     h.ndiscs = ndisc;
@@ -271,8 +272,9 @@ gp_status gp_export_pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, doubl
         const gp_grain2d *gr = &s->grains[g];
         put_u64(&w, pf);
         put_u64(&w, gr->ncontour);
+        size_t nd = view ? 0 : gr->ndiscs;
         put_u64(&w, df);
-        put_u64(&w, gr->ndiscs);
+        put_u64(&w, nd);
         put_f64(&w, gr->area);
         put_f64(&w, gr->orientation_deg);
         const gp_descriptors *d = &gr->descriptors;
@@ -284,14 +286,26 @@ gp_status gp_export_pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, doubl
             put_f64(&wp, gr->contour[k].x);
             put_f64(&wp, gr->contour[k].y);
         }
-        memcpy(wd, gr->discs, 24 * gr->ndiscs);
-        wd += 24 * gr->ndiscs;
+        if (nd) memcpy(wd, gr->discs, 24 * nd);
+        wd += 24 * nd;
         pf += gr->ncontour;
-        df += gr->ndiscs;
+        df += nd;
     }
     *pack = p;
     *len = (size_t)bytes;
     return GP_OK;
+}
+
+gp_status gp_export_pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, double density,
+                            void **pack, size_t *len, gp_error *err)
+{
+    return pack_2d(s, spec, density, 0, pack, len, err);
+}
+
+gp_status gp_export_pack_2d_view(const gp_specimen2d *s, const gp_spec2d *spec, void **pack,
+                                 size_t *len, gp_error *err)
+{
+    return pack_2d(s, spec, GP_EXPORT_DEFAULT_DENSITY, 1, pack, len, err);
 }
 
 /* ------------------------------------------------------------------ sources */
@@ -564,6 +578,11 @@ gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_exp
     gp_export *e;
     gp_status st = pack_open(src, &e, err);
     if (st) return st;
+    if (e->info.flags & GP_EXPORT_VIEW_ONLY) {
+        gp_export_destroy(e);
+        return gp_error_set(err, GP_ERR_INVALID,
+                            "a view pack has no ODEC discs to export (outputs must include \"odec\")");
+    }
     e->format = f;
     e->cap = 4096;
     e->buf = malloc(e->cap);
@@ -643,6 +662,16 @@ void gp_export_destroy(gp_export *e)
 struct gp_export_reader {
     gp_export *e; /* opened by pack_open: the header and the read cache, no format */
 };
+
+gp_status gp_export_pack_info(const gp_export_source *src, gp_export_info *info, gp_error *err)
+{
+    gp_export *e;
+    gp_status st = pack_open(src, &e, err);
+    if (st) return st;
+    *info = e->info;
+    gp_export_destroy(e);
+    return GP_OK;
+}
 
 gp_status gp_export_reader_open(const gp_export_source *src, gp_export_reader **out,
                                 gp_error *err)

@@ -31,7 +31,8 @@
  *     uint32   bom        0x01020304
  *     uint32   version    1
  *     uint32   dim        2 or 3
- *     uint32   flags      GP_EXPORT_HAS_DESCRIPTORS (2D)
+ *     uint32   flags      GP_EXPORT_HAS_DESCRIPTORS, GP_EXPORT_VIEW_ONLY (2D);
+ *                         GP_EXPORT_HAS_DEM (3D)
  *     uint64   nitems     3D: spheres; 2D: grains
  *     uint64   npoints    2D: contour points of all grains
  *     uint64   ndiscs     2D: ODEC discs of all grains
@@ -82,6 +83,9 @@ typedef enum gp_export_format {
 
 #define GP_EXPORT_HAS_DESCRIPTORS 1u
 #define GP_EXPORT_HAS_DEM 2u /* 3D: the pack ends with the DEM block (layout above) */
+/* 2D: a view pack (gp_export_pack_2d_view): the grains' records and contours without ODEC
+ * discs, for drawing them; no file is written from it (gp_export_open refuses it) */
+#define GP_EXPORT_VIEW_ONLY 4u
 
 /* The 2D default density (kg/m^3) when a spec has no material: quartz, 2650. */
 #define GP_EXPORT_DEFAULT_DENSITY 2650.0
@@ -115,6 +119,14 @@ gp_status gp_export_pack_3d_dem(const gp_specimen3d *s, const gp_spec3d *spec, v
 gp_status gp_export_pack_2d(const gp_specimen2d *s, const gp_spec2d *spec, double density,
                             void **pack, size_t *len, gp_error *err);
 
+/* A view pack of a 2D specimen whose grains may lack ODEC discs (outputs without "odec"):
+ * the layout of gp_export_pack_2d with no discs (ndiscs 0) and flag GP_EXPORT_VIEW_ONLY. Its
+ * records are what the record reader (below) hands out, at 80 bytes a grain and 16 a contour
+ * point: the service stores one with every 2D result that has grains, so that its pictures
+ * need not parse the result's text; its exports still need the ODEC discs. */
+gp_status gp_export_pack_2d_view(const gp_specimen2d *s, const gp_spec2d *spec, void **pack,
+                                 size_t *len, gp_error *err);
+
 /* ---- streaming ---- */
 
 /* Reads n bytes at offset off of the pack into dst; returns 0 on success. */
@@ -132,8 +144,9 @@ gp_export_source gp_export_memory_source(const void *pack, size_t len);
 typedef struct gp_export gp_export;
 
 /* Opens an export of the pack behind src in format f. GP_ERR_INVALID when the pack is not one
- * (magic, byte order, version, sizes) or the format does not exist for its dimension. The
- * source must stay valid until gp_export_destroy. */
+ * (magic, byte order, version, sizes), is a view pack (GP_EXPORT_VIEW_ONLY: a caller tells
+ * those apart first with gp_export_pack_info) or the format does not exist for its
+ * dimension. The source must stay valid until gp_export_destroy. */
 gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_export **out,
                          gp_error *err);
 
@@ -179,6 +192,10 @@ typedef struct gp_export_grain {
     uint64_t point_first, point_count, disc_first, disc_count;
     double area, orientation_deg, elongation, roundness, circularity, regularity;
 } gp_export_grain;
+
+/* The header of the pack behind src, checked as gp_export_open checks it (GP_ERR_INVALID when
+ * it is not a pack or cannot be read, GP_ERR_NOMEM). */
+gp_status gp_export_pack_info(const gp_export_source *src, gp_export_info *info, gp_error *err);
 
 /* Opens a reader of the pack behind src (GP_ERR_INVALID when it is not one, GP_ERR_NOMEM). */
 gp_status gp_export_reader_open(const gp_export_source *src, gp_export_reader **out,

@@ -800,25 +800,38 @@ static void free_export(void *cls)
     free(d);
 }
 
+/* 1 when the pack behind src is a view pack (gp_export.h: drawn, never exported); a pack
+ * that cannot be read is left to gp_export_open to report */
+static int view_pack(const gp_export_source *src)
+{
+    gp_export_info info;
+    return gp_export_pack_info(src, &info, NULL) == GP_OK && (info.flags & GP_EXPORT_VIEW_ONLY);
+}
+
 /* The pack of job id opened into d (export_dl: in memory or streamed) and the export of it in
- * format f; -1 when it has been answered (404, 409 without a pack, 500). */
+ * format f; -1 when it has been answered (404, 409 without a pack or with a view pack only,
+ * 500). */
 static int export_open(struct MHD_Connection *c, req *r, const char *id, const gpd_kind *k,
                        int f, export_dl *d, enum MHD_Result *ret)
 {
     char st[16];
     size_t len = 0;
     store_rc rc = store_stream_open(id, "pack", STREAM_SMALL, &d->stream, &d->pack, &len, st);
+    gp_export_source src = {0};
+    if (rc == STORE_OK && (d->pack || d->stream)) {
+        js_source v = store_value_source(d->pack, len, d->stream);
+        src = (gp_export_source){v.read, v.user, v.size};
+    }
+    int none = rc == STORE_OK && (!src.read || view_pack(&src));
     if (rc == STORE_NOT_FOUND) *ret = not_found(c, r, id);
     else if (rc == STORE_BUSY) *ret = send_busy(c, r);
     else if (rc != STORE_OK) *ret = send_store_error(c, r);
-    else if (!d->pack && !d->stream)
+    else if (none)
         *ret = send_error(c, r, 409, "missing_output", "/outputs",
                           "job %s has no %s to export (its spec did not ask for it): submit "
                           "the spec again with \"%s\" in outputs",
                           id, k->pack_what, k->pack_output);
-    if (rc != STORE_OK || (!d->pack && !d->stream)) return -1;
-    js_source v = store_value_source(d->pack, len, d->stream);
-    gp_export_source src = {v.read, v.user, v.size};
+    if (rc != STORE_OK || none) return -1;
     gp_error err;
     if (gp_export_open(f, &src, &d->e, &err) == GP_OK) return 0;
     if (!store_reachable()) /* the pack's stream broke with the server */

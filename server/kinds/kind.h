@@ -110,7 +110,9 @@ typedef struct gpd_kind {
     json_t *(*result)(const void *specimen, const void *spec, const json_t *spec_json,
                       gpd_jw *w);
     /* The export pack (core/export): 0 with a malloc'ed *pack, 1 when the spec asked for no
-     * output a pack is made of (*pack left NULL), -1 with err */
+     * output a pack is made of (*pack left NULL), -1 with err. A pack flagged
+     * GP_EXPORT_VIEW_ONLY is drawn by the SVG views and answered 409 by the exports, as no
+     * pack is (pack_what, pack_output) */
     int (*pack)(const void *specimen, const void *spec, void **pack, size_t *len,
                 gp_error *err);
     /* The "detail" of the final "done" progress (a new object; NULL: none, {}) */

@@ -1,10 +1,11 @@
 /* svg_job.h -- one SVG view of a stored job as a stream: what GET /v1/jobs/{id}/svg serves.
  *
  * The view reads the job's summary (store_get_summary: stats, warnings, container, box) and,
- * when it draws geometry, its items one at a time: 2D grains and 3D spheres from the export
- * pack (SQLite incremental blob I/O, as the export download), cells (which packs do not hold),
- * and grains or spheres of a job without a pack, from the stored result text, walked element
- * by element (server/util/json_scan.h). Memory is bounded whatever the job's size: the summary, one
+ * when it draws geometry, its items one at a time: 2D grains and 3D spheres from the job's
+ * pack (SQLite incremental blob I/O, as the export download; a 2D job without odec stores a
+ * view pack, its grains without discs, for this), cells (which packs do not hold), and grains
+ * or spheres of a job without a pack, from the stored result text, walked element by element
+ * (server/util/json_scan.h). Memory is bounded whatever the job's size: the summary, one
  * item, two 64 KiB caches, the private connections' page caches (256 KiB each) and a staging
  * buffer of about 16 KiB of SVG; nothing is proportional to the result.
  *

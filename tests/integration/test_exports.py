@@ -1,6 +1,7 @@
 """GET /v1/jobs/{id}/export (issue #8): every format is loaded into the real program that reads it
 -- LAMMPS, LIGGGHTS, YADE, VTK's own reader -- and compared with the job's JSON result; csv parses
-back to the result's floats exactly; headers; the error answers.
+back to the result's floats exactly; headers; the error answers; a job without odec has a view
+pack that draws its pictures as the export pack does and exports nothing.
 
 The programs come from Debian packages (bash deploy/install-deps.sh): lammps (lmp), liggghts,
 yade, python3-vtk9 (VTK's Python module, for /usr/bin/python3 -- set GPD_VTK_PYTHON to use
@@ -528,6 +529,25 @@ def test_errors(fx):
 
 
 @shared
+def test_view_pack(fx):
+    """The standard small job without odec stores a view pack (its grains without discs): its
+    five views are byte for byte those of the same job with odec (drawn from its export pack),
+    and every export of it is 409 missing_output as for a job without a pack."""
+    d = fx.d
+    jid = d.submit(dict(SPEC_2D, outputs=["grains", "descriptors", "cells"]))
+    job = d.wait(jid, timeout=120 * gpd.TIME_SCALE)
+    assert job["status"] == "succeeded", job
+    for view in ("packing", "cells", "size", "orientation", "descriptors"):
+        got = [d.request("GET", "/v1/jobs/%s/svg?view=%s" % (j, view)) for j in (fx.j2, jid)]
+        assert all(st == 200 for st, _, _ in got), (view, [st for st, _, _ in got])
+        assert got[0][2] == got[1][2], "%s: the view pack draws another picture" % view
+    for f in FORMATS_2D:
+        e = expect_error(d, "/v1/jobs/%s/export?format=%s" % (jid, f), 409, "missing_output",
+                         "/outputs")
+        assert '"odec"' in e["message"], e
+
+
+@shared
 def test_clean_exit(fx):
     """The shared daemon stops cleanly after serving every export (under ASan: no leak)."""
     rc = fx.d.stop()
@@ -539,4 +559,4 @@ if __name__ == "__main__":
         sys.argv[1] = os.path.abspath(sys.argv[1])
     gpd.main([test_headers, test_csv_round_trip, test_lammps_3d, test_liggghts_3d,
               test_lammps_2d, test_yade, test_vtk, test_tiled_export, test_errors,
-              test_clean_exit])
+              test_view_pack, test_clean_exit])

@@ -16,6 +16,10 @@ The daemon's own report (`stats.fit`, `warnings`) is then held to those numbers.
   test_sieve           a 2D sieve law: particles derived, percent passing by mass at 1/2/3 mm
                        within 3 points; `particles` with a sieve law is a 422 at /particles.
   test_grain_law       "of": "grains": the grain areas follow the law.
+  test_imc_max_steps   imc.max_steps left out: the result's stats.imc_steps says the default
+                       it used (10^6 at 3,000 grains of a law of grains, both IMC runs within
+                       it; 12 x N at 90,000 cells) and the effective spec leaves it out; a
+                       given one is kept, and a budget the first run uses up says so.
   test_wrong_specimen  an E3 job with 4 classes: the IMC error is small while the areas are not
                        what was asked; the fit report must say what the specimen is.
 Prints a table of what was measured (N, COV, a, KS vs critical, COV error, steps, seconds).
@@ -371,6 +375,56 @@ def test_grain_law(env):
     assert d.stop() == 0, d.read_log()
 
 
+def summary_of(d, spec):
+    jid = d.submit(spec)
+    job = d.wait(jid, timeout=JOB_TIMEOUT, interval=0.2)
+    assert job["status"] == "succeeded", (spec, job)
+    st, _, body = d.request("GET", "/v1/jobs/%s/summary" % jid, timeout=60)
+    assert st == 200, (st, body[:300])
+    st, _, eff = d.json("GET", "/v1/jobs/%s/spec" % jid)
+    assert st == 200, (st, eff)
+    return json.loads(body), eff
+
+
+def test_imc_max_steps(env):
+    d = env.daemon(workers=2)
+    n = 3000
+    grains = {"kind": KIND, "seed": 21, "particles": n, "contour_points": 32,
+              "size": {"cov": 0.5, "of": "grains"}, "outputs": ["grains"]}
+    r = run_all(d, [grains])[0]
+    st = r["stats"]["imc_steps"]
+    print("    of=grains, N %d, max_steps left out: %s" % (n, st))
+    # the default for 3,000 cells, both runs (cells, then resized for their grains) within it
+    assert st["max"] == 1000000 and st["default"] is True, st
+    assert len(st["runs"]) == 2 and all(k > 0 for k in st["runs"]), st
+    assert sum(st["runs"]) == st["achieved"] <= st["max"], st
+    areas = [abs(fc.shoelace(g["contour"])) for g in r["grains"]]
+    m = check_area_fit(r["stats"]["fit"]["grain_area"], "lognormal", areas, 0.65 / n, 0.5)
+    assert m["ks_area"] <= 0.5 * m["crit"], (m["ks_area"], m["crit"])
+    assert not [w for w in r["warnings"] if "not resized" in w], r["warnings"]
+
+    # a given budget is the user's: kept, and the first run using it up says so
+    given = dict(grains, imc={"max_steps": 5000})
+    r = run_all(d, [given])[0]
+    st = r["stats"]["imc_steps"]
+    print("    of=grains, N %d, max_steps 5000: %s" % (n, st))
+    assert st == {"max": 5000, "achieved": 5000, "default": False, "runs": [5000]}, st
+    said = [w for w in r["warnings"] if "not resized" in w]
+    assert len(said) == 1 and "(5000)" in said[0], r["warnings"]
+
+    # beyond 83,333 cells the default grows with N: 12 moves a cell
+    big = 90000
+    summary, eff = summary_of(d, {"kind": KIND, "seed": 3, "particles": big,
+                                  "outputs": ["cells"]})
+    st = summary["stats"]["imc_steps"]
+    print("    cells, N %d, max_steps left out: %s, stop %s" % (
+        big, st, summary["stats"]["imc_error"]["stop_reason"]))
+    assert st["max"] == 12 * big and st["default"] is True, st
+    assert st["runs"] == [st["achieved"]] and 0 < st["achieved"] <= st["max"], st
+    assert "max_steps" not in eff.get("imc", {}), eff  # the effective spec leaves it out
+    assert d.stop() == 0, d.read_log()
+
+
 def test_wrong_specimen(env):
     """E3 with 4 classes: a histogram of few classes can be matched by the wrong law. Whatever
     the specimen is, the fit report must be what the test measures on it, not the IMC's view."""
@@ -399,4 +453,4 @@ def test_wrong_specimen(env):
 
 if __name__ == "__main__":
     gpd.main([test_default_counts, test_grid, test_l_shape_and_low_cov, test_sieve,
-              test_grain_law, test_wrong_specimen])
+              test_grain_law, test_imc_max_steps, test_wrong_specimen])

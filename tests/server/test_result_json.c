@@ -504,6 +504,43 @@ static void test_result_2d(void)
     json_decref(sj);
 }
 
+/* stats.imc_steps: the budget used, whether it was the default, and each run's steps (a law of
+ * grains whose cells were resized: two) */
+static void test_imc_steps_2d(void)
+{
+    enum { NG = 4 };
+    static gp_grain2d g[NG];
+    gp_specimen2d s;
+    gp_spec2d spec;
+    specimen(&s, &spec, g, NG);
+    json_t *sj = json_pack("{s:[s]}", "outputs", "odec");
+    spec.imc_max_steps = 12000000;
+    spec.imc_max_steps_default = 1;
+    s.imc_runs = 2;
+    s.imc_steps = 7000123;
+    s.imc_steps_resize = 3000100;
+    json_t *r = gpd_result_2d(&s, &spec, sj, NULL);
+    json_t *want = json_pack("{s:I, s:I, s:b, s:[I, I]}", "max", (json_int_t)12000000,
+                             "achieved", (json_int_t)7000123, "default", 1, "runs",
+                             (json_int_t)4000023, (json_int_t)3000100);
+    CHECK(json_equal(json_object_get(json_object_get(r, "stats"), "imc_steps"), want));
+    json_decref(want);
+    json_decref(r);
+    /* one run, a budget the user gave */
+    spec.imc_max_steps = 5000;
+    spec.imc_max_steps_default = 0;
+    s.imc_runs = 1;
+    s.imc_steps = 5000;
+    s.imc_steps_resize = 0;
+    r = gpd_result_2d(&s, &spec, sj, NULL);
+    want = json_pack("{s:I, s:I, s:b, s:[I]}", "max", (json_int_t)5000, "achieved",
+                     (json_int_t)5000, "default", 0, "runs", (json_int_t)5000);
+    CHECK(json_equal(json_object_get(json_object_get(r, "stats"), "imc_steps"), want));
+    json_decref(want);
+    json_decref(r);
+    json_decref(sj);
+}
+
 int main(void)
 {
     test_strings();
@@ -513,5 +550,6 @@ int main(void)
     test_cancel();
     test_items();
     test_result_2d();
+    test_imc_steps_2d();
     return gp_test_summary();
 }

@@ -12,11 +12,12 @@
  * The size view from stats.fit (CDF curves, KS lines, warnings), and stats.fit / warnings as
  * server/jobs/result_json.c writes them from a specimen, drawn by the size view.
  * Compact reading (what GET /svg does): server/util/json_scan.c (member spans, array walks, the
- * summary of a result, cut texts refused), the element parser against jansson, the fast
- * "%.1f", and every view drawn as a pull stream from a summary plus an export pack or the
+ * summary of a result, cut texts refused), the element parser against jansson and its
+ * numbers against strtod, the fast "%.1f", and every view drawn as a pull stream from a summary plus an export pack or the
  * scanned result text, in pieces of 7 bytes to 1 MiB, byte for byte as gp_svg_render draws
  * the whole result; a source failing anywhere fails the picture (500 or a read error). */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1395,6 +1396,9 @@ static void test_compact_2d(void)
     size_t pack_len = 0;
     gp_error perr;
     CHECK(gp_export_pack_2d(&s, &spec, 2650, &pack, &pack_len, &perr) == GP_OK);
+    void *view = NULL; /* what a job without output odec stores */
+    size_t view_len = 0;
+    CHECK(gp_export_pack_2d_view(&s, &spec, &view, &view_len, &perr) == GP_OK);
     /* the summary: the result without its arrays */
     static const char *const skip[] = {"grains", "cells", "spheres", "contacts", NULL};
     js_source ts = json_scan_memory_source(text, strlen(text));
@@ -1406,13 +1410,14 @@ static void test_compact_2d(void)
     json_object_del(copy, "cells");
     CHECK(json_equal(copy, summary));
     json_decref(copy);
-    /* every view, from the pack and the scanned text, from the scanned text only, as the
-     * result in memory draws it (the statistics here have no histograms: the size, orientation
-     * and descriptors views fall back to the items) */
+    /* every view, from the scanned text only, from the export pack or the view pack and the
+     * scanned text, as the result in memory draws it (the statistics here have no histograms:
+     * the size, orientation and descriptors views fall back to the items) */
     const char *views[5] = {"packing", "cells", "size", "orientation", "descriptors"};
     gp_svg_options og = {.color = "orientation"}, ow = {.width = 1500};
-    for (int with_pack = 0; with_pack < 2; with_pack++) {
-        src_ctx ctx = {with_pack ? pack : NULL, pack_len, text, {{0}}, 0, 0};
+    for (int with_pack = 0; with_pack < 3; with_pack++) {
+        src_ctx ctx = {with_pack == 1 ? pack : with_pack == 2 ? view : NULL,
+                       with_pack == 1 ? pack_len : view_len, text, {{0}}, 0, 0};
         set_spans(&ctx);
         for (int v = 0; v < 5; v++) check_stream_equal(r, KIND_2D, views[v], NULL, &ctx, summary);
         check_stream_equal(r, KIND_2D, "packing", &og, &ctx, summary);
@@ -1429,6 +1434,7 @@ static void test_compact_2d(void)
     json_decref(summary);
     free(sum_text);
     free(pack);
+    free(view);
     free(text);
     json_decref(r);
     json_decref(sj);
@@ -1587,6 +1593,51 @@ static void test_item_parse(void)
     free(b.rings);
 }
 
+/* one number as a sphere's first value, bit for bit as strtod reads it; 0 when it differs */
+static int number_same(const char *num)
+{
+    char t[128];
+    snprintf(t, sizeof t, "[%s,0,0,0]", num);
+    svg_item c = {0};
+    int ok = svg_items_parse(GP_SVG_SPHERES, &c, t, strlen(t)) == 0;
+    double want = strtod(num, NULL);
+    ok = ok && memcmp(&c.q[0], &want, sizeof want) == 0;
+    if (!ok) fprintf(stderr, "the element parser reads %s as %.17g, strtod as %.17g\n", num, c.q[0], want);
+    return ok;
+}
+
+/* The element parser's numbers (its own fast path, strtod's fallback) are strtod's, bit for
+ * bit: midpoints between two doubles, the edges of the fast path (19 digits, 10^+-27,
+ * subnormals), forms JSON does not have, and random doubles written at 6 to 20 digits. */
+static void test_item_numbers(void)
+{
+    const char *lit[] = {"0", "-0", "0.0", "-0.0", "1", "-1", "0.5", "1e23", "8.589973e9",
+                         "9007199254740993", "9007199254740995", "9007199254740993.5",
+                         "4503599627370497.5", "1234567890123456789", "12345678901234567890",
+                         "0.1", "0.30000000000000004", "1e-27", "1e27", "1e-28", "1e28",
+                         "9.9999999999999999e26", "2.2250738585072011e-308", "4.9e-324",
+                         "1.7976931348623157e308", "1e400", "1E5", "1e+5", "1.e5", "0x10",
+                         "00012.5", "-0.000000000000000000000000001234",
+                         "0.011144915524144993", "5e-324", "1.5e-30"};
+    int bad = 0;
+    for (size_t i = 0; i < sizeof lit / sizeof *lit; i++) bad += !number_same(lit[i]);
+    unsigned x = 2024;
+    for (int i = 0; i < 300000; i++) {
+        uint64_t bits = 0;
+        for (int k = 0; k < 4; k++) {
+            x = x * 1103515245u + 12345u;
+            bits = bits << 16 | (x >> 16);
+        }
+        double mant = (double)(bits >> 11) / 9007199254740992.0; /* 53 random bits */
+        double d = ldexp(0.5 + mant / 2, (int)(bits % 200) - 100) * (bits >> 63 ? -1 : 1);
+        static const int digits[] = {6, 15, 16, 17, 20};
+        char num[64];
+        snprintf(num, sizeof num, "%.*g", digits[i % 5], d);
+        bad += !number_same(num);
+    }
+    CHECK(bad == 0);
+}
+
 /* printf's "%.1f" exactly, halves included */
 static void test_fmt_f1(void)
 {
@@ -1625,6 +1676,7 @@ int main(void)
     test_large();
     test_json_scan();
     test_item_parse();
+    test_item_numbers();
     test_fmt_f1();
     test_compact_2d();
     test_compact_3d();

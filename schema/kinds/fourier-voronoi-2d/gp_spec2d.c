@@ -329,11 +329,15 @@ static void read_imc_2d(gp_spec_reader *r, const json_t *imc, gp_spec2d *out)
 {
     out->imc_error = (gp_imc_error_kind)(gp_rd_enum(r, imc, "/imc/error", g_errors, 4) + 1);
     out->imc_threshold = gp_rd_num(r, imc, "/imc/threshold", -GP_RD_ANY, GP_RD_ANY);
-    out->imc_max_steps = (long)gp_rd_num(r, imc, "/imc/max_steps", 0, GP_RD_COUNT);
+    const json_t *ms = gp_rd_member(r, imc, "/imc/max_steps", JSON_REAL, 1);
+    out->imc_max_steps = ms ? (long)gp_rd_value(r, ms, "/imc/max_steps", 0, GP_RD_COUNT) : 0;
+    out->imc_max_steps_default = !ms; /* resolved from the cell count (default_steps_2d) */
     out->imc_init = (gp_init_kind)gp_rd_enum(r, imc, "/imc/init", g_inits, 2);
     const json_t *cl = gp_rd_member(r, imc, "/imc/classes", JSON_REAL, 1);
     out->imc_classes = cl ? (int)gp_rd_value(r, cl, "/imc/classes", 0, GP_RD_INT) : 0;
 }
+
+static long default_steps_2d(const gp_spec2d *s);
 
 /* gp_spec.h. Also the first step of the checks and the bounds (on an effective spec in the
  * making). */
@@ -363,6 +367,7 @@ int gp_spec2d_read(const json_t *full, gp_spec2d *out, gp_spec_problem *p)
     else
         rc = gp_rd_finish(&r, p);
     if (rc) gp_spec2d_free(out);
+    else if (out->imc_max_steps_default) out->imc_max_steps = default_steps_2d(out);
     return rc;
 }
 
@@ -761,28 +766,62 @@ static double shape_work_2d(const gp_spec2d *s, double cells)
     return 0;
 }
 
-static void bounds_2d(const gp_spec2d *s, size_t n, gp_spec_bounds_t *b)
+/* seconds of one IMC move among the cells, and (*edge) of its clipping against the container's
+ * edges near them */
+static double move_cost_2d(const gp_spec2d *s, double cells, double *edge)
 {
-    memset(b, 0, sizeof *b);
-    double cells = (double)n, np = (double)s->contour_points;
-    int sieve = s->size_law == GP_LAW_SIEVE;
-    b->cells = b->items = cells;
-    b->steps = (double)s->imc_max_steps;
     double edges = s->container == GP_CONTAINER_POLYGON ? (double)edges_2d(s) : 0;
     double per_bin = edges / fmax(1, cells / 2);
-    double imc = b->steps * COST_IMC_MOVE_S *
-                 (1 + COST_IMC_PER_DECADE * log10(fmax(cells, 1000) / 1000));
-    double imc_edges = b->steps * COST_IMC_EDGE_S * per_bin * sqrt(per_bin);
+    *edge = COST_IMC_EDGE_S * per_bin * sqrt(per_bin);
+    return COST_IMC_MOVE_S * (1 + COST_IMC_PER_DECADE * log10(fmax(cells, 1000) / 1000));
+}
+
+/* seconds of everything but the IMC: the grains (fill, ODEC, descriptors) and the shape */
+static double grain_work_2d(const gp_spec2d *s, double cells)
+{
     double per = COST_FILL_S;
     if (s->outputs & GP_OUT2_ODEC) per += COST_ODEC_S;
     if (s->outputs & GP_OUT2_DESCRIPTORS) per += COST_DESC_S;
-    double grains = cells * per * np / 128 + shape_work_2d(s, cells);
+    return cells * per * (double)s->contour_points / 128 + shape_work_2d(s, cells);
+}
+
+/* The imc.max_steps of a spec that leaves it out: gp_spec2d_default_max_steps of its cell count,
+ * clipped to the moves the work budget leaves after the grains, never below
+ * GP_IMC_DEFAULT_STEPS_MIN. So the default never turns a spec away: one that the work bound
+ * accepts with 10^6 moves is accepted with its default, and one it refuses with 10^6 moves is
+ * refused whatever the default. Within the limits of the API the clip does not bind (10^6
+ * cells of 4,096 points with every output, 1.2e7 moves: ~1.1e5 s of the 1.7e5); it keeps the
+ * default inside the budget whatever the container's edges. From the spec's numbers alone: the
+ * same on every machine. */
+static long default_steps_2d(const gp_spec2d *s)
+{
+    size_t n = 0;
+    gp_error err;
+    memset(&err, 0, sizeof err);
+    if (gp_spec2d_cell_count(s, NULL, &n, &err) != GP_OK) return GP_IMC_DEFAULT_STEPS_MIN;
+    double cells = (double)n, edge, move = move_cost_2d(s, cells, &edge);
+    /* 1 % short of the budget: the bound refuses work over it, not at it */
+    double room = 0.99 * (GP_SPEC_WORK_BUDGET_S - grain_work_2d(s, cells)) / (move + edge);
+    double steps = fmin((double)gp_spec2d_default_max_steps(n), floor(room));
+    return steps > (double)GP_IMC_DEFAULT_STEPS_MIN ? (long)steps : GP_IMC_DEFAULT_STEPS_MIN;
+}
+
+static void bounds_2d(const gp_spec2d *s, size_t n, gp_spec_bounds_t *b)
+{
+    memset(b, 0, sizeof *b);
+    double cells = (double)n, edge;
+    int sieve = s->size_law == GP_LAW_SIEVE;
+    b->cells = b->items = cells;
+    b->steps = (double)s->imc_max_steps;
+    double imc = b->steps * move_cost_2d(s, cells, &edge);
+    double imc_edges = b->steps * edge;
+    double grains = grain_work_2d(s, cells);
     b->work_s = imc + imc_edges + grains;
     b->work_pointer = imc_edges > imc && imc_edges > grains ? "/container"
                       : imc > grains                       ? "/imc/max_steps"
                       : sieve                              ? "/size/sieve"
                                                            : "/particles";
-    b->result_bytes = cells * bytes_per_grain(s->outputs, np);
+    b->result_bytes = cells * bytes_per_grain(s->outputs, (double)s->contour_points);
     b->result_pointer = sieve ? "/size/sieve" : "/particles";
 }
 
@@ -804,8 +843,9 @@ static int check_budget_2d(const gp_spec2d *s, size_t n, gp_spec_problem *p)
     char what[200], where[64] = "a circle";
     size_t edges = edges_2d(s);
     if (edges) snprintf(where, sizeof where, "a container of %zu edges", edges);
-    snprintf(what, sizeof what, "%.3g IMC moves at most (imc.max_steps) on %zu cells in %s, then "
-             "%zu grains of %zu contour points", b.steps, n, where, n, s->contour_points);
+    snprintf(what, sizeof what, "%.3g IMC moves at most (imc.max_steps%s) on %zu cells in %s, "
+             "then %zu grains of %zu contour points", b.steps,
+             s->imc_max_steps_default ? ", the default" : "", n, where, n, s->contour_points);
     return gp_spec_over_budget(&b, what, g_work_advice, p);
 }
 

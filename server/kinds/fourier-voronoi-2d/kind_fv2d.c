@@ -10,7 +10,9 @@
  *    "imc_error":       {"target": the threshold used, "achieved": e,
  *                        "measure": "AD|E1|E2|E3", "floor": f,
  *                        "stop_reason": "threshold|max_steps|floor|..."},
- *    "imc_steps":       {"max": max_steps, "achieved": steps},
+ *    "imc_steps":       {"max": max_steps used, "achieved": steps (every run),
+ *                        "default": whether max_steps was the default for the cell count,
+ *                        "runs": [steps of the cells' run, (the resize run of a grain law)]},
  *    "solid_fraction":  {"target": F_S, "achieved": grain area / container area},
  *    "container_area":  A,
  *    "cells_target_met": k,            cells whose grain reached F_S
@@ -272,6 +274,20 @@ static json_t *shape_json(const gp_specimen2d *s, const gp_spec2d *spec)
     return o;
 }
 
+/* the budget of the IMC, whether it was the default for the cell count, and what each run took
+ * of it: the cells' law, then (a law of grains whose cells were resized for their grains) the
+ * second run */
+static json_t *imc_steps(const gp_specimen2d *s, const gp_spec2d *spec)
+{
+    json_t *runs = json_array();
+    json_array_append_new(runs, json_integer((json_int_t)(s->imc_steps - s->imc_steps_resize)));
+    if (s->imc_runs > 1)
+        json_array_append_new(runs, json_integer((json_int_t)s->imc_steps_resize));
+    return json_pack("{s:I, s:I, s:b, s:o}", "max", (json_int_t)spec->imc_max_steps, "achieved",
+                     (json_int_t)s->imc_steps, "default", spec->imc_max_steps_default, "runs",
+                     runs);
+}
+
 /* stats: the targets against what was achieved */
 static json_t *stats_2d(const gp_specimen2d *s, const gp_spec2d *spec)
 {
@@ -282,9 +298,7 @@ static json_t *stats_2d(const gp_specimen2d *s, const gp_spec2d *spec)
                                   (json_int_t)target_particles(s, spec), "achieved",
                                   (json_int_t)s->fit.cell_area.n));
     json_object_set_new(st, "imc_error", imc_error(s, spec));
-    json_object_set_new(st, "imc_steps",
-                        json_pack("{s:I, s:I}", "max", (json_int_t)spec->imc_max_steps,
-                                  "achieved", (json_int_t)s->imc_steps));
+    json_object_set_new(st, "imc_steps", imc_steps(s, spec));
     /* without grains nothing was filled: achieved is null, not 0 */
     json_object_set_new(st, "solid_fraction",
                         json_pack("{s:o, s:o}", "target", gpd_jreal(spec->solid_fraction),
@@ -642,12 +656,17 @@ static json_t *result(const void *specimen, const void *spec, const json_t *spec
     return gpd_result_2d_write(specimen, spec, spec_json, w);
 }
 
-/* exports need the ODEC discs; without them there is no pack and GET .../export answers 409
- * naming the output to ask for */
+/* Exports need the ODEC discs. Without them the grains still get a view pack (their contours
+ * and descriptors, no discs): the SVG views read a pack's records about ten times faster
+ * than they parse the result's text, and GET .../export answers it 409 naming the output to
+ * ask for, as it does a job without a pack. Cells only: no pack. */
 static int pack(const void *specimen, const void *spec, void **pack, size_t *len, gp_error *err)
 {
-    if (!(((const gp_spec2d *)spec)->outputs & GP_OUT2_ODEC)) return 1;
-    return gp_export_pack_2d(specimen, spec, GP_EXPORT_DEFAULT_DENSITY, pack, len, err) ? -1 : 0;
+    unsigned out = ((const gp_spec2d *)spec)->outputs;
+    if (out & GP_OUT2_ODEC)
+        return gp_export_pack_2d(specimen, spec, GP_EXPORT_DEFAULT_DENSITY, pack, len, err) ? -1 : 0;
+    if (!(out & (GP_OUT2_GRAINS | GP_OUT2_DESCRIPTORS))) return 1;
+    return gp_export_pack_2d_view(specimen, spec, pack, len, err) ? -1 : 0;
 }
 
 /* How the IMC ended, the warnings and the fit summary (stats.fit without its CDF curves), so

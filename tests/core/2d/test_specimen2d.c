@@ -311,7 +311,9 @@ static void law_on_grains_large(void)
     }
     if (r[0] && r[1]) {
         int same = r[0]->ngrains == r[1]->ngrains &&
-                   r[0]->cell_law_power == r[1]->cell_law_power;
+                   r[0]->cell_law_power == r[1]->cell_law_power &&
+                   r[0]->imc_steps == r[1]->imc_steps &&
+                   r[0]->imc_steps_resize == r[1]->imc_steps_resize;
         for (size_t i = 0; same && i < r[0]->ngrains; i++)
             same = r[0]->grains[i].ncontour == r[1]->grains[i].ncontour &&
                    !memcmp(r[0]->grains[i].contour, r[1]->grains[i].contour,
@@ -326,20 +328,45 @@ static void law_on_grains_large(void)
     for (int t = 0; t < 2; t++) {
         gp_spec2d s = grains_spec(3000, 2);
         s.imc_max_steps = budgets[t];
+        s.imc_max_steps_default = t == 0; /* as if the default: the warning says so */
         gp_specimen2d *q = build(&s);
         CHECK(q != NULL);
         if (!q) continue;
-        printf("of grains, N 3000, max_steps %ld: %ld IMC steps, power %.4f, grain KS %.4f\n",
-               budgets[t], q->imc_steps, q->cell_law_power, q->fit.grain_area.ks);
+        long first = q->imc_steps - q->imc_steps_resize;
+        printf("of grains, N 3000, max_steps %ld: %ld + %ld IMC steps, power %.4f, miss %.4f "
+               "(critical %.4f), grain KS %.4f\n", budgets[t], first, q->imc_steps_resize,
+               q->cell_law_power, q->grain_law_miss, q->fit.grain_area.ks_critical,
+               q->fit.grain_area.ks);
         CHECK(q->imc_steps <= budgets[t]);
         CHECK(t == 0 ? q->cell_law_power == 1.0 : q->cell_law_power < 1.0);
         CHECK(q->cells_resize_blocked == (t == 0)); /* and says why, in a warning */
+        /* the second run's steps on their own: none when blocked, the rest of the budget at
+         * most when it ran; the miss that asked for it above half the critical value */
+        CHECK(t == 0 ? q->imc_steps_resize == 0 && first == budgets[t]
+                     : q->imc_steps_resize > 0 && first > 0 && first < budgets[t]);
+        CHECK(q->grain_law_miss > 0.5 * q->fit.grain_area.ks_critical);
         int said = 0;
         for (size_t w = 0; w < q->nwarnings; w++)
-            said |= strstr(q->warnings[w], "not resized") != NULL;
+            said |= strstr(q->warnings[w], "not resized") != NULL &&
+                    strstr(q->warnings[w], "(5000, the default)") != NULL;
         CHECK(said == (t == 0));
         gp_specimen2d_destroy(q);
     }
+}
+
+/* The default imc.max_steps: 10^6 up to 83,333 cells, 12 moves a cell beyond (10^6 cells:
+ * 1.2e7, room for both runs of a grain law, which took 6.6 moves a cell at 10^6 grains), and
+ * what gp_spec2d_defaults gives its 100 cells. */
+static void default_max_steps(void)
+{
+    CHECK(gp_spec2d_default_max_steps(1) == 1000000);
+    CHECK(gp_spec2d_default_max_steps(500) == 1000000);
+    CHECK(gp_spec2d_default_max_steps(83333) == 1000000);
+    CHECK(gp_spec2d_default_max_steps(100000) == 1200000);
+    CHECK(gp_spec2d_default_max_steps(1000000) == 12000000);
+    gp_spec2d s;
+    gp_spec2d_defaults(&s);
+    CHECK(s.imc_max_steps == 1000000 && s.imc_max_steps_default == 0);
 }
 
 /* A sieve curve by mass: 0.5-4 mm, 10 / 50 / 90 % passing at 1 / 2 / 3 mm in a 0.1 m square.
@@ -554,6 +581,7 @@ int main(void)
         example(1, seed, seed == 1);
         example(2, seed, seed == 1);
     }
+    default_max_steps();
     small_n();
     law_on_grains();
     law_on_grains_large();

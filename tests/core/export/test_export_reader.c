@@ -1,4 +1,4 @@
-/* test_export_reader.c -- the public reader of an export pack (gp_export_reader): the records of packs made here read back exactly (3D spheres, 2D grains with their contour points and discs, with and without descriptors), and a wrong record kind, an index past its count or a corrupt pack refused. */
+/* test_export_reader.c -- the public reader of an export pack (gp_export_reader): the records of packs made here read back exactly (3D spheres, 2D grains with their contour points and discs, with and without descriptors), and a wrong record kind, an index past its count or a corrupt pack refused. A view pack (gp_export_pack_2d_view: grains without discs) reads back its grains, says what it is (gp_export_pack_info) and is refused by every export format. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -108,9 +108,73 @@ static void test_reader(int with_desc)
     free(pack);
 }
 
+/* a view pack: the grains' records and contours, no discs even where the specimen has them,
+ * and no file written from it */
+static void test_view_pack(void)
+{
+    gp_grain2d gr[2];
+    memset(gr, 0, sizeof gr);
+    gr[0] = (gp_grain2d){.contour = sq, .ncontour = 4, .area = 1, .orientation_deg = 10,
+                         .descriptors = {1.0, 0.5, 0.9, 0.1}, .discs = d0, .ndiscs = 2};
+    gr[1] = (gp_grain2d){.contour = tri, .ncontour = 3, .area = 0.5, .orientation_deg = 45,
+                         .descriptors = {0.5, 0.4, 0.8, 0.2}};
+    gp_specimen2d s2;
+    memset(&s2, 0, sizeof s2);
+    s2.grains = gr;
+    s2.ngrains = 2;
+    gp_spec2d spec;
+    memset(&spec, 0, sizeof spec);
+    spec.container = GP_CONTAINER_POLYGON;
+    static gp_vec2 box[4] = {{-1, -1}, {4, -1}, {4, 2}, {-1, 2}};
+    spec.outer.pts = box;
+    spec.outer.n = 4;
+    spec.outputs = GP_OUT2_GRAINS | GP_OUT2_DESCRIPTORS;
+    void *pack;
+    size_t len;
+    gp_error e;
+    CHECK(gp_export_pack_2d(&s2, &spec, 2650, &pack, &len, &e) == GP_ERR_INVALID);
+    CHECK(gp_export_pack_2d_view(&s2, &spec, &pack, &len, &e) == GP_OK);
+    CHECK(len == 128 + 2 * 80 + 7 * 16);
+    gp_export_source src = gp_export_memory_source(pack, len);
+    gp_export_info info;
+    CHECK(gp_export_pack_info(&src, &info, &e) == GP_OK);
+    CHECK(info.dim == 2 && info.nitems == 2 && info.npoints == 7 && info.ndiscs == 0);
+    CHECK(info.flags == (GP_EXPORT_VIEW_ONLY | GP_EXPORT_HAS_DESCRIPTORS));
+    gp_export_reader *r;
+    CHECK(gp_export_reader_open(&src, &r, &e) == GP_OK);
+    for (uint64_t k = 0; k < 2; k++) {
+        gp_export_grain g;
+        CHECK(gp_export_reader_grain(r, k, &g, &e) == GP_OK);
+        CHECK(g.point_count == gr[k].ncontour && g.disc_count == 0);
+        CHECK(g.area == gr[k].area && g.regularity == gr[k].descriptors.regularity);
+        for (uint64_t i = 0; i < g.point_count; i++) {
+            double p[2];
+            CHECK(gp_export_reader_point(r, g.point_first + i, p, &e) == GP_OK);
+            CHECK(p[0] == gr[k].contour[i].x && p[1] == gr[k].contour[i].y);
+        }
+    }
+    double d[3];
+    CHECK(gp_export_reader_disc(r, 0, d, &e) == GP_ERR_INVALID);
+    gp_export_reader_destroy(r);
+    for (int f = 0; f < GP_EXPORT_NFORMATS; f++) {
+        gp_export *x = NULL;
+        CHECK(gp_export_open((gp_export_format)f, &src, &x, &e) == GP_ERR_INVALID && x == NULL);
+    }
+    CHECK(strstr(e.message, "\"odec\"") != NULL);
+    /* an export pack is no view pack */
+    free(pack);
+    gr[1].discs = d1;
+    gr[1].ndiscs = 1;
+    CHECK(gp_export_pack_2d(&s2, &spec, 2650, &pack, &len, &e) == GP_OK);
+    src = gp_export_memory_source(pack, len);
+    CHECK(gp_export_pack_info(&src, &info, &e) == GP_OK && !(info.flags & GP_EXPORT_VIEW_ONLY));
+    free(pack);
+}
+
 int main(void)
 {
     test_reader(1);
     test_reader(0);
+    test_view_pack();
     return gp_test_summary();
 }
