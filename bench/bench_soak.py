@@ -124,6 +124,10 @@ class Tally:
         self.add("failures")
         print("  " + what, flush=True)
 
+    def set(self, key, value):
+        with self.mu:
+            self.total[key] = value
+
     def get(self, key):
         with self.mu:
             return self.total.get(key, 0)
@@ -268,7 +272,7 @@ def slow_loop(port, n, stop, tally):
                 open_ += 1
             except OSError:
                 s.close()
-        tally.add("slow_open_now", open_ - tally.get("slow_open_now"))
+        tally.set("slow_open_now", open_)
         stop.wait(5)
     for s in socks:
         if s is not None:

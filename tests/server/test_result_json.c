@@ -393,12 +393,13 @@ static void test_items(void)
     CHECK(gpd_jw_take(&w, NULL) == NULL);
 }
 
-/* a synthetic 2D specimen of n grains of NP points each (one shared contour, odd values) */
+/* a synthetic 2D specimen of n grains of NP points each (one shared contour, odd values); returns
+ * the JSON spec it stands for (outputs odec), the caller's */
 enum { NP = 64 };
 static gp_vec2 contour[NP];
 static double discs[6] = {0.1, 0.2, 0.05, 0.3, 0.4, 1.0 / 7};
 
-static void specimen(gp_specimen2d *s, gp_spec2d *spec, gp_grain2d *g, size_t n)
+static json_t *specimen(gp_specimen2d *s, gp_spec2d *spec, gp_grain2d *g, size_t n)
 {
     memset(s, 0, sizeof *s);
     memset(spec, 0, sizeof *spec);
@@ -423,6 +424,7 @@ static void specimen(gp_specimen2d *s, gp_spec2d *spec, gp_grain2d *g, size_t n)
     spec->particles = n;
     spec->outputs = GP_OUT2_ODEC;
     spec->seed = 99;
+    return json_pack("{s:[s]}", "outputs", "odec");
 }
 
 static void test_result_2d(void)
@@ -431,8 +433,7 @@ static void test_result_2d(void)
     static gp_grain2d g[NG];
     gp_specimen2d s;
     gp_spec2d spec;
-    specimen(&s, &spec, g, NG);
-    json_t *sj = json_pack("{s:[s]}", "outputs", "odec");
+    json_t *sj = specimen(&s, &spec, g, NG);
 
     gpd_jw w;
     gpd_jw_init(&w, NULL);
@@ -512,8 +513,7 @@ static void test_imc_steps_2d(void)
     static gp_grain2d g[NG];
     gp_specimen2d s;
     gp_spec2d spec;
-    specimen(&s, &spec, g, NG);
-    json_t *sj = json_pack("{s:[s]}", "outputs", "odec");
+    json_t *sj = specimen(&s, &spec, g, NG);
     spec.imc_max_steps = 12000000;
     spec.imc_max_steps_default = 1;
     s.imc_runs = 2;

@@ -13,6 +13,28 @@ static gp_vec2 tri[3] = {{2, 0}, {3, 0}, {2, 1}};
 static double d0[6] = {0.3, 0.5, 0.3, 0.7, 0.5, 0.3};
 static double d1[3] = {2.3, 0.3, 0.29};
 
+/* a specimen of two grains, a square (two discs, first orientation orient0) and a triangle (one
+ * disc if second_discs), in a 5 x 3 box, asking for outputs */
+static void two_grains(gp_grain2d gr[2], gp_specimen2d *s2, gp_spec2d *spec, double orient0,
+                       int second_discs, unsigned outputs)
+{
+    static gp_vec2 box[4] = {{-1, -1}, {4, -1}, {4, 2}, {-1, 2}};
+    memset(gr, 0, 2 * sizeof *gr);
+    gr[0] = (gp_grain2d){.contour = sq, .ncontour = 4, .area = 1, .orientation_deg = orient0,
+                         .descriptors = {1.0, 0.5, 0.9, 0.1}, .discs = d0, .ndiscs = 2};
+    gr[1] = (gp_grain2d){.contour = tri, .ncontour = 3, .area = 0.5, .orientation_deg = 45,
+                         .descriptors = {0.5, 0.4, 0.8, 0.2}, .discs = second_discs ? d1 : NULL,
+                         .ndiscs = second_discs ? 1 : 0};
+    memset(s2, 0, sizeof *s2);
+    s2->grains = gr;
+    s2->ngrains = 2;
+    memset(spec, 0, sizeof *spec);
+    spec->container = GP_CONTAINER_POLYGON;
+    spec->outer.pts = box;
+    spec->outer.n = 4;
+    spec->outputs = outputs;
+}
+
 static void test_reader(int with_desc)
 {
     gp_error e;
@@ -44,22 +66,9 @@ static void test_reader(int with_desc)
     free(pack);
     /* 2D */
     gp_grain2d gr[2];
-    memset(gr, 0, sizeof gr);
-    gr[0] = (gp_grain2d){.contour = sq, .ncontour = 4, .area = 1, .orientation_deg = 0,
-                         .descriptors = {1.0, 0.5, 0.9, 0.1}, .discs = d0, .ndiscs = 2};
-    gr[1] = (gp_grain2d){.contour = tri, .ncontour = 3, .area = 0.5, .orientation_deg = 45,
-                         .descriptors = {0.5, 0.4, 0.8, 0.2}, .discs = d1, .ndiscs = 1};
     gp_specimen2d s2;
-    memset(&s2, 0, sizeof s2);
-    s2.grains = gr;
-    s2.ngrains = 2;
     gp_spec2d spec;
-    memset(&spec, 0, sizeof spec);
-    spec.container = GP_CONTAINER_POLYGON;
-    static gp_vec2 box[4] = {{-1, -1}, {4, -1}, {4, 2}, {-1, 2}};
-    spec.outer.pts = box;
-    spec.outer.n = 4;
-    spec.outputs = GP_OUT2_ODEC | (with_desc ? GP_OUT2_DESCRIPTORS : 0);
+    two_grains(gr, &s2, &spec, 0, 1, GP_OUT2_ODEC | (with_desc ? GP_OUT2_DESCRIPTORS : 0));
     CHECK(gp_export_pack_2d(&s2, &spec, 2650, &pack, &len, &e) == GP_OK);
     src = gp_export_memory_source(pack, len);
     CHECK(gp_export_reader_open(&src, &r, &e) == GP_OK);
@@ -113,22 +122,9 @@ static void test_reader(int with_desc)
 static void test_view_pack(void)
 {
     gp_grain2d gr[2];
-    memset(gr, 0, sizeof gr);
-    gr[0] = (gp_grain2d){.contour = sq, .ncontour = 4, .area = 1, .orientation_deg = 10,
-                         .descriptors = {1.0, 0.5, 0.9, 0.1}, .discs = d0, .ndiscs = 2};
-    gr[1] = (gp_grain2d){.contour = tri, .ncontour = 3, .area = 0.5, .orientation_deg = 45,
-                         .descriptors = {0.5, 0.4, 0.8, 0.2}};
     gp_specimen2d s2;
-    memset(&s2, 0, sizeof s2);
-    s2.grains = gr;
-    s2.ngrains = 2;
     gp_spec2d spec;
-    memset(&spec, 0, sizeof spec);
-    spec.container = GP_CONTAINER_POLYGON;
-    static gp_vec2 box[4] = {{-1, -1}, {4, -1}, {4, 2}, {-1, 2}};
-    spec.outer.pts = box;
-    spec.outer.n = 4;
-    spec.outputs = GP_OUT2_GRAINS | GP_OUT2_DESCRIPTORS;
+    two_grains(gr, &s2, &spec, 10, 0, GP_OUT2_GRAINS | GP_OUT2_DESCRIPTORS);
     void *pack;
     size_t len;
     gp_error e;
