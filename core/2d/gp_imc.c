@@ -46,11 +46,13 @@
  * nothing next to a step. */
 #define GP_IMC_CANCEL_EVERY 1
 /* Default AD threshold: the excess A^2 over N's floor at which to stop. A^2 grows like N D^2
- * for a KS distance D, so a fixed threshold keeps D / (1.36 / sqrt(N)) fixed at every N: at 0.1
- * the cell-area KS lies well inside its 5 % critical value and the COV close to the best
- * sample's (docs/design/imc.md). Lower thresholds stall on the orientations of near-regular
- * cells. */
-#define GP_IMC_AD_THRESHOLD 0.1
+ * for a KS distance D, so a fixed threshold keeps D / (1.36 / sqrt(N)) fixed at every N: at
+ * 0.05 the cell-area KS is at most 0.2 of its 5 % critical value, as tight as Neper's fitted
+ * tessellations at N = 500 and 2,000, and the orientation KS about 0.2 (bench_fit2d; the
+ * figures in docs/design/imc.md). */
+#define GP_IMC_AD_THRESHOLD 0.05
+/* the orientations' excess counts half in the error and the descent (gp_imc.h "Objective") */
+#define GP_IMC_ORIENT_WEIGHT 0.5
 
 void gp_imc_params_defaults(gp_imc_params *p)
 {
@@ -226,6 +228,12 @@ typedef struct imc_state {
     struct ad_val {
         double sk, sg, sh, tk, tg, th, ang;
     } *adv;
+    /* AD: cells whose orientation is a wall's direction (wall_tie_of) */
+    double *wall_dir;          /* the container's edge directions, radians, sorted, distinct */
+    int nwall;
+    long *tie_count;           /* per direction, the cells on it */
+    int *tie_of;               /* per cell, its direction's index or -1 */
+    long tie_pairs;            /* sum over directions of k (k - 1) */
 } imc_state;
 
 static void state_free(imc_state *S)
@@ -241,6 +249,9 @@ static void state_free(imc_state *S)
     gp_adstat_destroy(S->ads);
     gp_adstat_destroy(S->adt);
     free(S->adv);
+    free(S->wall_dir);
+    free(S->tie_count);
+    free(S->tie_of);
 }
 
 static inline int size_class(const imc_state *s, double a)
@@ -268,7 +279,113 @@ typedef struct cell_val {
     double sk, sg, sh;         /* area: key, ln F, ln(1 - F) */
     double tk, tg, th;         /* orientation: key, ln u, ln(1 - u) */
     double ang;                /* the orientation they come from, radians */
+    int tie;                   /* the wall direction it lies on, or -1 */
 } cell_val;
+
+/* Walls tie orientations. A cell against a straight wall often has its thinnest side across
+ * the wall, and then its orientation is the wall's direction exactly: on a square of N = 500,
+ * 15-30 cells at exactly 0 deg. A^2 barely sees such a tie (the values next to it can make up
+ * the step within a rank or two: a cost of order k^3 / N^2), but the KS distance, and the eye
+ * on a rose diagram, see a step of k / N. So the orientation excess carries
+ * sum_d k_d (k_d - 1) / N over the wall directions d with k_d cells on them: N D^2 for the step
+ * D ~ k / N, the scale of A^2, and 0 for a lone cell on a direction. Integer counts: exact,
+ * and the same whatever the order of the moves. */
+#define GP_IMC_TIE_EPS 1e-9
+
+static int wall_tie_of(const imc_state *S, double th)
+{
+    int lo = 0, hi = S->nwall; /* first direction >= th */
+    while (lo < hi) {
+        int mid = (lo + hi) >> 1;
+        if (S->wall_dir[mid] < th) lo = mid + 1;
+        else hi = mid;
+    }
+    /* the nearest directions, and across the cut of (-pi/2, pi/2] the ends */
+    int cand[4] = {lo, lo - 1, 0, S->nwall - 1};
+    for (int k = 0; k < 4; k++) {
+        if (cand[k] < 0 || cand[k] >= S->nwall) continue;
+        double d = fabs(S->wall_dir[cand[k]] - th);
+        if (d < GP_IMC_TIE_EPS || GP_IMC_PI - d < GP_IMC_TIE_EPS) return cand[k];
+    }
+    return -1;
+}
+
+static double tie_term(const imc_state *S, long pairs) { return (double)pairs / (double)S->n; }
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static size_t ring_dirs(const gp_vec2 *r, size_t m, double *out)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < m; i++) {
+        double dx = r[(i + 1) % m].x - r[i].x, dy = r[(i + 1) % m].y - r[i].y;
+        if (dx == 0.0 && dy == 0.0) continue;
+        double a = atan2(dy, dx);
+        a = a <= -GP_IMC_PI / 2 ? a + GP_IMC_PI : a > GP_IMC_PI / 2 ? a - GP_IMC_PI : a;
+        out[k++] = a;
+    }
+    return k;
+}
+
+/* The container's edge directions (sorted, one of each within GP_IMC_TIE_EPS) and the tie
+ * counts, every cell on none; for the AD objective only. */
+static gp_status walls_init(imc_state *S, const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *holes,
+                            const size_t *nhole, size_t nholes, size_t n, gp_error *err)
+{
+    size_t m = nouter;
+    for (size_t h = 0; h < nholes; h++) m += nhole[h];
+    S->wall_dir = malloc((m ? m : 1) * sizeof *S->wall_dir);
+    S->tie_of = malloc(n * sizeof *S->tie_of);
+    if (!S->wall_dir || !S->tie_of) return gp_error_set(err, GP_ERR_NOMEM, "imc: out of memory");
+    size_t k = ring_dirs(outer, nouter, S->wall_dir);
+    for (size_t h = 0; h < nholes; h++) k += ring_dirs(holes[h], nhole[h], S->wall_dir + k);
+    qsort(S->wall_dir, k, sizeof *S->wall_dir, cmp_double);
+    size_t d = 0;
+    for (size_t i = 0; i < k; i++)
+        if (d == 0 || S->wall_dir[i] - S->wall_dir[d - 1] >= GP_IMC_TIE_EPS) S->wall_dir[d++] = S->wall_dir[i];
+    if (d > 1 && S->wall_dir[0] + GP_IMC_PI - S->wall_dir[d - 1] < GP_IMC_TIE_EPS) d--; /* -pi/2 is pi/2 */
+    S->nwall = (int)d;
+    S->tie_count = calloc(d ? d : 1, sizeof *S->tie_count);
+    if (!S->tie_count) return gp_error_set(err, GP_ERR_NOMEM, "imc: out of memory");
+    for (size_t i = 0; i < n; i++) S->tie_of[i] = -1;
+    return GP_OK;
+}
+
+/* The change of sum_d k_d (k_d - 1) if the nch cells ch[] took the directions nv[].tie
+ * (quadratic in nch, a dozen cells a step: no buffer) */
+static long dir_change(const imc_state *S, const uint32_t *ch, size_t nch, const cell_val *nv, int d)
+{
+    long dk = 0;
+    for (size_t k = 0; k < nch; k++) dk += (nv[k].tie == d) - (S->tie_of[ch[k]] == d);
+    return dk;
+}
+
+static int dir_seen(const imc_state *S, const uint32_t *ch, size_t upto, const cell_val *nv, int d)
+{
+    for (size_t k = 0; k < upto; k++)
+        if (nv[k].tie != S->tie_of[ch[k]] && (nv[k].tie == d || S->tie_of[ch[k]] == d)) return 1;
+    return 0;
+}
+
+static long tie_pairs_if(const imc_state *S, const uint32_t *ch, size_t nch, const cell_val *nv)
+{
+    long delta = 0;
+    for (size_t k = 0; k < nch; k++) {
+        int from = S->tie_of[ch[k]], to = nv[k].tie;
+        if (from == to) continue;
+        for (int side = 0; side < 2; side++) {
+            int d = side ? to : from;
+            if (d < 0 || dir_seen(S, ch, k, nv, d)) continue;
+            long c = S->tie_count[d], c2 = c + dir_change(S, ch, nch, nv, d);
+            delta += c2 * (c2 - 1) - c * (c - 1);
+        }
+    }
+    return delta;
+}
 
 /* Cell i's contribution; with recorded (its values as S holds them), an orientation equal to
  * the recorded one bit for bit keeps the recorded u and logs: a neighbour of a moved seed keeps
@@ -283,6 +400,7 @@ static void cell_eval(const imc_state *S, const gp_voronoi *v, size_t i, cell_va
     c->sk = a;
     gp_law_log_cdf_sf(S->law, a, &c->sg, &c->sh);
     c->ang = th;
+    c->tie = wall_tie_of(S, th);
     const struct ad_val *o = &S->adv[i];
     if (recorded && memcmp(&o->ang, &th, sizeof th) == 0) {
         c->tk = o->tk;
@@ -312,6 +430,9 @@ static void cell_put(imc_state *S, size_t i, const cell_val *c)
     gp_adstat_set(S->ads, i, c->sk, c->sg, c->sh, c->sk * c->sk);
     gp_adstat_set(S->adt, i, c->tk, c->tg, c->th, 0.0);
     S->adv[i] = (struct ad_val){c->sk, c->sg, c->sh, c->tk, c->tg, c->th, c->ang};
+    if (S->tie_of[i] >= 0) S->tie_pairs -= 2 * --S->tie_count[S->tie_of[i]];
+    if (c->tie >= 0) S->tie_pairs += 2 * S->tie_count[c->tie]++;
+    S->tie_of[i] = c->tie;
 }
 
 /* cell i's recorded contribution */
@@ -328,6 +449,7 @@ static void cell_get(const imc_state *S, size_t i, cell_val *c)
     c->tg = a->tg;
     c->th = a->th;
     c->ang = a->ang;
+    c->tie = S->tie_of[i];
 }
 
 static void hist_errors(const imc_state *s, int kind, double *es, double *et)
@@ -359,7 +481,7 @@ static double cov_term_of(const imc_state *s, double sum_sq)
 static void ad_errors(const imc_state *s, double *es, double *et)
 {
     *es = gp_adstat_a2(s->ads) - s->ad_floor + cov_term_of(s, gp_adstat_sum_extra(s->ads));
-    *et = gp_adstat_a2(s->adt) - s->ad_floor;
+    *et = gp_adstat_a2(s->adt) - s->ad_floor + tie_term(s, s->tie_pairs);
 }
 
 /* COV (population) of the N quantiles of the law at (2i - 1) / 2N: the COV of the closest
@@ -387,6 +509,7 @@ static objective evaluate(const imc_state *s)
     double a, b;
     if (s->kind == GP_IMC_ERROR_AD) {
         ad_errors(s, &a, &b);
+        b *= GP_IMC_ORIENT_WEIGHT;
         o.error = a > b ? a : b;
         o.descent = a + b;
         o.tie = 0.0;
@@ -752,7 +875,9 @@ static objective evaluate_ad_if(const imc_state *S, const uint32_t *ch, size_t n
     double sx;
     double as = gp_adstat_a2_if(S->ads, nch, b->ids, b->sk, b->sg, b->sh, b->sx, &sx);
     double at = gp_adstat_a2_if(S->adt, nt, b->tids, b->tk, b->tg, b->th, b->tx, NULL);
-    double es = as - S->ad_floor + cov_term_of(S, sx), et = at - S->ad_floor;
+    double es = as - S->ad_floor + cov_term_of(S, sx);
+    double et = at - S->ad_floor + tie_term(S, S->tie_pairs + tie_pairs_if(S, ch, nch, nv));
+    et *= GP_IMC_ORIENT_WEIGHT;
     objective o = {es > et ? es : et, es + et, 0.0};
     return o;
 }
@@ -1300,6 +1425,8 @@ gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *
         }
     }
     double floor_e = 0.0;
+    if (p->error_kind == GP_IMC_ERROR_AD) st = walls_init(&S, outer, nouter, holes, nhole, nholes, n, err);
+    if (st != GP_OK) goto done;
     st = state_init(&S, p, law, v, n, cancel, &floor_e, err);
     if (st != GP_OK) goto done;
     objective cur = evaluate(&S);

@@ -9,9 +9,11 @@ The daemon's own report (`stats.fit`, `warnings`) is then held to those numbers.
   test_default_counts  N = 1, 5, 20, 60, 150 with default settings: success, the cells tile the
                        container, every cell's area field is its polygons' area, a warnings list.
   test_grid            N = 500, 2000 x lognormal COV 0.1 .. 1.2 x anisotropy 1, 0.3, 0.1 (30 jobs
-                       at once): area KS and orientation KS under 1.36/sqrt(N), COV within 5 %,
-                       and stats.fit equal to the test's figures.
-  test_l_shape_and_low_cov  the same on an L-shaped container with a square hole, and a COV 0.05
+                       at once), default settings: area KS at most AREA_GOAL of 1.36/sqrt(N)
+                       (printed beside Neper's where it was run: issue #33), orientation KS at
+                       most ORIENT_GOAL of it, COV within 5 %, and stats.fit equal to the test's
+                       figures.
+  test_l_shape_and_low_cov  the same goals on an L-shaped container with a square hole, and a COV 0.05
                        case that converges or says in its warnings how close it came.
   test_sieve           a 2D sieve law: particles derived, percent passing by mass at 1/2/3 mm
                        within 3 points; `particles` with a sieve law is a 422 at /particles.
@@ -215,6 +217,13 @@ def test_default_counts(env):
 
 
 GRID_N = (500, 2000)
+# Neper's cell-area KS at the same N and COV, isotropic (issue #33, measured on this machine
+# class), and the bounds of the default specimen, as fractions of the 5 % critical value: the
+# default AD threshold keeps the area KS at 0.07-0.21 of it in bench_fit2d (three seeds a case);
+# one seed of the 30 here reaches 0.23 (N = 500, COV 0.8: 0.0138, where Neper has 0.010-0.012)
+NEPER_KS = {(500, 0.2): 0.021, (500, 0.8): 0.012, (2000, 0.2): 0.015, (2000, 0.8): 0.005}
+AREA_GOAL = 0.25
+ORIENT_GOAL = 0.3
 GRID_COV = (0.1, 0.2, 0.5, 0.8, 1.2)
 GRID_A = (1.0, 0.3, 0.1)
 
@@ -236,12 +245,16 @@ def test_grid(env):
         m = measure_cells(r, n, UNIT_SQUARE, cov, a)
         row("grid", n, cov, a, m, *steps_secs(r))
         why = []
-        if m["ks_area"] > m["crit"]:
-            why.append("area KS %.4f > %.4f" % (m["ks_area"], m["crit"]))
+        area_bound = AREA_GOAL * m["crit"]
+        if a == 1.0 and (n, cov) in NEPER_KS:
+            print("    N=%d COV=%s: area KS %.4f, Neper's %.3f" % (n, cov, m["ks_area"],
+                                                                   NEPER_KS[(n, cov)]))
+        if m["ks_area"] > area_bound:
+            why.append("area KS %.4f > %.4f" % (m["ks_area"], area_bound))
         if abs(m["cov_err"]) > COV_TOL:
             why.append("COV %.4f for %.4f" % (m["cov"], cov))
-        if m["ks_orient"] > m["crit"]:
-            why.append("orientation KS %.4f > %.4f" % (m["ks_orient"], m["crit"]))
+        if m["ks_orient"] > ORIENT_GOAL * m["crit"]:
+            why.append("orientation KS %.4f > %.4f" % (m["ks_orient"], ORIENT_GOAL * m["crit"]))
         if m["mism"]:
             why.append("%d cells' orientation_deg differ from their min-caliper direction"
                        % m["mism"])
@@ -286,9 +299,9 @@ def test_l_shape_and_low_cov(env):
         if name == "L+hole":
             multi = sum(1 for c in r["cells"] if len(c["polygons"]) > 1)
             print("    L+hole COV %s: %d multi-part cells" % (cov, multi))
-            assert m["ks_area"] <= m["crit"], m
+            assert m["ks_area"] <= AREA_GOAL * m["crit"], m
             assert abs(m["cov_err"]) <= COV_TOL, m
-            assert m["ks_orient"] <= m["crit"], m
+            assert m["ks_orient"] <= ORIENT_GOAL * m["crit"], m
             assert m["mism"] == 0, m
         else:
             missed = converged_or_says_so(r, m, cov)
