@@ -38,6 +38,7 @@
 
 #include "gp_fill.h"
 #include "gp_fourier.h"
+#include "gp_imc.h"
 #include "gp_rng.h"
 #include "gp_specimen2d.h"
 
@@ -67,7 +68,7 @@ static void setup(const row *r, gp_spec2d *s)
     s->threads = r->threads;
     s->outputs = r->outputs;
     s->imc_error = (gp_imc_error_kind)r->error;
-    s->imc_threshold = r->error == GP_IMC_AD ? 0.1 : 0.002;
+    s->imc_threshold = gp_imc_default_threshold(r->error == GP_IMC_AD ? GP_IMC_ERROR_AD : r->error);
     s->size_of_grains = r->law == 1;
     if (r->law == 2) {
         s->outer.pts = (gp_vec2 *)SQ10;
@@ -400,7 +401,7 @@ int main(int argc, char **argv)
         {"of grains, 10,000", 10000, 0.5, 1.0, 0.1, 0.05, 0.02, 2, GP_OUT2_GRAINS, GP_IMC_AD, 1},
         {"10,000 grains, 2 thr.", 10000, 0.5, 1.0, 0.1, 0.05, 0.02, 2, all, GP_IMC_AD, 0},
     };
-    printf("2D Fourier-Voronoi specimen, end to end (F_S = 0.65, Np = 128; AD threshold 0.1, E3 0.002)\n");
+    printf("2D Fourier-Voronoi specimen, end to end (F_S = 0.65, Np = 128; AD threshold %g, E3 %g)\n", gp_imc_default_threshold(GP_IMC_ERROR_AD), gp_imc_default_threshold(3));
     printf("fill/s = grains filled per second of the fill phase (wall); KS/c = KS distance over its 5 %% "
            "critical value (<= 1 passes); pass = largest sieve error, percentage points\n\n");
     printf("| %-24s | %6s | %2s | %11s | %7s | %6s | %6s | %6s | %7s | %7s | %7s | %5s | %5s | %8s | %5s | %6s | %5s | %5s |\n",

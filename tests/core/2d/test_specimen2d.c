@@ -324,7 +324,7 @@ static void law_on_grains_large(void)
         gp_specimen2d_destroy(r[t]);
     /* imc.max_steps bounds both IMC runs together: a budget the first run uses up leaves the
      * cells as they are; one it leaves room in caps the second */
-    const long budgets[2] = {5000, 12000};
+    const long budgets[2] = {5000, 18000};
     for (int t = 0; t < 2; t++) {
         gp_spec2d s = grains_spec(3000, 2);
         s.imc_max_steps = budgets[t];
