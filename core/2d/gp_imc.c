@@ -1332,7 +1332,11 @@ static gp_status fill_report(gp_imc_report *rep, const imc_state *S, const gp_im
     for (int j = 0; j < S->ks; j++) rep->size_achieved[j] = S->cs[j] / (double)S->n;
     for (int j = 0; j < S->kt; j++) rep->orient_achieved[j] = S->ct[j] / (double)S->n;
     hist_errors(S, S->kind == 2 ? 2 : 3, &rep->error_size, &rep->error_orient);
-    if (S->kind == GP_IMC_ERROR_AD) ad_errors(S, &rep->error_size_ad, &rep->error_orient_ad);
+    if (S->kind == GP_IMC_ERROR_AD) {
+        ad_errors(S, &rep->error_size_ad, &rep->error_orient_ad);
+        for (int d = 0; d < S->nwall; d++) rep->wall_ties += S->tie_count[d] > 1 ? (size_t)S->tie_count[d] : 0;
+        rep->error_orient_ties = tie_term(S, S->tie_pairs);
+    }
     return GP_OK;
 }
 

@@ -159,6 +159,9 @@ typedef struct gp_imc_report {
     double floor;        /* E1-E3: the integer-count floor of these classes; AD: 0 */
     double error_size_ad;   /* AD excess of the areas and orientations at the end (all kinds) */
     double error_orient_ad;
+    size_t wall_ties;       /* AD: cells at the end whose orientation is a container edge's
+                             * direction, shared with another cell (the walls' ties) */
+    double error_orient_ties; /* AD: their term in error_orient_ad, sum k (k - 1) / N */
     gp_imc_stop stop_reason;
     size_t nsize, norient;
     double *size_edges;     /* nsize + 1, area units; size_edges[nsize] = +inf */

@@ -278,6 +278,10 @@ typedef struct gp_specimen2d {
                                  * quantiles, missed it (the KS distance by number or by mass,
                                  * the larger), which decided the resize; 0 otherwise */
     const char *imc_error_kind; /* "AD", "E1", "E2", "E3" */
+    size_t imc_wall_ties;       /* AD: cells whose orientation is a container edge's direction,
+                                 * shared with another (gp_imc_report.wall_ties) */
+    double imc_error_ties;      /* AD: their share of the error (half their term: the
+                                 * orientations count half) */
     gp_fit2d fit;               /* measured on the cells and grains themselves */
     char **warnings;            /* nwarnings one-line messages: a target not reached, and how
                                  * close it came (IMC threshold, fit beyond its KS critical

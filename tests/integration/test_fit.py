@@ -331,6 +331,9 @@ def test_l_shape_and_low_cov(env):
                 "missed " + str(missed) if missed else "KS and COV goals met", ties,
                 json.dumps(r["stats"]["imc_error"]), r["warnings"]))
             assert ties >= 10, ties
+            if r["stats"]["imc_error"]["stop_reason"] != "threshold":
+                assert any("%d cells have their thinnest side along a straight wall" % ties in w
+                           for w in r["warnings"]), (ties, r["warnings"])
         else:
             # ... while the same law in a container without long straight walls converges
             print("    COV 0.05, 256-gon: imc_error %s" % json.dumps(r["stats"]["imc_error"]))
