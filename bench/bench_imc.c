@@ -12,7 +12,11 @@
  * is timed between the first progress report (step 4096) and the end, so that neither the
  * initial tessellation (nor the replicas' builds) nor the O(N) set-up of the objective counts,
  * in wall time and in the process's CPU time (all threads'); the error reached is printed
- * beside it.
+ * beside it. The 100k rows' 10^5 steps are the first step per cell of that run (a third of them
+ * accepted), the 1k rows' the 4th to the 100th (2 % accepted), so one more row times N = 1,000
+ * at the same stage, its first N steps (a third accepted as well), and one more ratio sets the
+ * 100k rate against it; a progress report comes only every 4,096 steps, so that row takes the
+ * least time of several runs of N steps less the least of as many runs of none (the set-up).
  * Usage: bench_imc [max_steps] [speed_steps] [N] [threads]   (max_steps 0 skips the fidelity
  * table; N > 0: only that rate row, on `threads` -- for callgrind, with threads 1: the
  * instructions per step are the difference of two runs of different speed_steps over their
@@ -132,6 +136,42 @@ static int mark(void *user, const gp_progress *pr)
     return 0;
 }
 
+/* The rate of the first n steps at N = n, one thread (early_rate's reps runs of n steps and of
+ * none, the least time of each) */
+static double early_rate(size_t n, int reps, double *cpu_rate)
+{
+    double tw[2] = {INFINITY, INFINITY}, tc[2] = {INFINITY, INFINITY}, err = 0.0;
+    long acc = 0;
+    for (int r = 0; r < reps; r++)
+        for (int k = 0; k < 2; k++) {
+            gp_imc_params p;
+            gp_imc_params_defaults(&p);
+            p.threads = 1;
+            p.cov = 0.8;
+            p.threshold = 1e-12;
+            p.max_steps = k ? (long)n : 0;
+            gp_voronoi *v = NULL;
+            gp_imc_report rep;
+            double w0 = now(), c0 = cpu_now();
+            gp_imc_run(SQ, 4, NULL, NULL, 0, n, &p, NULL, NULL, NULL, &v, &rep, NULL);
+            tw[k] = fmin(tw[k], now() - w0);
+            tc[k] = fmin(tc[k], cpu_now() - c0);
+            if (k) {
+                acc = rep.accepted;
+                err = rep.error;
+            }
+            gp_voronoi_destroy(v);
+            gp_imc_report_free(&rep);
+        }
+    double t = tw[1] - tw[0], c = tc[1] - tc[0];
+    double rate = t > 0 ? (double)n / t : 0.0, crate = c > 0 ? (double)n / c : 0.0;
+    printf("| first N steps |       1 | %6zu | %8zu | %8ld | %7.4f | %9.0f | %9.0f | %9.4g |\n", n, n, acc, t, rate,
+           crate, err);
+    fflush(stdout);
+    if (cpu_rate) *cpu_rate = crate;
+    return rate;
+}
+
 static double speed(size_t n, long steps, int threads, double *cpu_rate)
 {
     gp_imc_params p;
@@ -197,6 +237,11 @@ rates:
         for (int k = 0; k < 3; k++) rate[k][0] = speed(sn[k], speed_steps, tc[c], &rate[k][1]);
         printf("| ratio 100k/1k | %7d |      |          |          |         | %9.3f | %9.3f |           |\n", tc[c],
                rate[0][0] > 0 ? rate[2][0] / rate[0][0] : 0.0, rate[0][1] > 0 ? rate[2][1] / rate[0][1] : 0.0);
+        if (c > 0) continue;
+        double early[2];
+        early[0] = early_rate(sn[0], 20, &early[1]);
+        printf("| ratio 100k/1k, first N steps each | 1 |  |  |  |  | %9.3f | %9.3f |           |\n",
+               early[0] > 0 ? rate[2][0] / early[0] : 0.0, early[1] > 0 ? rate[2][1] / early[1] : 0.0);
     }
     return 0;
 }

@@ -269,12 +269,19 @@ static void test_ties(void)
 /* gp_adstat_a2_if: the A^2 a change would give, judged without making it, equals the A^2
  * after making it -- for small moves, jumps across the set, unchanged elements in the batch,
  * and batches of 1 to GP_ADSTAT_IF_MAX elements; the set is left untouched */
-static void test_a2_if(void)
+/* u, or with levels > 0 the middle of its 1/levels class: ties of key (with equal logs), many
+ * to a key, across a block's chunks and across blocks */
+static double level(double u, double levels)
 {
-    const size_t n = 500;
+    return levels > 0 ? (floor(u * levels) + 0.5) / levels : u;
+}
+
+/* n values: 500 (a few blocks) and 5,000 (many blocks, a batch's values in different ones) */
+static void test_a2_if_n(size_t n, double levels)
+{
     gp_adstat *s = gp_adstat_create(n, NULL);
     mirror m = {n, calloc(n, sizeof(double)), calloc(n, sizeof(double)), calloc(n, sizeof(int))};
-    for (size_t i = 0; i < n; i++) put(s, &m, i, unif(), unif());
+    for (size_t i = 0; i < n; i++) put(s, &m, i, level(unif(), levels), unif());
     size_t ids[GP_ADSTAT_IF_MAX];
     double key[GP_ADSTAT_IF_MAX], g[GP_ADSTAT_IF_MAX], h[GP_ADSTAT_IF_MAX], x[GP_ADSTAT_IF_MAX];
     for (int round = 0; round < 400; round++) {
@@ -290,7 +297,7 @@ static void test_a2_if(void)
             ids[i] = id;
             double u = round % 3 == 0 ? unif() : m.u[id] + 1e-3 * (unif() - 0.5);
             if (i % 7 == 3) u = m.u[id]; /* unchanged */
-            u = fmin(fmax(u, 1e-9), 1 - 1e-9);
+            u = level(fmin(fmax(u, 1e-9), 1 - 1e-9), levels);
             key[i] = u;
             g[i] = log(u);
             h[i] = log1p(-u);
@@ -311,6 +318,13 @@ static void test_a2_if(void)
     free(m.x);
     free(m.on);
     gp_adstat_destroy(s);
+}
+
+static void test_a2_if(void)
+{
+    test_a2_if_n(500, 0);
+    test_a2_if_n(5000, 0);
+    test_a2_if_n(5000, 256);
 }
 
 /* Block splits and merges: sorted runs in both directions (every insert into the same block),
