@@ -4,7 +4,8 @@
 # ranks), liggghts and yade, and VTK's Python reader, which prove that the export files load,
 # node (the dashboard's script) and promtool (package prometheus: checks the /metrics text),
 # postgresql (initdb, pg_ctl, psql: the it_pg_* tests start a server of their own; the
-# package's own cluster is not used),
+# package's own cluster is not used), voro++-dev (the reference test_voronoi3d_voro compares
+# gp_voronoi3d with),
 # and for the dashboard's browser test chromium, npm and then, by `npm ci` in
 # tests/integration/browser/, puppeteer-core as pinned in its package-lock.json (tests/run.sh
 # passes --test). npm runs as the user running this script; only apt-get goes through sudo.
@@ -19,7 +20,7 @@ TEST=0
 if [ "${1:-}" = "--test" ]; then
   TEST=1
   PKGS="$PKGS lammps openmpi-bin liggghts yade python3-vtk9 nodejs prometheus chromium fonts-dejavu-core \
-    postgresql"
+    postgresql voro++-dev"
 fi
 missing=""
 for p in $PKGS; do
