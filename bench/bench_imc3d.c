@@ -2,7 +2,7 @@
  * and the raw step rate.
  *
  * Fit rows: a unit box, lognormal volumes of COV 0.2, 0.5, 1.0, orientations isotropic and
- * a = 0.3 about z, N = 1,000 (and 10,000 at COV 0.5), the default threshold: steps, seconds
+ * a = 0.3 about z, N = 1,000 and 5,000 (and 10,000 at COV 0.5), the default threshold: steps, seconds
  * (the first tessellation and the steps), the volume KS over its 5 % critical value, the COV
  * error, the orientation KS over critical -- measured on the tessellation's cells after the
  * run, not read from the run's error.
@@ -104,10 +104,12 @@ int main(int argc, char **argv)
         printf("| N | COV | a | steps | stop | s | volume KS/crit | COV err | orient KS/crit |\n");
         printf("|---|---|---|---|---|---|---|---|---|\n");
         const double covs[3] = {0.2, 0.5, 1.0};
-        for (int k = 0; k < 3; k++) {
-            fit_row(1000, covs[k], 1.0);
-            fit_row(1000, covs[k], 0.3);
-        }
+        const size_t ns[2] = {1000, 5000};
+        for (int j = 0; j < 2; j++)
+            for (int k = 0; k < 3; k++) {
+                fit_row(ns[j], covs[k], 1.0);
+                fit_row(ns[j], covs[k], 0.3);
+            }
         fit_row(10000, 0.5, 1.0);
         printf("\n");
     }
