@@ -1,7 +1,9 @@
 /* gp_voronoi3d.c -- bounded 3D Voronoi tessellation with local updates. See gp_voronoi3d.h.
  *
  * Layout: convex polyhedra and their cutting ("poly"), the object and its grid of seeds, one
- * cell (the search), the container, the build, the moves, the queries.
+ * cell (the search), canonical cells (the finished polyhedron rewritten from its planes, so
+ * that its bits do not depend on the cuts' order), the container, the build, the moves, the
+ * queries.
  *
  * Tags: every face of a polyhedron carries a tag: >= 0 the seed whose bisector it lies on,
  * -1 - k the container's half-space k, TAG_BBOX + k (k < 6) a side of the starting box of a
@@ -21,6 +23,9 @@
 #define V3_SEEDS_PER_BIN 3.0
 #define V3_SLACK (1.0 + 1e-9)  /* the security radius' comparisons, against rounding */
 #define V3_PI 3.14159265358979323846
+#define V3_COND 1e-3           /* a vertex's triple of planes is well-conditioned from this */
+#define V3_SNAP 1e-6           /* a canonical vertex this far (times R) from the cut's is refused */
+#define V3_MAXDEG 16           /* the planes a degenerate vertex's triple is chosen from */
 #define TAG_BBOX (INT32_MIN + 16)
 #define CANCEL_EVERY 1024
 
@@ -34,9 +39,11 @@ typedef struct poly {
     int32_t nv, nf, nl, pool; /* vertex slots, faces, loop entries in use, pool entries used */
     int32_t vcap, fcap, lcap, nfree;
     double *x;                /* 3 per slot */
+    double *x2;               /* per slot: |x|^2 (0 when free), for r2 without recomputing it */
     int32_t *ref;             /* per slot: the loop entries naming it, -1 when free */
     int32_t *freel;           /* free slots */
     int32_t *foff, *flen, *fcp, *ftag; /* per face: offset, length, room, tag */
+    double *fpl;              /* per face: its plane n . x <= c as cut (n, c), 4 each */
     int32_t *fv;              /* the loops, counter-clockwise seen from outside */
     double r2;                /* largest squared distance of a vertex from the frame's origin */
 } poly;
@@ -45,10 +52,25 @@ typedef struct xedge {
     int32_t a, b, v; /* edge a < b got the new vertex v */
 } xedge;
 
+/* Per inside vertex of a cut (valid when stamp is the cut's number): the new vertices on its
+ * first three edges to outside vertices o, so that the second face to meet an edge finds its
+ * vertex without a search; more edges go to the xedge list. */
+typedef struct xslot {
+    uint32_t stamp;
+    int32_t n, o[3], v[3];
+} xslot;
+
 typedef struct cand {
     double r[3], d2; /* from the cell's seed to seed j (read from the bin, which is in cache) */
     int32_t j;
 } cand;
+
+/* A vertex's place in the canonical order: its three lowest tags, as unsigned keys (hi: the
+ * first two), and its slot. */
+typedef struct vkey {
+    uint64_t hi, lo;
+    int32_t slot;
+} vkey;
 
 /* vertex classes of a cut, as bits so that a face's classes are one OR */
 enum { C_OUT = 1, C_IN = 2, C_ON = 4 };
@@ -65,6 +87,8 @@ typedef struct scratch {
     int32_t bufcap;
     xedge *xe;
     int32_t nxe, xecap;
+    xslot *xs;         /* per slot, with the capacity dcap */
+    uint32_t cutno;    /* the current cut's number for xs (never 0: fresh slots are 0) */
     int32_t *cf, *ct;  /* the new face's directed edges */
     unsigned char *cdead;
     int32_t nce, cecap;
@@ -74,6 +98,11 @@ typedef struct scratch {
     int32_t dup;       /* a seed found to coincide with the cell's */
     int32_t *cut;      /* seeds whose planes cut the cell */
     int32_t ncut, cutcap;
+    /* canonical cells: per slot the offset of its faces in vfac (one per loop entry) and its
+     * key; per vertex its slot; per face the order */
+    int32_t *voff, *vfac, *vord, *ford;
+    vkey *vkey;
+    int32_t canv, canl, canf;
 } scratch;
 
 static int grow(void **p, int32_t *cap, int32_t need, size_t elt)
@@ -93,21 +122,26 @@ static int poly_reserve(scratch *S, int32_t nv, int32_t nf, int32_t nl)
 {
     poly *P = &S->p;
     int32_t c[8];
-    for (int k = 0; k < 8; k++) c[k] = k < 3 ? P->vcap : (k < 6 ? S->dcap : P->fcap);
+    for (int k = 0; k < 8; k++) c[k] = k < 3 || k == 7 ? P->vcap : (k < 6 ? S->dcap : P->fcap);
     if (grow((void **)&P->x, &c[0], nv, 3 * sizeof(double)) ||
         grow((void **)&P->ref, &c[1], nv, sizeof(int32_t)) ||
-        grow((void **)&P->freel, &c[2], nv, sizeof(int32_t)))
+        grow((void **)&P->freel, &c[2], nv, sizeof(int32_t)) ||
+        grow((void **)&P->x2, &c[7], nv, sizeof(double)))
         return -1;
     P->vcap = c[0];
+    int32_t c6 = S->dcap;
     if (grow((void **)&S->d, &c[3], nv, sizeof(double)) ||
-        grow((void **)&S->cls, &c[4], nv, 1) || grow((void **)&S->remap, &c[5], nv, sizeof(int32_t)))
+        grow((void **)&S->cls, &c[4], nv, 1) || grow((void **)&S->remap, &c[5], nv, sizeof(int32_t)) ||
+        grow((void **)&S->xs, &c6, nv, sizeof(xslot)))
         return -1;
+    if (c6 > S->dcap) memset(S->xs + S->dcap, 0, (size_t)(c6 - S->dcap) * sizeof(xslot));
     S->dcap = c[3];
-    int32_t f[4] = {P->fcap, P->fcap, P->fcap, P->fcap};
+    int32_t f[5] = {P->fcap, P->fcap, P->fcap, P->fcap, P->fcap};
     if (grow((void **)&P->foff, &f[0], nf, sizeof(int32_t)) ||
         grow((void **)&P->flen, &f[1], nf, sizeof(int32_t)) ||
         grow((void **)&P->fcp, &f[2], nf, sizeof(int32_t)) ||
-        grow((void **)&P->ftag, &f[3], nf, sizeof(int32_t)))
+        grow((void **)&P->ftag, &f[3], nf, sizeof(int32_t)) ||
+        grow((void **)&P->fpl, &f[4], nf, 4 * sizeof(double)))
         return -1;
     P->fcap = f[0];
     return grow((void **)&P->fv, &P->lcap, nl, sizeof(int32_t));
@@ -116,12 +150,14 @@ static int poly_reserve(scratch *S, int32_t nv, int32_t nf, int32_t nl)
 static void poly_free(poly *P)
 {
     free(P->x);
+    free(P->x2);
     free(P->ref);
     free(P->freel);
     free(P->foff);
     free(P->flen);
     free(P->fcp);
     free(P->ftag);
+    free(P->fpl);
     free(P->fv);
     memset(P, 0, sizeof *P);
 }
@@ -142,6 +178,7 @@ static int poly_box(scratch *S, const double lo[3], const double hi[3], const in
         x[2] = (k & 4) ? hi[2] : lo[2];
         P->ref[k] = 3;
         double r2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+        P->x2[k] = r2;
         P->r2 = r2 > P->r2 ? r2 : P->r2;
     }
     for (int f = 0; f < 6; f++) {
@@ -149,6 +186,10 @@ static int poly_box(scratch *S, const double lo[3], const double hi[3], const in
         P->flen[f] = 4;
         P->fcp[f] = 8;
         P->ftag[f] = tag[f];
+        double *q = P->fpl + 4 * f; /* x <= hi, -x <= -lo */
+        q[0] = q[1] = q[2] = 0;
+        q[f / 2] = (f & 1) ? 1 : -1;
+        q[3] = (f & 1) ? hi[f / 2] : -lo[f / 2];
         memcpy(P->fv + 8 * f, loops[f], sizeof loops[f]);
     }
     P->nv = 8;
@@ -159,32 +200,33 @@ static int poly_box(scratch *S, const double lo[3], const double hi[3], const in
     return 0;
 }
 
-/* The largest n . x over P's vertex slots (free slots sit at the origin, which every plane
- * of a seed leaves inside; for a wall they can only cost a classification). A plane test that
- * writes nothing: most tests find nothing to cut. */
-static double poly_max(const poly *P, const double n[3])
+/* The largest n . x over P's vertex slots, each n . x kept in S->d for classify() (S->d holds
+ * P->nv: cut_reserve() leaves room for what a cut adds). Free slots sit at the origin, which
+ * every plane of a seed leaves inside; for a wall they can only cost a classification. The test
+ * before a cut, cheap because most tests find nothing to cut. */
+static double poly_max(scratch *S, const double n[3])
 {
-    double m = -INFINITY;
-    for (int32_t k = 0; k < P->nv; k++) {
-        const double *x = P->x + 3 * k;
-        double d = n[0] * x[0] + n[1] * x[1] + n[2] * x[2];
+    const double *x = S->p.x, n0 = n[0], n1 = n[1], n2 = n[2];
+    double m = -INFINITY, *dist = S->d;
+    for (int32_t k = 0, nv = S->p.nv; k < nv; k++) {
+        double d = n0 * x[3 * k] + n1 * x[3 * k + 1] + n2 * x[3 * k + 2];
+        dist[k] = d;
         m = d > m ? d : m;
     }
     return m;
 }
 
-/* Signed distances (in units of |n|) and classes of P's vertices; returns the number outside,
- * *nin the number inside. Free slots get no class. */
-static int classify(scratch *S, const double n[3], double c, double tol, int *nin)
+/* Signed distances (in units of |n|: poly_max()'s n . x less c) and classes of P's vertices;
+ * returns the number outside, *nin the number inside. Free slots get no class. */
+static int classify(scratch *S, double c, double tol, int *nin)
 {
     /* locals, so that the stores (a char may alias anything) force no reloads */
-    const double *x = S->p.x, n0 = n[0], n1 = n[1], n2 = n[2];
     const int32_t *ref = S->p.ref;
     double *dist = S->d;
     unsigned char *cls = S->cls;
     int nout = 0, nins = 0;
     for (int32_t k = 0, nv = S->p.nv; k < nv; k++) {
-        double d = n0 * x[3 * k] + n1 * x[3 * k + 1] + n2 * x[3 * k + 2] - c;
+        double d = dist[k] - c;
         /* without branches: the classes are as good as random, a mispredicted branch costs
          * more than the arithmetic */
         int live = ref[k] >= 0, o = (d > tol) & live, in = (d < -tol) & live;
@@ -200,18 +242,29 @@ static int classify(scratch *S, const double n[3], double c, double tol, int *ni
 /* The new vertex on edge a-b (one inside, one outside), made once per edge (class ON). */
 static int32_t cross_vertex(scratch *S, int32_t a, int32_t b)
 {
+    int32_t in = S->cls[a] == C_IN ? a : b, out = in == a ? b : a;
+    xslot *X = &S->xs[in];
+    if (X->stamp != S->cutno) X->stamp = S->cutno, X->n = 0;
+    for (int32_t q = 0; q < X->n; q++)
+        if (X->o[q] == out) return X->v[q];
     int32_t lo = a < b ? a : b, hi = a < b ? b : a;
-    for (int32_t k = 0; k < S->nxe; k++)
+    for (int32_t k = 0; k < S->nxe && X->n == 3; k++)
         if (S->xe[k].a == lo && S->xe[k].b == hi) return S->xe[k].v;
     poly *P = &S->p;
-    int32_t in = S->cls[a] == C_IN ? a : b, out = in == a ? b : a;
     double t = S->d[in] / (S->d[in] - S->d[out]);
     int32_t k = P->nfree ? P->freel[--P->nfree] : P->nv++;
     const double *xi = P->x + 3 * in, *xo = P->x + 3 * out;
-    for (int q = 0; q < 3; q++) P->x[3 * k + q] = xi[q] + t * (xo[q] - xi[q]);
+    double *x = P->x + 3 * k;
+    for (int q = 0; q < 3; q++) x[q] = xi[q] + t * (xo[q] - xi[q]);
+    P->x2[k] = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
     P->ref[k] = 0;
     S->cls[k] = C_ON;
-    S->xe[S->nxe++] = (xedge){lo, hi, k};
+    if (X->n < 3) {
+        X->o[X->n] = out;
+        X->v[X->n++] = k;
+    } else {
+        S->xe[S->nxe++] = (xedge){lo, hi, k};
+    }
     return k;
 }
 
@@ -238,6 +291,7 @@ static void face_drop(poly *P, int32_t f)
     P->flen[f] = P->flen[g];
     P->fcp[f] = P->fcp[g];
     P->ftag[f] = P->ftag[g];
+    memcpy(P->fpl + 4 * f, P->fpl + 4 * g, 4 * sizeof(double));
 }
 
 /* Face f clipped to the inside, in place (moved to the pool's end if it outgrows its room). */
@@ -288,7 +342,7 @@ static void face_cut(scratch *S, int32_t f)
 
 /* The new face from the recorded edges: pairs met in both directions cancel (two kept faces
  * meeting on the plane), the rest must chain into one loop. -2 when they do not. */
-static int cap_face(scratch *S, int32_t tag)
+static int cap_face(scratch *S, const double n[3], double c, int32_t tag)
 {
     for (int32_t e = 0; e < S->nce; e++)
         for (int32_t g = e + 1; g < S->nce && !S->cdead[e]; g++)
@@ -322,6 +376,8 @@ static int cap_face(scratch *S, int32_t tag)
     P->flen[f] = m;
     P->fcp[f] = m + 4;
     P->ftag[f] = tag;
+    double *q = P->fpl + 4 * f;
+    q[0] = n[0], q[1] = n[1], q[2] = n[2], q[3] = c;
     P->pool += m + 4;
     P->nl += m;
     return 0;
@@ -369,14 +425,14 @@ static void free_dead(poly *P)
 {
     P->r2 = 0;
     for (int32_t k = 0; k < P->nv; k++) {
-        double *x = P->x + 3 * k;
         if (P->ref[k] == 0) {
+            double *x = P->x + 3 * k;
             P->ref[k] = -1;
             x[0] = x[1] = x[2] = 0;
+            P->x2[k] = 0;
             P->freel[P->nfree++] = k;
         }
-        double r2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
-        P->r2 = r2 > P->r2 ? r2 : P->r2;
+        P->r2 = P->x2[k] > P->r2 ? P->x2[k] : P->r2;
     }
 }
 
@@ -386,43 +442,59 @@ static void free_dead(poly *P)
 static int poly_cut(scratch *S, const double n[3], double c, double tol, int32_t tag)
 {
     poly *P = &S->p;
-    if (poly_max(P, n) - c <= tol) return 0;
+    if (poly_max(S, n) - c <= tol) return 0;
     if (cut_reserve(S)) return -1;
-    int nin, nout = classify(S, n, c, tol, &nin);
+    int nin, nout = classify(S, c, tol, &nin);
     if (nout == 0) return 0;
     if (nin == 0) return -2;
     S->nxe = S->nce = 0;
+    if (++S->cutno == 0) { /* wrapped: no stamp may look current */
+        memset(S->xs, 0, (size_t)S->dcap * sizeof(xslot));
+        S->cutno = 1;
+    }
     for (int32_t f = P->nf - 1; f >= 0; f--) face_cut(S, f); /* backwards: drops swap in done faces */
-    int rc = cap_face(S, tag);
+    int rc = cap_face(S, n, c, tag);
     if (rc) return rc;
     free_dead(P);
     return 1;
 }
 
-/* Volume, centroid and second moments (integral of x x^T, about the frame's origin: xx xy xz
- * yy yz zz) of P, from tetrahedra (origin, fan triangles of each face). */
+/* Adds the tetrahedra (origin, fan triangles from L[0] of the loop L of m vertices of x) to
+ * s: 6 V, then 24 V g, then 120 times the integral of x x^T (xx xy xz yy yz zz). */
+static void loop_moments(const double *x, const int32_t *L, int32_t m, double s[10])
+{
+    const double *a = x + 3 * L[0];
+    double u[10]; /* the face's sums in registers (s may alias x for all the compiler knows) */
+    memcpy(u, s, sizeof u);
+    for (int32_t k = 1; k + 1 < m; k++) {
+        const double *b = x + 3 * L[k], *c = x + 3 * L[k + 1];
+        double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                     a[2] * (b[0] * c[1] - b[1] * c[0]);
+        double t[3] = {a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2]};
+        u[0] += det;
+        for (int q = 0; q < 3; q++) u[1 + q] += det * t[q];
+        int idx = 4;
+        for (int p = 0; p < 3; p++)
+            for (int q = p; q < 3; q++)
+                u[idx++] += det * (a[p] * a[q] + b[p] * b[q] + c[p] * c[q] + t[p] * t[q]);
+    }
+    memcpy(s, u, sizeof u);
+}
+
+/* Volume, centroid and second moments about the frame's origin from loop_moments' sums. */
+static void moments_finish(const double s[10], double *vol, double g[3], double m[6])
+{
+    *vol = s[0] / 6;
+    for (int q = 0; q < 3; q++) g[q] = s[0] != 0 ? s[1 + q] / (4 * s[0]) : 0;
+    for (int q = 0; q < 6; q++) m[q] = s[4 + q] / 120;
+}
+
+/* Volume, centroid and second moments (about the frame's origin) of P. */
 static void poly_moments(const poly *P, double *vol, double g[3], double m[6])
 {
-    double V = 0, G[3] = {0, 0, 0}, M[6] = {0, 0, 0, 0, 0, 0};
-    for (int32_t f = 0; f < P->nf; f++) {
-        const int32_t *L = P->fv + P->foff[f];
-        const double *a = P->x + 3 * L[0];
-        for (int32_t k = 1; k + 1 < P->flen[f]; k++) {
-            const double *b = P->x + 3 * L[k], *c = P->x + 3 * L[k + 1];
-            double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                         a[2] * (b[0] * c[1] - b[1] * c[0]);
-            double s[3] = {a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2]};
-            V += det;
-            for (int q = 0; q < 3; q++) G[q] += det * s[q];
-            int idx = 0;
-            for (int p = 0; p < 3; p++)
-                for (int q = p; q < 3; q++)
-                    M[idx++] += det * (a[p] * a[q] + b[p] * b[q] + c[p] * c[q] + s[p] * s[q]);
-        }
-    }
-    *vol = V / 6;
-    for (int q = 0; q < 3; q++) g[q] = V != 0 ? G[q] / (4 * V) : 0;
-    for (int q = 0; q < 6; q++) m[q] = M[q] / 120;
+    double s[10] = {0};
+    for (int32_t f = 0; f < P->nf; f++) loop_moments(P->x, P->fv + P->foff[f], P->flen[f], s);
+    moments_finish(s, vol, g, m);
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -787,11 +859,217 @@ static void sort_unique(int32_t *a, int32_t *n)
     *n = m;
 }
 
-/* Volume, centroid and inertia about the centroid of c from its polyhedron P. */
-static void cell_moments(vcell *c, const poly *P)
+/* ------------------------------------------------------------------------------------------ */
+/* canonical cells: the reported numbers as a function of the final planes                    */
+
+static void cross3(const double a[3], const double b[3], double r[3])
 {
-    double m[6];
-    poly_moments(P, &c->vol, c->cen, m);
+    r[0] = a[1] * b[2] - a[2] * b[1];
+    r[1] = a[2] * b[0] - a[0] * b[2];
+    r[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* The point on planes a, b, c (n0 n1 n2 c each) by Cramer's rule, one fixed formula; returns
+ * the determinant. */
+static double solve3(const double *a, const double *b, const double *c, double x[3])
+{
+    double u[3], w[3], z[3];
+    cross3(b, c, u);
+    cross3(c, a, w);
+    cross3(a, b, z);
+    double det = dot3(a, u);
+    for (int q = 0; q < 3; q++) x[q] = (a[3] * u[q] + b[3] * w[q] + c[3] * z[q]) / det;
+    return det;
+}
+
+/* The conditioning of planes a, b, c given their determinant: |det| / (|n_a| |n_b| |n_c|). */
+static double conditioning(const double *a, const double *b, const double *c, double det)
+{
+    double nn = sqrt(dot3(a, a) * dot3(b, b) * dot3(c, c));
+    return nn > 0 ? fabs(det) / nn : 0;
+}
+
+/* A vertex's canonical position from the planes of its faces (F[0..d), sorted by tag): of
+ * three planes, their point; of more (degenerate input), the first triple in lexicographic
+ * order whose conditioning reaches V3_COND, else the best-conditioned one (the first of
+ * equals), trying only the lowest V3_MAXDEG planes. Keeps the cut's position xcut when the
+ * solution is not finite or lies farther than V3_SNAP R from it (a triple too close to
+ * singular). */
+static void vertex_canon(const poly *P, const int32_t *F, int32_t d, const double *xcut,
+                         double R, double x[3])
+{
+    if (d == 3) {
+        solve3(P->fpl + 4 * F[0], P->fpl + 4 * F[1], P->fpl + 4 * F[2], x);
+    } else {
+        double best = -1, y[3];
+        d = d < V3_MAXDEG ? d : V3_MAXDEG;
+        memcpy(x, xcut, 3 * sizeof(double));
+        for (int32_t a = 0; a < d && best < V3_COND; a++)
+            for (int32_t b = a + 1; b < d && best < V3_COND; b++)
+                for (int32_t c = b + 1; c < d && best < V3_COND; c++) {
+                    const double *pa = P->fpl + 4 * F[a], *pb = P->fpl + 4 * F[b], *pc = P->fpl + 4 * F[c];
+                    double cond = conditioning(pa, pb, pc, solve3(pa, pb, pc, y));
+                    if (cond > best) {
+                        best = cond;
+                        memcpy(x, y, sizeof y);
+                    }
+                }
+    }
+    double e[3] = {x[0] - xcut[0], x[1] - xcut[1], x[2] - xcut[2]};
+    if (!(dot3(e, e) <= V3_SNAP * V3_SNAP * R * R)) memcpy(x, xcut, 3 * sizeof(double));
+}
+
+static int canon_reserve(scratch *S)
+{
+    const poly *P = &S->p;
+    int32_t c[3] = {S->canv, S->canv, S->canv}, l = S->canl, f = S->canf;
+    if (grow((void **)&S->voff, &c[0], P->nv + 1, sizeof(int32_t)) ||
+        grow((void **)&S->vkey, &c[1], P->nv + 1, sizeof(vkey)) ||
+        grow((void **)&S->vord, &c[2], P->nv + 1, sizeof(int32_t)) ||
+        grow((void **)&S->vfac, &l, P->nl, sizeof(int32_t)) ||
+        grow((void **)&S->ford, &f, P->nf, sizeof(int32_t)))
+        return -1;
+    S->canv = c[0];
+    S->canl = l;
+    S->canf = f;
+    return 0;
+}
+
+/* A tag as an unsigned key of the same order. */
+static uint64_t tag_key(int32_t t)
+{
+    return (uint64_t)((uint32_t)t ^ 0x80000000u);
+}
+
+/* Faces F[0..3) sorted by tag, without branches (the order is as good as random). */
+static void sort3(const int32_t *tag, int32_t F[3])
+{
+    int32_t a = F[0], b = F[1], c = F[2], t;
+    int s = tag[a] > tag[b];
+    t = s ? a : b, a = s ? b : a, b = t;
+    s = tag[b] > tag[c];
+    t = s ? b : c, b = s ? c : b, c = t;
+    s = tag[a] > tag[b];
+    t = s ? a : b, a = s ? b : a, b = t;
+    F[0] = a, F[1] = b, F[2] = c;
+}
+
+/* Each live slot's faces, sorted by tag, into vfac[voff[k] .. voff[k + 1]), and its key (its
+ * three lowest tags) into vkey[k]. -2 when a vertex has fewer than three faces (not a closed
+ * polyhedron). */
+static int vertex_faces(scratch *S)
+{
+    const poly *P = &S->p;
+    int32_t *fill = S->remap;
+    S->voff[0] = 0;
+    for (int32_t k = 0; k < P->nv; k++) {
+        S->voff[k + 1] = S->voff[k] + (P->ref[k] > 0 ? P->ref[k] : 0);
+        fill[k] = S->voff[k];
+    }
+    for (int32_t f = 0; f < P->nf; f++) {
+        const int32_t *L = P->fv + P->foff[f];
+        for (int32_t k = 0; k < P->flen[f]; k++) S->vfac[fill[L[k]]++] = f;
+    }
+    for (int32_t k = 0; k < P->nv; k++) {
+        if (P->ref[k] < 0) continue;
+        int32_t *F = S->vfac + S->voff[k], d = S->voff[k + 1] - S->voff[k];
+        if (d < 3) return -2;
+        if (d == 3) {
+            sort3(P->ftag, F);
+        } else {
+            for (int32_t a = 1; a < d; a++) {
+                int32_t t = F[a], m = a;
+                for (; m > 0 && P->ftag[F[m - 1]] > P->ftag[t]; m--) F[m] = F[m - 1];
+                F[m] = t;
+            }
+        }
+        S->vkey[k] = (vkey){tag_key(P->ftag[F[0]]) << 32 | tag_key(P->ftag[F[1]]),
+                            tag_key(P->ftag[F[2]]), k};
+    }
+    return 0;
+}
+
+/* Vertex a before vertex b: their tags in lexicographic order (a prefix first); equal lists
+ * (two vertices on the same planes: degenerate input only) by slot. */
+static int vertex_before(const scratch *S, const vkey *a, const vkey *b)
+{
+    if (a->hi != b->hi) return a->hi < b->hi;
+    if (a->lo != b->lo) return a->lo < b->lo;
+    const int32_t *A = S->vfac + S->voff[a->slot], *B = S->vfac + S->voff[b->slot];
+    int32_t na = S->voff[a->slot + 1] - S->voff[a->slot], nb = S->voff[b->slot + 1] - S->voff[b->slot];
+    for (int32_t k = 3; k < na && k < nb; k++)
+        if (S->p.ftag[A[k]] != S->p.ftag[B[k]]) return S->p.ftag[A[k]] < S->p.ftag[B[k]];
+    return na != nb ? na < nb : a->slot < b->slot;
+}
+
+/* The faces by tag into ford: each face's rank is the count of smaller tags (one face per
+ * plane, so the tags differ; counting has no unpredictable branch, unlike a sort). */
+static void face_order(scratch *S)
+{
+    const poly *P = &S->p;
+    for (int32_t f = 0; f < P->nf; f++) {
+        int32_t r = 0, t = P->ftag[f];
+        for (int32_t g = 0; g < P->nf; g++) r += P->ftag[g] < t;
+        S->ford[r] = f;
+    }
+}
+
+/* The canonical loops and tags of P into c: faces by tag, each loop from its vertex of lowest
+ * key, the vertices numbered in order of first appearance along the loops so written (their
+ * slots in vord, their numbers in remap). */
+static void cell_loops(scratch *S, vcell *c)
+{
+    const poly *P = &S->p;
+    int32_t n = 0;
+    for (int32_t k = 0; k < P->nv; k++) S->remap[k] = -1;
+    c->foff[0] = 0;
+    for (int32_t q = 0; q < P->nf; q++) {
+        int32_t f = S->ford[q], m = P->flen[f], lo = 0;
+        const int32_t *L = P->fv + P->foff[f];
+        for (int32_t k = 1; k < m; k++) {
+            const vkey *a = &S->vkey[L[k]], *b = &S->vkey[L[lo]];
+            /* the keys differ but at degenerate vertices: decide those in full */
+            int less = (a->hi < b->hi) | ((a->hi == b->hi) & (a->lo < b->lo));
+            if (a->hi == b->hi && a->lo == b->lo) less = vertex_before(S, a, b);
+            lo = less ? k : lo;
+        }
+        int32_t *out = c->fv + c->foff[q];
+        for (int32_t k = 0, j = lo; k < m; k++, j = j + 1 < m ? j + 1 : 0) {
+            int32_t u = L[j], fresh = S->remap[u] < 0; /* first seen: the next number */
+            S->vord[n] = u;
+            S->remap[u] = fresh ? n : S->remap[u];
+            n += fresh;
+            out[k] = S->remap[u];
+        }
+        c->foff[q + 1] = c->foff[q] + m;
+        c->ftag[q] = P->ftag[f];
+    }
+}
+
+/* The canonical positions of P's vertices into c, in vord's order. */
+static void cell_vertices(const scratch *S, vcell *c)
+{
+    const poly *P = &S->p;
+    double R = sqrt(P->r2);
+    for (int32_t m = 0; m < c->nv; m++) {
+        int32_t k = S->vord[m];
+        vertex_canon(P, S->vfac + S->voff[k], S->voff[k + 1] - S->voff[k], P->x + 3 * k, R,
+                     c->x + 3 * m);
+    }
+}
+
+/* Volume, centroid and inertia about the centroid of c from its own vertices and loops. */
+static void cell_moments(vcell *c)
+{
+    double s[10] = {0}, m[6];
+    for (int32_t f = 0; f < c->nf; f++)
+        loop_moments(c->x, c->fv + c->foff[f], c->foff[f + 1] - c->foff[f], s);
+    moments_finish(s, &c->vol, c->cen, m);
     /* about the centroid: integral of r r^T less V g g^T; inertia = tr Id - that */
     const double *g = c->cen;
     double C[6] = {m[0] - c->vol * g[0] * g[0], m[1] - c->vol * g[0] * g[1],
@@ -806,16 +1084,19 @@ static void cell_moments(vcell *c, const poly *P)
     c->inr[5] = tr - C[5];
 }
 
-/* The finished polyhedron and cutters packed into one block. */
-static vcell *cell_pack(scratch *S)
+/* The finished polyhedron, made canonical, and its cutters packed into one block: GP_OK and
+ * *out, or an error status. */
+static gp_status cell_pack(scratch *S, vcell **out)
 {
     const poly *P = &S->p;
+    if (canon_reserve(S)) return GP_ERR_NOMEM;
+    if (vertex_faces(S)) return GP_ERR_INTERNAL;
     sort_unique(S->cut, &S->ncut);
     int32_t nnb = 0, nv = P->nv - P->nfree;
     for (int32_t f = 0; f < P->nf; f++) nnb += P->ftag[f] >= 0;
     size_t ni = (size_t)(P->nf + 1) + (size_t)P->nl + (size_t)P->nf + (size_t)nnb + (size_t)S->ncut;
     vcell *c = malloc(sizeof(vcell) + 3 * (size_t)nv * sizeof(double) + ni * sizeof(int32_t));
-    if (!c) return NULL;
+    if (!c) return GP_ERR_NOMEM;
     c->nv = nv;
     c->nf = P->nf;
     c->nl = P->nl;
@@ -825,26 +1106,17 @@ static vcell *cell_pack(scratch *S)
     c->fv = c->foff + P->nf + 1;
     c->ftag = c->fv + P->nl;
     c->nb = c->ftag + P->nf;
-    /* the live slots numbered in order, the loops one after the other */
-    for (int32_t k = 0, m = 0; k < P->nv; k++) {
-        S->remap[k] = P->ref[k] < 0 ? -1 : m;
-        if (P->ref[k] >= 0) memcpy(c->x + 3 * m++, P->x + 3 * k, 3 * sizeof(double));
-    }
-    c->foff[0] = 0;
-    for (int32_t f = 0; f < P->nf; f++) {
-        const int32_t *L = P->fv + P->foff[f];
-        for (int32_t k = 0; k < P->flen[f]; k++) c->fv[c->foff[f] + k] = S->remap[L[k]];
-        c->foff[f + 1] = c->foff[f] + P->flen[f];
-    }
-    memcpy(c->ftag, P->ftag, (size_t)P->nf * sizeof(int32_t));
+    face_order(S);
+    cell_loops(S, c);
+    cell_vertices(S, c);
     c->nnb = 0;
     for (int32_t f = 0; f < P->nf; f++)
-        if (P->ftag[f] >= 0) c->nb[c->nnb++] = P->ftag[f];
-    sort_unique(c->nb, &c->nnb);
+        if (c->ftag[f] >= 0) c->nb[c->nnb++] = c->ftag[f]; /* ascending: the faces are by tag */
     c->cut = c->nb + c->nnb;
     if (S->ncut > 0) memcpy(c->cut, S->cut, (size_t)S->ncut * sizeof(int32_t)); /* NULL when 0 */
-    cell_moments(c, P);
-    return c;
+    cell_moments(c);
+    *out = c;
+    return GP_OK;
 }
 
 /* Cell i computed from the current seeds: GP_OK and *out, or an error status. */
@@ -859,8 +1131,7 @@ static gp_status cell_compute(gp_voronoi3d *v, uint32_t i, vcell **out)
     if (rc) return GP_ERR_INTERNAL;
     for (int32_t f = 0; f < S->p.nf; f++)
         if (S->p.ftag[f] <= TAG_BBOX + 5) return GP_ERR_INTERNAL;
-    *out = cell_pack(S);
-    return *out ? GP_OK : GP_ERR_NOMEM;
+    return cell_pack(S, out);
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -1195,6 +1466,7 @@ static void scratch_free(scratch *S)
     free(S->cls);
     free(S->remap);
     free(S->xe);
+    free(S->xs);
     free(S->cf);
     free(S->ct);
     free(S->cdead);
@@ -1202,6 +1474,11 @@ static void scratch_free(scratch *S)
     free(S->cd2);
     free(S->cnt);
     free(S->cut);
+    free(S->voff);
+    free(S->vkey);
+    free(S->vfac);
+    free(S->vord);
+    free(S->ford);
 }
 
 void gp_voronoi3d_destroy(gp_voronoi3d *v)

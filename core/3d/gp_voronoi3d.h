@@ -56,6 +56,31 @@
  * face of area ~1e-20 of the cell's surface on one cell and not on its neighbour; the
  * volumes are unaffected, and the neighbour relation is mutual for every face above that.
  *
+ * Canonical cells: the same planes give the same bits. The cutting leaves each vertex where its
+ * history put it (an edge's crossing with a plane, interpolated on an intermediate polyhedron
+ * that other cut orders never build), so the finished polyhedron is rewritten from its planes
+ * alone. A face's plane is the one it was cut with, a function of its tag and the seeds only:
+ * for seed j, n = s_j - s_i and c = |n|^2 / 2 (coordinates relative to the container's
+ * bounding box's lower corner, n . x <= c in cell i's seed frame); for a wall, the container's
+ * half-space moved to that frame. Each vertex is recomputed from the planes of the faces
+ * that meet at it, sorted by tag: from three (the generic case) their point by Cramer's rule
+ * in that order; from four or more (degenerate input), the first triple in lexicographic order
+ * of tags whose conditioning |det| / (|n_a| |n_b| |n_c|) reaches 1e-3, else the
+ * best-conditioned (of the lowest 16 planes), so a near-singular triple is not used where a
+ * sound one exists. The faces are written in increasing tag (the walls, -1 - k, first), each
+ * loop from its vertex of lowest key (the sorted list of its faces' tags, lexicographic), the
+ * vertices numbered in order of first appearance along the loops so written; volume, centroid
+ * and inertia are integrated from those vertices in that order. So every reported number of a
+ * cell (vertices and their order, loops, neighbour ids, volume, centroid, inertia) is a
+ * function of its seed and its final planes, not of the order or the history of its cuts. A
+ * recomputed vertex lies within about 1e-16 R / conditioning of the cut's (7e-13 R at most
+ * on random seeds, 2.4e-10 R with lattices, co-spherical seeds and scaled containers); one
+ * farther than 1e-6 R, or not finite, would keep the cut's position (a guard, never met in
+ * the tests). Cost: about 10 % of a cell's instructions, a third of it bought back in the
+ * cuts (the plane test's dot products reused by the classification; an edge's new vertex
+ * found from its inside vertex, not by a search; |x|^2 kept per vertex): 7 % more
+ * instructions per cell in all (docs/design/voronoi3d.md has the times).
+ *
  * Local updates. Lemma: cell j (j != i) changes when seed i moves from a to b only if i is a
  * neighbour of j before or after the move. Proof: V_j = W_j intersected with H_ji, with
  * W_j = D intersected with H_jk over k != i, j, which the move does not change. If i is not a
@@ -66,15 +91,17 @@
  * it (read from the new cell i, computed first). gp_voronoi3d_try_move() recomputes those --
  * taken from the seeds whose planes cut cell i while it was being built, a superset of its
  * neighbours, so that a face at the tolerance's edge is still covered -- with the same
- * function as the full build (the grid search), so a
- * recomputed cell is bit for bit the one a rebuild gives. A cell that is not recomputed is
- * mathematically unchanged, but its bits come from its own last computation, in which the
- * moved seed may have cut an intermediate polyhedron (then rounding at 1e-16 of the cell
- * differs from a rebuild's); so the guarantee after any sequence of moves is: neighbour sets
- * identical to a rebuild's (barring the one-sided slivers of degenerate inputs above, which
- * a move can leave behind), and each cell's volume, centroid and inertia within 1e-12
- * relative (test_voronoi3d checks 10,000 moves, committed or rolled back at random, against
- * a rebuild after every one).
+ * function as the full build (the grid search). A cell that is not recomputed keeps its final
+ * planes, and its bits are a function of them (canonical cells, above), even where the moved
+ * seed cut one of its intermediate polyhedra. So after any sequence of moves, committed or
+ * rolled back, every cell is bit for bit the one a full rebuild of the same seeds gives:
+ * vertices, loops, neighbours, volume, centroid and inertia (test_voronoi3d compares every
+ * cell after each of 10,000 moves on random seeds in a box and in a cylinder, with memcmp).
+ * The one exception is degenerate input, where four or more planes meet within the cutting
+ * tolerance: there the cut order can decide which of the coincident planes keeps a face (or a
+ * one-sided sliver, above), and a cell not recomputed keeps the choice of its last
+ * computation; the volumes still agree to 1e-12 (on a cubic lattice with moves to its quarter
+ * points every cell was bit-equal all the same).
  *
  * Memory. One block per cell (vertices, loops, face tags, neighbours, cutters), replaced when
  * the cell is recomputed: about 1.4 KB a cell in all (150 MB for 10^5 random seeds).
@@ -85,7 +112,8 @@
  * the origin behaves the same. Output coordinates are the caller's.
  *
  * Determinism: single-threaded; the tessellation is a pure function of the container and the
- * seeds (bit for bit on one build of the code), and after moves equal to one as stated above.
+ * seeds (bit for bit on one build of the code), and after any sequence of moves bit for bit
+ * the tessellation of the current seeds (barring degenerate input, above).
  *
  * Ownership: gp_voronoi3d_create() copies the caller's arrays; the object owns everything and
  * gp_voronoi3d_destroy() frees it. Thread safety: one object per thread for moves; queries
@@ -157,8 +185,9 @@ size_t gp_voronoi3d_cell_vertices(const gp_voronoi3d *v, size_t i, double *xyz, 
 size_t gp_voronoi3d_cell_face_count(const gp_voronoi3d *v, size_t i);
 /* Face f of cell i: its vertex loop (indices into the cell's vertices, counter-clockwise seen
  * from outside the cell) written into loop (at most cap), and in *neighbour (may be NULL) the
- * seed across it or a negative wall id (-1 - k). Returns the loop's length (0 for a bad
- * index). */
+ * seed across it or a negative wall id (-1 - k). The faces come in increasing neighbour id
+ * (walls first), each loop from its canonical first vertex (see "Canonical cells"). Returns
+ * the loop's length (0 for a bad index). */
 size_t gp_voronoi3d_cell_face(const gp_voronoi3d *v, size_t i, size_t f, uint32_t *loop,
                               size_t cap, int32_t *neighbour);
 /* The neighbour seeds of cell i (ascending, no repeats) into out (at most cap); returns their
