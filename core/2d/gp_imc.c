@@ -472,11 +472,16 @@ static void hist_errors(const imc_state *s, int kind, double *es, double *et)
  * as the sample COV (n - 1) the user measures: not that of the law's N quantiles, which is
  * below it at small N (-3.5 % at N = 500, COV 1.2: the largest quantile is the 1 - 1/2N one);
  * the largest cells take up the difference at little cost in A^2 (docs/design/imc.md). */
+double gp_imc_cov_term(size_t n, double mu, double cov_t, double sum_sq)
+{
+    double nn = (double)n, var = sum_sq / nn - mu * mu;
+    double c = sqrt(var > 0 ? var : 0) / mu, r = c / cov_t - 1.0;
+    return nn * r * r;
+}
+
 static double cov_term_of(const imc_state *s, double sum_sq)
 {
-    double n = (double)s->n, var = sum_sq / n - s->mu * s->mu;
-    double c = sqrt(var > 0 ? var : 0) / s->mu, r = c / s->cov_t - 1.0;
-    return n * r * r;
+    return gp_imc_cov_term(s->n, s->mu, s->cov_t, sum_sq);
 }
 
 static void ad_errors(const imc_state *s, double *es, double *et)

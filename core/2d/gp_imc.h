@@ -140,6 +140,11 @@ typedef enum gp_imc_stop {
     GP_IMC_STOP_SINGLE_CELL  /* N = 1: the cell is the container, nothing can move */
 } gp_imc_stop;
 
+/* The COV term of the AD size excess: n (COV / cov_t - 1)^2 for n values of mean mu whose
+ * squares sum to sum_sq (COV the population one; cov_t the population COV aimed at, that of
+ * the law as a sample COV: gp_imc.c cov_term_of says why). Shared with the 3D IMC. */
+double gp_imc_cov_term(size_t n, double mu, double cov_t, double sum_sq);
+
 /* Steps without a 1 % gain of the AD error after which a run stops as "stalled":
  * 20,000 + 50 N (a few seconds at most at small N, where the least error of N cells can lie
  * above the threshold; far beyond the gaps between gains of a run that still converges). */

@@ -296,9 +296,7 @@ static void cell_put(state *S, size_t i, const cell_val *c)
 
 static double cov_term(const state *S, double sum_sq)
 {
-    double n = (double)S->n, var = sum_sq / n - S->mu * S->mu;
-    double c = sqrt(var > 0 ? var : 0) / S->mu, r = c / S->cov_t - 1.0;
-    return n * r * r;
+    return gp_imc_cov_term(S->n, S->mu, S->cov_t, sum_sq);
 }
 
 static objective objective_of(double ev, double eo)
@@ -475,26 +473,28 @@ static int point_in_cell(const gp_voronoi3d *v, size_t i, cellbuf *b, gp_rng *r,
     return 0;
 }
 
-/* the paper's move: a cell of {i} and its neighbours, chosen by volume */
-static size_t cell_by_volume(const gp_voronoi3d *v, size_t i, cellbuf *b, gp_rng *r)
+/* the paper's move: a cell of {i} and its neighbours, chosen by volume (vol: every cell's
+ * current volume, the run's recorded values) */
+static size_t cell_by_volume(const gp_voronoi3d *v, const cell_val *vol, size_t i, cellbuf *b, gp_rng *r)
 {
     size_t k = gp_voronoi3d_neighbours(v, i, NULL, 0);
     if (!grow((void **)&b->nb, &b->nb_cap, k, sizeof(size_t))) return i;
     gp_voronoi3d_neighbours(v, i, b->nb, k);
-    double total = gp_voronoi3d_cell_volume(v, i);
-    for (size_t j = 0; j < k; j++) total += gp_voronoi3d_cell_volume(v, b->nb[j]);
-    double t = gp_rng_uniform(r) * total - gp_voronoi3d_cell_volume(v, i);
+    double total = vol[i].vk;
+    for (size_t j = 0; j < k; j++) total += vol[b->nb[j]].vk;
+    double t = gp_rng_uniform(r) * total - vol[i].vk;
     for (size_t j = 0; j < k && t >= 0.0; j++) {
-        t -= gp_voronoi3d_cell_volume(v, b->nb[j]);
+        t -= vol[b->nb[j]].vk;
         if (t < 0.0) return b->nb[j];
     }
     return i;
 }
 
-static int propose(const gp_voronoi3d *v, const shape *s, size_t i, cellbuf *b, gp_rng *r, double q[3])
+static int propose(const gp_voronoi3d *v, const cell_val *vol, const shape *s, size_t i, cellbuf *b, gp_rng *r,
+                   double q[3])
 {
     double u = gp_rng_uniform(r);
-    if (u < 0.4) return point_in_cell(v, cell_by_volume(v, i, b, r), b, r, q);
+    if (u < 0.4) return point_in_cell(v, cell_by_volume(v, vol, i, b, r), b, r, q);
     if (u < 0.8) return point_in_cell(v, i, b, r, q);
     return point_in_box(s, r, q);
 }
@@ -516,7 +516,7 @@ typedef struct run {
 static int step(run *R, gp_voronoi3d *v, size_t i, gp_error *err)
 {
     double q[3];
-    if (!propose(v, &R->sh, i, &R->b, R->r, q)) return 0;
+    if (!propose(v, R->S.val, &R->sh, i, &R->b, R->r, q)) return 0;
     gp_error e;
     gp_status st = gp_voronoi3d_try_move(v, i, q, &e);
     if (st == GP_ERR_INVALID) return 0; /* a duplicate of another seed, or outside */
