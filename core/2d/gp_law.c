@@ -35,6 +35,7 @@ struct gp_law {
     size_t nrows;
     double *d, *pw, *slope, *cum;
     double ztot;
+    int dim; /* 2: A = pi d^2 / 4, mass ~ d^2; 3: volumes V = pi d^3 / 6, mass ~ d^3 */
     /* tail law for bounded kinds: lognormal (tm, ts) */
     double tm, ts;
     /* a powered law (gp_law_powered): A = lam B^kappa, B the law above (the "base"; every
@@ -119,6 +120,7 @@ static gp_law *law_alloc(gp_law_kind kind)
         l->kind = kind;
         l->scale = 1.0;
         l->kappa = l->lam = 1.0;
+        l->dim = 2;
     }
     return l;
 }
@@ -177,7 +179,19 @@ static gp_status sieve_check(const double *d, const double *pw, size_t n, gp_err
     return GP_OK;
 }
 
-gp_law *gp_law_create_sieve(const double *d, const double *pw, size_t n, gp_error *err)
+/* the number weight of a bin [a, b] of mass slope s: the integral of s / x^dim */
+static double sieve_bin_weight(int dim, double s, double a, double x)
+{
+    return dim == 2 ? s * (1.0 / a - 1.0 / x) : 0.5 * s * (1.0 / (a * a) - 1.0 / (x * x));
+}
+
+/* the size of a grain of diameter x: its area (dim 2) or volume (dim 3) */
+static double sieve_size(int dim, double x)
+{
+    return dim == 2 ? LAW_PI / 4 * x * x : LAW_PI / 6 * x * x * x;
+}
+
+static gp_law *sieve_create(const double *d, const double *pw, size_t n, int dim, gp_error *err)
 {
     if (sieve_check(d, pw, n, err) != GP_OK) return NULL;
     gp_law *l = law_alloc(GP_LAW_SIEVE);
@@ -190,27 +204,39 @@ gp_law *gp_law_create_sieve(const double *d, const double *pw, size_t n, gp_erro
     memcpy(l->d, d, n * sizeof *d);
     memcpy(l->pw, pw, n * sizeof *pw);
     l->nrows = n;
-    /* number weight of bin k: integral of s_k / d^2 = s_k (1/d_k - 1/d_k+1); moments of
-     * A = pi d^2 / 4 by number: E[A] Z = (pi/4) sum s_k dd_k, E[A^2] Z = (pi^2/16) sum s_k
-     * (d_k+1^3 - d_k^3) / 3 */
-    double z = 0.0, ea = 0.0, ea2 = 0.0;
+    l->dim = dim;
+    /* a grain's size is c x^dim and its mass ~ x^dim, so the number density of bin k is
+     * s_k / x^dim; by number E[A] Z = c sum s_k (b - a) and E[A^2] Z = c^2 sum s_k
+     * (b^(dim+1) - a^(dim+1)) / (dim + 1) */
+    double z = 0.0, ea = 0.0, ea2 = 0.0, c = sieve_size(dim, 1.0);
     for (size_t k = 0; k + 1 < n; k++) {
         double a = d[k], b = d[k + 1], s = (pw[k + 1] - pw[k]) / (b - a);
         l->slope[k] = s;
         l->cum[k] = z;
-        z += s * (1.0 / a - 1.0 / b);
+        z += sieve_bin_weight(dim, s, a, b);
         ea += s * (b - a);
-        ea2 += s * (b * b * b - a * a * a) / 3.0;
+        ea2 += dim == 2 ? s * (b * b * b - a * a * a) / 3.0 : s * (b * b * b * b - a * a * a * a) / 4.0;
     }
     l->cum[n - 1] = z;
     l->ztot = z;
-    l->lo = LAW_PI / 4 * d[0] * d[0];
-    l->hi = LAW_PI / 4 * d[n - 1] * d[n - 1];
-    l->mean = LAW_PI / 4 * ea / z;
-    double m2 = LAW_PI * LAW_PI / 16 * ea2 / z, var = m2 - l->mean * l->mean;
+    l->lo = sieve_size(dim, d[0]);
+    l->hi = sieve_size(dim, d[n - 1]);
+    l->mean = c * ea / z;
+    double c2 = dim == 2 ? LAW_PI * LAW_PI / 16 : LAW_PI * LAW_PI / 36;
+    double m2 = c2 * ea2 / z, var = m2 - l->mean * l->mean;
     l->cov = sqrt(var > 0 ? var : 0) / l->mean;
     lognormal_params(l->mean, l->cov > 1 ? l->cov : 1.0, &l->tm, &l->ts);
     return l;
+}
+
+gp_law *gp_law_create_sieve(const double *d, const double *pw, size_t n, gp_error *err)
+{
+    return sieve_create(d, pw, n, 2, err);
+}
+
+gp_law *gp_law_create_sieve3d(const double *d, const double *pw, size_t n, gp_error *err)
+{
+    return sieve_create(d, pw, n, 3, err);
 }
 
 gp_law *gp_law_scaled(const gp_law *src, double factor, gp_error *err)
@@ -227,7 +253,7 @@ gp_law *gp_law_scaled(const gp_law *src, double factor, gp_error *err)
     *l = *src;
     l->d = l->pw = l->slope = l->cum = NULL;
     if (src->kind == GP_LAW_SIEVE) {
-        gp_law *c = gp_law_create_sieve(src->d, src->pw, src->nrows, err);
+        gp_law *c = sieve_create(src->d, src->pw, src->nrows, src->dim, err);
         if (!c) {
             free(l);
             return NULL;
@@ -410,6 +436,40 @@ static double sieve_quantile_d(const gp_law *l, double p)
     return fmin(fmax(x, l->d[k]), l->d[k + 1]);
 }
 
+/* sieve on volumes: the number CDF at base-unit volume v. In bin k (lower row a, volume v_a)
+ * the weight s / (2 a^2) (1 - (v_a / v)^(2/3)) is taken as -expm1(-(2/3) log1p((v - v_a) / v_a)):
+ * v - v_a is exact near v_a, so the CDF keeps its relative precision at the bottom of a bin */
+static double sieve3_cdf_v(const gp_law *l, double v)
+{
+    size_t n = l->nrows;
+    double x = cbrt(6.0 * v / LAW_PI);
+    if (x <= l->d[0] && v <= l->lo) return 0.0;
+    if (v >= l->hi) return 1.0;
+    size_t lo = 0, hi = n - 1;
+    while (hi - lo > 1) {
+        size_t mid = (lo + hi) / 2;
+        if (l->d[mid] <= x) lo = mid; else hi = mid;
+    }
+    double a = l->d[lo], va = sieve_size(3, a), r = (v - va) / va;
+    double w = r > 0 ? l->slope[lo] / (2.0 * a * a) * -expm1(-2.0 / 3.0 * log1p(r)) : 0.0;
+    return fmin(1.0, (l->cum[lo] + w) / l->ztot);
+}
+
+/* its quantile: t - cum = s / (2 a^2) (1 - (v_a / v)^(2/3)) solved for v */
+static double sieve3_quantile_v(const gp_law *l, double p)
+{
+    size_t n = l->nrows;
+    double t = p * l->ztot;
+    size_t k = 0;
+    while (k + 2 < n && l->cum[k + 1] <= t) k++;
+    while (k + 2 < n && l->slope[k] == 0.0) k++;
+    double va = sieve_size(3, l->d[k]), vb = sieve_size(3, l->d[k + 1]);
+    if (l->slope[k] == 0.0) return va;
+    double a = l->d[k], e = 2.0 * a * a * (t - l->cum[k]) / l->slope[k];
+    double v = e < 1.0 ? va * exp(-1.5 * log1p(-e)) : vb;
+    return fmin(fmax(v, va), vb);
+}
+
 static double base_cdf(const gp_law *l, double a)
 {
     if (!(a > 0)) return 0.0;
@@ -423,6 +483,7 @@ static double base_cdf(const gp_law *l, double a)
     case GP_LAW_UNIFORM:
         return a <= l->lo ? 0.0 : a >= l->hi ? 1.0 : (a - l->lo) / (l->hi - l->lo);
     case GP_LAW_SIEVE:
+        if (l->dim == 3) return sieve3_cdf_v(l, a / l->scale);
         return sieve_cdf_d(l, sqrt(4.0 * (a / l->scale) / LAW_PI));
     }
     return NAN;
@@ -444,6 +505,7 @@ static double base_quantile(const gp_law *l, double p)
     case GP_LAW_UNIFORM:
         return l->lo + p * (l->hi - l->lo);
     case GP_LAW_SIEVE: {
+        if (l->dim == 3) return sieve3_quantile_v(l, p) * l->scale;
         double x = sieve_quantile_d(l, p);
         return LAW_PI / 4 * x * x * l->scale;
     }

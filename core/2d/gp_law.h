@@ -10,7 +10,8 @@
  *     (d = sqrt(4 A / pi); 2D mass is proportional to area). Between sieves the mass is
  *     uniform in d (passing linear in d), the convention of gp_sieve for 3D. The number
  *     density in d is then proportional to s_k / d^2 in bin k (s_k the mass per unit d), which
- *     gives the number CDF, quantile, mean and COV of A in closed form.
+ *     gives the number CDF, quantile, mean and COV of A in closed form. The same curve on
+ *     volumes (gp_law_create_sieve3d: d = (6 V / pi)^(1/3), mass ~ V) is the 3D law.
  * Every law can be scaled (A -> factor A): a grain law is the cell law scaled by the solid
  * fraction, and a sieve law is put on cells by scaling with 1 / solid fraction.
  *
@@ -61,6 +62,11 @@ gp_law *gp_law_create(gp_law_kind kind, double mean, double cov, gp_error *err);
 /* A sieve law on areas: n >= 2 rows, d strictly increasing and > 0 (length units of the
  * areas), pw non-decreasing from 0 to 100 (percent passing by mass, within 1e-9). */
 gp_law *gp_law_create_sieve(const double *d, const double *pw, size_t n, gp_error *err);
+
+/* The same on volumes V = pi d^3 / 6 with mass proportional to V (the 3D grains of
+ * gp_fv3d.h): in bin k the number density is s_k / d^3. Scaled, powered and queried as any law;
+ * gp_law_sieve_rows gives its rows. */
+gp_law *gp_law_create_sieve3d(const double *d, const double *pw, size_t n, gp_error *err);
 
 /* The same law with every area multiplied by factor > 0. */
 gp_law *gp_law_scaled(const gp_law *law, double factor, gp_error *err);

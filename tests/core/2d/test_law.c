@@ -276,6 +276,59 @@ static void test_sieve(void)
     gp_law_destroy(l);
 }
 
+/* the sieve on volumes: number density s_k / d^3, V = pi d^3 / 6, integrated by the test */
+static double vol3(double d) { return M_PI / 6 * d * d * d; }
+
+static void test_sieve3d(void)
+{
+    gp_error e;
+    gp_law *l = gp_law_create_sieve3d(SD, SP, 5, &e);
+    CHECK(l != NULL);
+    if (!l) return;
+    double z = 0, e1 = 0, e2 = 0, cdf[5] = {0};
+    for (int k = 0; k < 4; k++) {
+        const int n = 20000;
+        double a = SD[k], h = (SD[k + 1] - a) / n, s = (SP[k + 1] - SP[k]) / (SD[k + 1] - a);
+        for (int i = 0; i <= n; i++) {
+            double d = a + i * h, w = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2), nd = w * h / 3 * s / (d * d * d);
+            z += nd;
+            e1 += nd * vol3(d);
+            e2 += nd * vol3(d) * vol3(d);
+        }
+        cdf[k + 1] = z;
+    }
+    double mean = e1 / z, cov = sqrt(e2 / z - mean * mean) / mean;
+    for (int k = 0; k < 5; k++) CHECK_NEAR(gp_law_cdf(l, vol3(SD[k])), cdf[k] / z, 1e-11);
+    CHECK_REL(gp_law_mean(l), mean, 1e-11);
+    CHECK_REL(gp_law_cov(l), cov, 1e-10);
+    double lo, hi;
+    gp_law_support(l, &lo, &hi);
+    CHECK_REL(lo, vol3(0.5), 1e-15);
+    CHECK_REL(hi, vol3(4), 1e-15);
+    check_round_trip(l);
+    for (int i = 1; i < 100; i++) {
+        double a = lo + (hi - lo) * i / 100.0;
+        CHECK_REL(gp_law_quantile(l, gp_law_cdf(l, a)), a, 1e-11);
+    }
+    /* a quantile sample passes the sieves by mass (volume) as the curve says */
+    const int M = 200000;
+    double tot = 0, pass[5] = {0};
+    for (int i = 1; i <= M; i++) {
+        double a = gp_law_quantile(l, (i - 0.5) / M);
+        tot += a;
+        for (int k = 0; k < 5; k++)
+            if (a < vol3(SD[k])) pass[k] += a;
+    }
+    for (int k = 0; k < 5; k++) CHECK_NEAR(100 * pass[k] / tot, SP[k], 0.1);
+    printf("3D sieve: mean %.6g (test %.6g), COV %.6g (test %.6g), 50 %% passing %.4f %% by mass\n",
+           gp_law_mean(l), mean, gp_law_cov(l), cov, 100 * pass[2] / tot);
+    /* scaled, it keeps its kind and its rows */
+    gp_law *sc = gp_law_scaled(l, 2.0, &e);
+    CHECK(sc && fabs(gp_law_cdf(sc, 2 * vol3(2)) - cdf[2] / z) < 1e-11);
+    gp_law_destroy(sc);
+    gp_law_destroy(l);
+}
+
 static void test_scaled(void)
 {
     const double f = 0.65;
@@ -490,6 +543,7 @@ int main(void)
     test_log_cdf_sf();
     test_log_cdf_sf_finite();
     test_sieve();
+    test_sieve3d();
     test_scaled();
     test_powered();
     test_invalid();
