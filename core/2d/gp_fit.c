@@ -199,7 +199,7 @@ static double sieve_scale(const gp_law *law, const double *d, size_t nrows)
 {
     double lo, hi;
     gp_law_support(law, &lo, &hi);
-    return hi / (M_PI / 4 * d[nrows - 1] * d[nrows - 1]);
+    return hi / gp_law_sieve_size(law, d[nrows - 1]);
 }
 
 /* Where F may have a kink: the support's finite ends and, for a sieve law, the rows' areas. */
@@ -218,7 +218,7 @@ static double *law_kinks(const gp_law *law, size_t *nk)
     if (nrows > 0 && isfinite(hi)) {
         double scale = sieve_scale(law, d, nrows);
         for (size_t r = 0; r < nrows; r++)
-            k[m++] = scale * M_PI / 4 * d[r] * d[r];
+            k[m++] = gp_law_dim(law) == 2 ? scale * M_PI / 4 * d[r] * d[r] : scale * gp_law_sieve_size(law, d[r]);
     }
     qsort(k, m, sizeof *k, cmp_double);
     *nk = m;
@@ -461,14 +461,14 @@ static void passing_sweep(const double *dg, const double *ag, size_t n, gp_fit_p
 }
 
 /* grains by increasing diameter: the pairs (d, A) sorted by d (an area sorts as its d) */
-static gp_status passing_grains(const double *areas, size_t n, double **dg, double **ag)
+static gp_status passing_grains(const double *areas, size_t n, const gp_law *law, double **dg, double **ag)
 {
     *ag = sorted_copy(areas, n);
     *dg = malloc(n * sizeof **dg);
     if (!*ag || !*dg)
         return GP_ERR_NOMEM;
     for (size_t i = 0; i < n; i++)
-        (*dg)[i] = sqrt(4.0 * (*ag)[i] / M_PI);
+        (*dg)[i] = gp_law_sieve_diameter(law, (*ag)[i]);
     return GP_OK;
 }
 
@@ -488,9 +488,10 @@ gp_status gp_fit_passing_measure(const double *areas, size_t n, const gp_law *si
     double *dg = NULL, *ag = NULL;
     st = passing_alloc(out, nrows);
     if (!st)
-        st = passing_grains(areas, n, &dg, &ag);
+        st = passing_grains(areas, n, sieve_law, &dg, &ag);
     if (!st) {
-        double f = sqrt(sieve_scale(sieve_law, d, nrows));  /* the law's own diameters */
+        /* the law's own diameters */
+        double sc = sieve_scale(sieve_law, d, nrows), f = gp_law_dim(sieve_law) == 2 ? sqrt(sc) : cbrt(sc);
         for (size_t k = 0; k < nrows; k++)
             out->diameters[k] = f * d[k];
         memcpy(out->target, pw, nrows * sizeof *pw);

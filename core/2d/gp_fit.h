@@ -94,8 +94,9 @@ gp_status gp_fit_orient_measure(const double *theta_deg, size_t n, double mean_d
 
 /* Percent passing by mass of n grain areas (>= 0) at the sieve diameters of sieve_law (the law
  * the grains must follow, not the cell law scaled from it): its rows (gp_law_sieve_rows), in the
- * length unit of sqrt(area), times sqrt(factor) for a law made by gp_law_scaled. A law that is
- * not a sieve, or n = 0, gives out->n = 0 and GP_OK. */
+ * length unit of sqrt(area), times sqrt(factor) for a law made by gp_law_scaled. A sieve on
+ * volumes (gp_law_create_sieve3d) takes grain volumes: d = (6 V / pi)^(1/3), cbrt(factor). A law
+ * that is not a sieve, or n = 0, gives out->n = 0 and GP_OK. */
 gp_status gp_fit_passing_measure(const double *areas, size_t n, const gp_law *sieve_law,
                                  gp_fit_passing *out, gp_error *err);
 void gp_fit_passing_free(gp_fit_passing *p);

@@ -400,6 +400,22 @@ void gp_law_support(const gp_law *l, double *lo, double *hi)
     if (hi) *hi = bounded ? from_base(l, l->hi) : INFINITY;
 }
 
+int gp_law_dim(const gp_law *l)
+{
+    return l->kind == GP_LAW_SIEVE ? l->dim : 2;
+}
+
+double gp_law_sieve_size(const gp_law *l, double d)
+{
+    return sieve_size(l->kind == GP_LAW_SIEVE ? l->dim : 2, d);
+}
+
+double gp_law_sieve_diameter(const gp_law *l, double a)
+{
+    if (l->kind == GP_LAW_SIEVE && l->dim == 3) return cbrt(6.0 * a / LAW_PI);
+    return sqrt(4.0 * a / LAW_PI);
+}
+
 size_t gp_law_sieve_rows(const gp_law *l, const double **d, const double **pw)
 {
     if (l->kind != GP_LAW_SIEVE || l->kappa != 1.0) return 0;

@@ -95,6 +95,13 @@ double gp_law_quantile(const gp_law *law, double p);
 /* ln F_w(a) and ln(1 - F_w(a)) of the working law (above), both finite for finite a > 0. */
 void gp_law_log_cdf_sf(const gp_law *law, double a, double *log_cdf, double *log_sf);
 
+/* The size of a grain of diameter d by the law's convention, pi d^2 / 4 (areas; every law but a
+ * 3D sieve) or pi d^3 / 6 (gp_law_create_sieve3d), and its inverse: the diameter of size a. */
+double gp_law_sieve_size(const gp_law *law, double d);
+/* 3 for a sieve made by gp_law_create_sieve3d (or scaled from one), else 2 */
+int gp_law_dim(const gp_law *law);
+double gp_law_sieve_diameter(const gp_law *law, double a);
+
 /* Sieve laws only: the rows as given (n, d[], pw[]); 0 rows for other kinds. The pointers
  * stay valid while the law lives. */
 size_t gp_law_sieve_rows(const gp_law *law, const double **d, const double **pw);

@@ -19,6 +19,7 @@ void gp_fill3d_params_defaults(gp_fill3d_params *p)
     p->rotations = 24;
     p->turn = 0.35;
     p->margin = 1e-9;
+    p->rotation = NULL;
 }
 
 /* ------------------------------------------------------------------------------ the LP */
@@ -180,15 +181,19 @@ static double det3(const double M[9])
            M[2] * (M[3] * M[7] - M[4] * M[6]);
 }
 
+int gp_fill3d_frame(const double I[9], double E[9])
+{
+    if (!axes_of(I, E)) return 0;
+    if (det3(E) < 0)
+        for (int r = 0; r < 3; r++) E[3 * r + 2] = -E[3 * r + 2];
+    return 1;
+}
+
 /* R = E G^T: the grain's axis k onto the cell's axis k, a proper rotation */
 static int aligned_rotation(const double Ic[9], const double Ig[9], double R[9])
 {
     double E[9], G[9];
-    if (!axes_of(Ic, E) || !axes_of(Ig, G)) return 0;
-    if (det3(E) < 0)
-        for (int r = 0; r < 3; r++) E[3 * r + 2] = -E[3 * r + 2];
-    if (det3(G) < 0)
-        for (int r = 0; r < 3; r++) G[3 * r + 2] = -G[3 * r + 2];
+    if (!gp_fill3d_frame(Ic, E) || !gp_fill3d_frame(Ig, G)) return 0;
     for (int r = 0; r < 3; r++)
         for (int c = 0; c < 3; c++)
             R[3 * r + c] = E[3 * r] * G[3 * c] + E[3 * r + 1] * G[3 * c + 1] + E[3 * r + 2] * G[3 * c + 2];
@@ -361,7 +366,9 @@ static gp_status place(search *S, const gp_fill3d_cell *cell, const gp_fill3d_pa
                        void *state, gp_fill3d_result *out, gp_error *err)
 {
     const local_cell *lc = S->lc;
-    if (!aligned_rotation(cell->inertia, S->g->inertia, S->R))
+    if (p->rotation)
+        memcpy(S->R, p->rotation, sizeof S->R);
+    else if (!aligned_rotation(cell->inertia, S->g->inertia, S->R))
         return gp_error_set(err, GP_ERR_INVALID, "fill3d: the cell's or the grain's inertia is not finite");
     if (evaluate(S, S->R, S->c, &S->u) != 0) return gp_error_set(err, GP_ERR_INTERNAL, "fill3d: the scale LP failed");
     for (size_t f = 0; f < lc->nf; f++)

@@ -15,7 +15,7 @@
  *
  * Rotation. R first maps the grain's principal axes onto the cell's, longest on longest (least
  * moment of inertia), shortest on shortest, so that a grain takes its cell's orientation as the
- * 2D grain takes its cell's minimum-caliper axis. When s_t is out of reach there, a hill climb
+ * 2D grain takes its cell's minimum-caliper axis (or starts from the caller's R). When s_t is out of reach there, a hill climb
  * turns R by random small rotations (axis uniform on the sphere, angle up to `turn`, halved
  * after a run of failures) and keeps those that raise the largest scale, for `rotations` tries
  * or until s_t is reached.
@@ -64,6 +64,8 @@ typedef struct gp_fill3d_params {
     int rotations;         /* hill-climb tries when F_S is out of reach aligned (default 24) */
     double turn;           /* largest turn of a try, radians (default 0.35) */
     double margin;         /* clearance from every face, relative to the cell's size (1e-9) */
+    const double *rotation; /* NULL: principal axes aligned; else R to start from (row-major,
+                            * proper), e.g. a grain already shaped in its cell's frame */
 } gp_fill3d_params;
 
 void gp_fill3d_params_defaults(gp_fill3d_params *p);
@@ -88,6 +90,10 @@ typedef double (*gp_fill3d_u01_fn)(void *state);
 gp_status gp_fill3d_place(const gp_fill3d_cell *cell, const gp_fill3d_grain *grain,
                           const gp_fill3d_params *params, gp_fill3d_u01_fn u01, void *state,
                           gp_fill3d_result *out, gp_error *err);
+
+/* The cell's principal frame: the columns of E are the unit eigenvectors of the symmetric
+ * inertia I, least moment (longest axis) first, right-handed; 0 when I is not finite. */
+int gp_fill3d_frame(const double I[9], double E[9]);
 
 /* The LP itself, exposed for tests and other placements: maximises x[3] over x in R^4 subject
  * to a[4 k] x[0] + a[4 k + 1] x[1] + a[4 k + 2] x[2] + a[4 k + 3] x[3] <= b[k], k < m, given

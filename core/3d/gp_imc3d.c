@@ -631,7 +631,11 @@ gp_status gp_imc3d_run(const gp_voronoi3d_container *c, size_t n, const gp_imc3d
         law = own = gp_law_create(GP_LAW_LOGNORMAL, gp_voronoi3d_container_volume(v) / (double)n, p->cov, err);
         if (!law) st = err ? err->code : GP_ERR_INVALID;
     }
-    if (st == GP_OK && p->law) {
+    if (st == GP_OK && p->law && p->scale_law) {
+        double want = gp_voronoi3d_container_volume(v) / (double)n;
+        law = own = gp_law_scaled(p->law, want / gp_law_mean(p->law), err);
+        if (!law) st = err ? err->code : GP_ERR_INVALID;
+    } else if (st == GP_OK && p->law) {
         double want = gp_voronoi3d_container_volume(v) / (double)n, mean = gp_law_mean(p->law);
         if (!(fabs(mean - want) <= 1e-9 * want))
             st = gp_error_set(err, GP_ERR_INVALID, "imc3d: the law's mean volume %g is not the container's "

@@ -5,11 +5,12 @@
  * fourier-voronoi.md): the 2D IMC of gp_imc.h on the cells of gp_voronoi3d.h.
  *
  * Targets. Cell volumes follow a law of gp_law.h (lognormal, normal, uniform, or any law the
- * caller builds) whose mean must be the container's volume / N. A cell's orientation is the
- * angle theta between its longest axis -- the principal axis of its inertia tensor with the
- * least moment -- and a given unit axis; axes are lines, so the value is c = |cos theta| in
- * [0, 1]. The orientation law: density on the sphere proportional to 1 + k P2(cos theta),
- * P2(x) = (3 x^2 - 1) / 2, the sphere's analogue of the circle's cosine law of gp_law.h; for c
+ * caller builds) whose mean must be the container's volume / N (or any mean, with scale_law).
+ * A cell's orientation is the angle theta between its longest axis -- the principal axis of its
+ * inertia tensor with the least moment -- and a given unit axis; axes are lines, so the value
+ * is c = |cos theta| in [0, 1]. The orientation law: density on the sphere proportional to
+ * 1 + k P2(cos theta), P2(x) = (3 x^2 - 1) / 2, the sphere's analogue of the circle's cosine
+ * law of gp_law.h; for c
  *     f(c) = 1 + k (3 c^2 - 1) / 2,   F(c) = c + k (c^3 - c) / 2   on [0, 1]
  * (an isotropic sphere gives c uniform). As in 2D the anisotropy a in (0, 1] is the ratio of
  * the least density to the largest, (1 - k/2) / (1 + k), so k = 2 (1 - a) / (1 + 2 a): a = 1 is
@@ -55,6 +56,8 @@
 typedef struct gp_imc3d_params {
     const gp_law *law;   /* the cell volume law (not owned); NULL: lognormal of `cov` with mean
                           * container volume / n */
+    int scale_law;       /* 1: only the law's shape counts: it is scaled so that its mean is the
+                          * container's volume / n (a law of grains put on cells) */
     double cov;          /* COV of cell volumes when law is NULL, > 0 */
     double axis[3];      /* the orientation law's axis (any length > 0) */
     double anisotropy;   /* in (0, 1]; 1 isotropic */
