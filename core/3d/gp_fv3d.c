@@ -569,7 +569,7 @@ static gp_status run_imc(gp_fv3d *S, const gp_fv3d_spec *spec, gp_progress_fn pr
     gp_imc3d_params p;
     gp_imc3d_params_defaults(&p);
     p.law = spec->law;
-    p.scale_law = spec->law_of_grains;
+    p.scale_law = 1;
     memcpy(p.axis, spec->axis, sizeof p.axis);
     p.anisotropy = spec->anisotropy;
     p.threshold = spec->imc_threshold;
@@ -623,14 +623,16 @@ static gp_status run_grains(gp_fv3d *S, const gp_fv3d_spec *spec, gp_progress_fn
     return st;
 }
 
-/* the laws of the cells and of the grains, as the tessellation's volume makes them */
+/* the laws of the cells and of the grains, as the tessellation's volume makes them: a
+ * parametric law gives its shape (the cells' mean is container / N, the grains' solid_fraction
+ * of it); a sieve of grains is absolute */
 static gp_status laws_of(const gp_fv3d *S, const gp_fv3d_spec *spec, gp_law **cell_law, gp_law **grain_law,
                          gp_error *err)
 {
-    double mean = gp_voronoi3d_container_volume(S->cells) / (double)S->n;
-    double f = spec->law_of_grains ? mean / gp_law_mean(spec->law) : 1.0;
-    *cell_law = gp_law_scaled(spec->law, f, err);
-    *grain_law = gp_law_scaled(spec->law, spec->law_of_grains ? 1.0 : spec->solid_fraction, err);
+    double mean = gp_voronoi3d_container_volume(S->cells) / (double)S->n, m = gp_law_mean(spec->law);
+    int sieve = gp_law_kind_of(spec->law) == GP_LAW_SIEVE;
+    *cell_law = gp_law_scaled(spec->law, mean / m, err);
+    *grain_law = gp_law_scaled(spec->law, sieve ? 1.0 : spec->solid_fraction * mean / m, err);
     return *cell_law && *grain_law ? GP_OK : (err ? err->code : GP_ERR_NOMEM);
 }
 

@@ -59,8 +59,10 @@ enum {
 typedef struct gp_fv3d_spec {
     gp_voronoi3d_container container; /* its planes (convex) are the caller's */
     size_t particles;                 /* N >= 1 */
-    const gp_law *law;                /* volumes; its mean: container / N (cells) or
-                                       * solid_fraction x container / N (grains) */
+    const gp_law *law;                /* volumes: a parametric law gives its shape (its mean is
+                                       * taken as container / N for cells, solid_fraction x that
+                                       * for grains); a sieve (gp_law_create_sieve3d) is
+                                       * absolute, a law of grains */
     int law_of_grains;                /* 1: the grains follow the law (always for a sieve) */
     double axis[3];                   /* orientation law: axis (any length > 0) */
     double anisotropy;                /* (0, 1], 1 isotropic */
