@@ -12,6 +12,8 @@
  */
 #include "gp_clump3d.h"
 
+#include "gp_mesh3d.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1200,54 +1202,13 @@ nomem:
 /* figures of merit                                                                            */
 
 /* Eigenvalues (ascending) and unit eigenvectors (the columns of E, row-major) of a symmetric
- * 3 x 3 tensor: cyclic Jacobi. */
+ * 3 x 3 tensor (gp_mesh3d's cyclic Jacobi). */
 static void eigen3(const double I[9], double lam[3], double E[9])
 {
-    double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) a[i][j] = 0.5 * (I[3 * i + j] + I[3 * j + i]);
-    for (int sweep = 0; sweep < 64; sweep++) {
-        double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
-        double diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
-        if (off == 0 || off <= 1e-34 * diag) break;
-        for (int p = 0; p < 2; p++)
-            for (int q = p + 1; q < 3; q++) {
-                if (a[p][q] == 0) continue;
-                double th = (a[q][q] - a[p][p]) / (2 * a[p][q]);
-                double t = fabs(th) > 1e150 ? 0.5 / th
-                                            : (th >= 0 ? 1 : -1) / (fabs(th) + sqrt(th * th + 1));
-                double c = 1 / sqrt(t * t + 1), s = t * c, apq = a[p][q];
-                for (int r = 0; r < 3; r++) {
-                    double vrp = v[r][p], vrq = v[r][q];
-                    v[r][p] = c * vrp - s * vrq;
-                    v[r][q] = s * vrp + c * vrq;
-                    if (r == p || r == q) continue;
-                    double arp = a[r][p], arq = a[r][q];
-                    a[r][p] = a[p][r] = c * arp - s * arq;
-                    a[r][q] = a[q][r] = s * arp + c * arq;
-                }
-                a[p][p] -= t * apq;
-                a[q][q] += t * apq;
-                a[p][q] = a[q][p] = 0;
-            }
-    }
-    int ord[3] = {0, 1, 2};
-    for (int i = 1; i < 3; i++)
-        for (int j = i; j > 0 && a[ord[j - 1]][ord[j - 1]] > a[ord[j]][ord[j]]; j--) {
-            int x = ord[j];
-            ord[j] = ord[j - 1];
-            ord[j - 1] = x;
-        }
-    for (int k = 0; k < 3; k++) {
-        lam[k] = a[ord[k]][ord[k]];
-        for (int r = 0; r < 3; r++) E[3 * r + k] = v[r][ord[k]];
-    }
-}
-
-void gp_clump3d_principal(const double I[9], double lam[3])
-{
-    double E[9];
-    eigen3(I, lam, E);
+    double vec[3][3];
+    gp_mesh3d_eigen_sym3(I, lam, vec);
+    for (int k = 0; k < 3; k++)
+        for (int r = 0; r < 3; r++) E[3 * r + k] = vec[k][r];
 }
 
 void gp_clump3d_compare(const gp_clump3d_body *body, const gp_clump3d_body *ref,
@@ -1257,8 +1218,9 @@ void gp_clump3d_compare(const gp_clump3d_body *body, const gp_clump3d_body *ref,
     double ve = NAN, ie = NAN, se = NAN, co = NAN;
     if (body && ref && ref->volume > 0) {
         double lb[3], lr[3], dn = 0, ds = 0, nr = 0;
-        gp_clump3d_principal(body->inertia, lb);
-        gp_clump3d_principal(ref->inertia, lr);
+        double E[9];
+        eigen3(body->inertia, lb, E);
+        eigen3(ref->inertia, lr, E);
         double sc = body->volume > 0 ? ref->volume / body->volume : NAN;
         for (int k = 0; k < 3; k++) {
             dn += (lb[k] - lr[k]) * (lb[k] - lr[k]);

@@ -196,12 +196,9 @@ gp_status gp_clump3d_union(const gp_clump3d_sphere *s, size_t n, gp_clump3d_body
                            gp_error *err);
 
 /* The figures of merit of a body against a reference (see above): any pointer may be NULL.
- * The principal moments come from a cyclic Jacobi iteration. */
+ * The principal moments come from gp_mesh3d_eigen_sym3. */
 void gp_clump3d_compare(const gp_clump3d_body *body, const gp_clump3d_body *ref,
                         double *volume_error, double *inertia_error,
                         double *inertia_shape_error, double *centroid_offset);
-
-/* The principal moments of a symmetric 3 x 3 tensor, ascending. */
-void gp_clump3d_principal(const double I[9], double lambda[3]);
 
 #endif /* GP_CLUMP3D_H */
