@@ -1,9 +1,10 @@
 /* gp_voronoi3d.c -- bounded 3D Voronoi tessellation with local updates. See gp_voronoi3d.h.
  *
- * Layout: convex polyhedra and their cutting ("poly"), the object and its grid of seeds, one
- * cell (the search), canonical cells (the finished polyhedron rewritten from its planes, so
- * that its bits do not depend on the cuts' order), the container, the build, the moves, the
- * queries.
+ * Layout: convex polyhedra as vertex graphs and their cutting ("poly"), the object and its
+ * grid of seeds, one cell (the search), canonical cells (the finished polyhedron rewritten
+ * from its planes, so that its bits do not depend on the cuts' order), the container (and
+ * its queries), the build, the moves, the queries. docs/design/voronoi3d.md has the reasons
+ * and the measurements.
  *
  * Tags: every face of a polyhedron carries a tag: >= 0 the seed whose bisector it lies on,
  * -1 - k the container's half-space k, TAG_BBOX + k (k < 6) a side of the starting box of a
@@ -16,6 +17,10 @@
 #include <string.h>
 
 #include "gp_grid.h"
+
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #define V3_EPS 1e-12           /* cutting tolerance, relative to the polyhedron's radius */
 #define V3_DUP 1e-10           /* duplicates: closer than this times the container's size */
@@ -32,33 +37,28 @@
 /* ------------------------------------------------------------------------------------------ */
 /* convex polyhedra                                                                            */
 
-/* A convex polyhedron cut in place: vertex slots (alive, or free with ref -1 and coordinates
- * 0), faces as loops in a pool (each face its own stretch, with room to grow). A cut touches
- * only the faces it crosses; the others stay as they are. */
+/* A convex polyhedron as its vertex graph (voro++'s representation), in the cell's frame:
+ * vertices 0 .. nv-1, each with its edges in counter-clockwise order seen from outside. Edge
+ * entry k of vertex v holds the neighbour e_k, the index of v among e_k's entries (back) and
+ * the face of the half-edge v -> e_k: the face between e_k and e_k+1, whose loop (counter-
+ * clockwise from outside) runs ... e_k+1 -> v -> e_k ..., so that the half-edge after v -> w
+ * in its face is w -> (w's entry before v's). A face is an id: its tag and the plane it was
+ * cut with; a face no edge names any more is gone. A vertex slot owns a stretch of the edge
+ * pool (3 entries, more for a degenerate vertex), which stays with the slot when vertices
+ * move to keep 0 .. nv-1 dense. */
 typedef struct poly {
-    int32_t nv, nf, nl, pool; /* vertex slots, faces, loop entries in use, pool entries used */
-    int32_t vcap, fcap, lcap, nfree;
-    double *x;                /* 3 per slot */
-    double *x2;               /* per slot: |x|^2 (0 when free), for r2 without recomputing it */
-    int32_t *ref;             /* per slot: the loop entries naming it, -1 when free */
-    int32_t *freel;           /* free slots */
-    int32_t *foff, *flen, *fcp, *ftag; /* per face: offset, length, room, tag */
-    double *fpl;              /* per face: its plane n . x <= c as cut (n, c), 4 each */
-    int32_t *fv;              /* the loops, counter-clockwise seen from outside */
-    double r2;                /* largest squared distance of a vertex from the frame's origin */
+    int32_t nv, vcap;      /* live vertices, slot capacity */
+    int32_t nslot;         /* slots given edge storage since the polyhedron was started */
+    int32_t ep, ecap;      /* edge pool: entries handed out, capacity */
+    int32_t nf, fcap;      /* face ids */
+    double *x, *y, *z;     /* per vertex: coordinates (apart, for the plane test's loop) */
+    double *x2;            /* per vertex: |x|^2 */
+    int32_t *deg, *off, *room; /* per slot: degree, edge storage offset and size */
+    int32_t *nb, *bk, *ef; /* per edge entry: neighbour, back index, face id */
+    int32_t *ftag;         /* per face id: tag */
+    double *fpl;           /* per face id: its plane n . x <= c as cut (n, c), 4 each */
+    double r2;             /* largest squared distance of a vertex from the frame's origin */
 } poly;
-
-typedef struct xedge {
-    int32_t a, b, v; /* edge a < b got the new vertex v */
-} xedge;
-
-/* Per inside vertex of a cut (valid when stamp is the cut's number): the new vertices on its
- * first three edges to outside vertices o, so that the second face to meet an edge finds its
- * vertex without a search; more edges go to the xedge list. */
-typedef struct xslot {
-    uint32_t stamp;
-    int32_t n, o[3], v[3];
-} xslot;
 
 typedef struct cand {
     double r[3], d2; /* from the cell's seed to seed j (read from the bin, which is in cache) */
@@ -72,37 +72,52 @@ typedef struct vkey {
     int32_t slot;
 } vkey;
 
-/* vertex classes of a cut, as bits so that a face's classes are one OR */
-enum { C_OUT = 1, C_IN = 2, C_ON = 4 };
+/* vertex classes of a cut (DEAD: an on vertex left without a face by a degenerate cut) */
+enum { C_OUT = 1, C_IN = 2, C_ON = 4, C_DEAD = 8 };
 
 /* Scratch of the cutting and of one cell's search (one per object: builds and moves are
  * single-threaded). */
 typedef struct scratch {
     poly p;
-    double *d;
-    unsigned char *cls;
-    int32_t *remap;
-    int32_t dcap;
-    int32_t *buf;      /* one clipped loop; the pool while it is compacted */
-    int32_t bufcap;
-    xedge *xe;
-    int32_t nxe, xecap;
-    xslot *xs;         /* per slot, with the capacity dcap */
-    uint32_t cutno;    /* the current cut's number for xs (never 0: fresh slots are 0) */
-    int32_t *cf, *ct;  /* the new face's directed edges */
-    unsigned char *cdead;
-    int32_t nce, cecap;
-    cand *cd, *cd2;    /* candidates; the bucket sort's second array */
-    int32_t *cnt;      /* the bucket sort's counts */
-    int32_t ncd, cdcap, cd2cap, cntcap;
-    int32_t dup;       /* a seed found to coincide with the cell's */
-    int32_t *cut;      /* seeds whose planes cut the cell */
+    int32_t scap;       /* capacity of the per-slot scratch */
+    double *d;          /* per slot: n . x - c of the current cut */
+    unsigned char *cls; /* per slot: class */
+    int32_t *outl;      /* the outside vertices, ascending; then the dead ones */
+    /* per new vertex: the entry where the walk to its cap neighbour starts (degenerate cut);
+     * what the plain cut reads before it writes */
+    int32_t wcap, *ws;
+    struct xnew {
+        double x, y, z;
+        int32_t e, u, w, j, f1, f2, prev, next;
+    } * xt;
+    int32_t *cnext, *cprev; /* degenerate cut: the cap's loop through each of its vertices */
+    int32_t *wl;        /* degenerate cut: the rebuilt vertices */
+    int32_t xcap;       /* capacity of the per-entry scratch */
+    int32_t *xn;        /* per entry of an outside vertex to an inside one: the new vertex */
+    int32_t *rs, *re;   /* degenerate cut, per entry of an on vertex: the cap's ends there */
+    int32_t *enx;       /* canonical cell, per entry: the next entry of its face */
+    int32_t tcap, *tnb, *tef; /* degenerate cut: one rebuilt vertex's entries */
+    int32_t fmcap;
+    unsigned char *fmask; /* degenerate cut, per face id: its vertices' classes */
+    cand *cd;           /* candidates */
+    int32_t *ord, *bkt; /* the bucket sort's order and buckets */
+    int32_t ordcap;
+    int32_t *cnt;       /* the bucket sort's counts */
+    int32_t ncd, cdcap, cntcap;
+    double cdmax;       /* the largest d2 of the candidates */
+    int32_t *bl;        /* the bins of a batch in reach */
+    double si[3];       /* the cell's seed (local frame) */
+    int32_t dup;        /* a seed found to coincide with the cell's */
+    double near_d2;     /* the nearest candidate of the last batch (when ncd > 0) */
+    int32_t near_j;
+    int32_t *cut;       /* seeds whose planes cut the cell */
     int32_t ncut, cutcap;
-    /* canonical cells: per slot the offset of its faces in vfac (one per loop entry) and its
-     * key; per vertex its slot; per face the order */
-    int32_t *voff, *vfac, *vord, *ford;
-    vkey *vkey;
+    /* canonical cells: per vertex the offset of its faces in vfac, its key, its number; per
+     * face id its first edge entry; the present faces, by tag; one loop */
     int32_t canv, canl, canf;
+    int32_t *voff, *vfac, *vord, *remap, *fent, *fpres, *ford, *lbuf;
+    vkey *vkey;
+    double *pp;         /* per vertex: x_p x_q (the moments) */
 } scratch;
 
 static int grow(void **p, int32_t *cap, int32_t need, size_t elt)
@@ -117,368 +132,628 @@ static int grow(void **p, int32_t *cap, int32_t need, size_t elt)
     return 0;
 }
 
-/* Room for nv vertex slots (with the scratch per slot), nf faces and a pool of nl entries. */
-static int poly_reserve(scratch *S, int32_t nv, int32_t nf, int32_t nl)
+/* Arrays of one capacity grown together. */
+typedef struct slab {
+    void **p;
+    size_t elt;
+} slab;
+
+static int grow_set(const slab *a, int n, int32_t *cap, int32_t need)
+{
+    if (need <= *cap) return 0;
+    int32_t c = *cap ? *cap : 32;
+    while (c < need) c *= 2;
+    for (int k = 0; k < n; k++) {
+        void *q = realloc(*a[k].p, (size_t)c * a[k].elt);
+        if (!q) return -1;
+        *a[k].p = q;
+    }
+    *cap = c;
+    return 0;
+}
+
+/* Room for nv vertex slots (and their scratch). */
+static int vslots(scratch *S, int32_t nv)
 {
     poly *P = &S->p;
-    int32_t c[8];
-    for (int k = 0; k < 8; k++) c[k] = k < 3 || k == 7 ? P->vcap : (k < 6 ? S->dcap : P->fcap);
-    if (grow((void **)&P->x, &c[0], nv, 3 * sizeof(double)) ||
-        grow((void **)&P->ref, &c[1], nv, sizeof(int32_t)) ||
-        grow((void **)&P->freel, &c[2], nv, sizeof(int32_t)) ||
-        grow((void **)&P->x2, &c[7], nv, sizeof(double)))
-        return -1;
-    P->vcap = c[0];
-    int32_t c6 = S->dcap;
-    if (grow((void **)&S->d, &c[3], nv, sizeof(double)) ||
-        grow((void **)&S->cls, &c[4], nv, 1) || grow((void **)&S->remap, &c[5], nv, sizeof(int32_t)) ||
-        grow((void **)&S->xs, &c6, nv, sizeof(xslot)))
-        return -1;
-    if (c6 > S->dcap) memset(S->xs + S->dcap, 0, (size_t)(c6 - S->dcap) * sizeof(xslot));
-    S->dcap = c[3];
-    int32_t f[5] = {P->fcap, P->fcap, P->fcap, P->fcap, P->fcap};
-    if (grow((void **)&P->foff, &f[0], nf, sizeof(int32_t)) ||
-        grow((void **)&P->flen, &f[1], nf, sizeof(int32_t)) ||
-        grow((void **)&P->fcp, &f[2], nf, sizeof(int32_t)) ||
-        grow((void **)&P->ftag, &f[3], nf, sizeof(int32_t)) ||
-        grow((void **)&P->fpl, &f[4], nf, 4 * sizeof(double)))
-        return -1;
-    P->fcap = f[0];
-    return grow((void **)&P->fv, &P->lcap, nl, sizeof(int32_t));
+    if (nv + 1 <= P->vcap && nv + 1 <= S->scap) return 0;
+    slab a[] = {{(void **)&P->x, sizeof(double)},   {(void **)&P->y, sizeof(double)},
+                {(void **)&P->z, sizeof(double)},   {(void **)&P->x2, sizeof(double)},
+                {(void **)&P->deg, sizeof(int32_t)}, {(void **)&P->off, sizeof(int32_t)},
+                {(void **)&P->room, sizeof(int32_t)}};
+    slab b[] = {{(void **)&S->d, sizeof(double)},     {(void **)&S->cls, 1},
+                {(void **)&S->outl, sizeof(int32_t)}, {(void **)&S->cnext, sizeof(int32_t)},
+                {(void **)&S->cprev, sizeof(int32_t)}, {(void **)&S->wl, sizeof(int32_t)}};
+    return grow_set(a, 7, &P->vcap, nv + 1) || grow_set(b, 6, &S->scap, nv + 1) ? -1 : 0;
+}
+
+/* Room for ne edge entries (and their scratch). */
+static int eslots(scratch *S, int32_t ne)
+{
+    poly *P = &S->p;
+    if (ne <= P->ecap && ne <= S->xcap) return 0;
+    slab a[] = {{(void **)&P->nb, sizeof(int32_t)}, {(void **)&P->bk, sizeof(int32_t)},
+                {(void **)&P->ef, sizeof(int32_t)}};
+    slab b[] = {{(void **)&S->xn, sizeof(int32_t)}, {(void **)&S->rs, sizeof(int32_t)},
+                {(void **)&S->re, sizeof(int32_t)}, {(void **)&S->enx, sizeof(int32_t)}};
+    return grow_set(a, 3, &P->ecap, ne) || grow_set(b, 4, &S->xcap, ne) ? -1 : 0;
+}
+
+/* Room for nf face ids. */
+static int fslots(scratch *S, int32_t nf)
+{
+    poly *P = &S->p;
+    if (nf <= P->fcap) return 0;
+    slab a[] = {{(void **)&P->ftag, sizeof(int32_t)}, {(void **)&P->fpl, 4 * sizeof(double)}};
+    return grow_set(a, 2, &P->fcap, nf);
 }
 
 static void poly_free(poly *P)
 {
-    free(P->x);
-    free(P->x2);
-    free(P->ref);
-    free(P->freel);
-    free(P->foff);
-    free(P->flen);
-    free(P->fcp);
-    free(P->ftag);
-    free(P->fpl);
-    free(P->fv);
+    void *a[] = {P->x, P->y, P->z, P->x2, P->deg, P->off, P->room, P->nb, P->bk, P->ef, P->ftag, P->fpl};
+    for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) free(a[k]);
     memset(P, 0, sizeof *P);
 }
 
 /* The box [lo, hi] (frame coordinates), face k (x-, x+, y-, y+, z-, z+) tagged tag[k]. Vertex
- * index bx + 2 by + 4 bz; the loops are counter-clockwise seen from outside. */
+ * k = bx + 2 by + 4 bz; its neighbours are k ^ 1, k ^ 4, k ^ 2 counter-clockwise from outside
+ * at a corner with an even number of hi coordinates, k ^ 1, k ^ 2, k ^ 4 at an odd one; the
+ * face between the edges along two axes is the one across the third axis, on k's side. */
 static int poly_box(scratch *S, const double lo[3], const double hi[3], const int32_t tag[6])
 {
-    static const int32_t loops[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                        {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-    if (poly_reserve(S, 8, 6, 48)) return -1;
+    static const int32_t nb[24] = {1, 4, 2, 0, 3, 5, 3, 0, 6, 2, 7, 1,
+                                   5, 6, 0, 4, 1, 7, 7, 2, 4, 6, 5, 3};
+    static const int32_t bk[24] = {0, 2, 1, 0, 2, 1, 0, 2, 1, 0, 2, 1,
+                                   0, 2, 1, 0, 2, 1, 0, 2, 1, 0, 2, 1};
+    static const int32_t ef[24] = {2, 0, 4, 4, 1, 2, 4, 0, 3, 3, 1, 4,
+                                   5, 0, 2, 2, 1, 5, 3, 0, 5, 5, 1, 3};
+    if (vslots(S, 8) || eslots(S, 24) || fslots(S, 6)) return -1;
     poly *P = &S->p;
     P->r2 = 0;
-    for (int k = 0; k < 8; k++) {
-        double *x = P->x + 3 * k;
-        x[0] = (k & 1) ? hi[0] : lo[0];
-        x[1] = (k & 2) ? hi[1] : lo[1];
-        x[2] = (k & 4) ? hi[2] : lo[2];
-        P->ref[k] = 3;
-        double r2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+    for (int32_t k = 0; k < 8; k++) {
+        P->x[k] = (k & 1) ? hi[0] : lo[0];
+        P->y[k] = (k & 2) ? hi[1] : lo[1];
+        P->z[k] = (k & 4) ? hi[2] : lo[2];
+        double r2 = P->x[k] * P->x[k] + P->y[k] * P->y[k] + P->z[k] * P->z[k];
         P->x2[k] = r2;
         P->r2 = r2 > P->r2 ? r2 : P->r2;
+        P->deg[k] = 3;
+        P->off[k] = 3 * k;
+        P->room[k] = 3;
     }
+    memcpy(P->nb, nb, sizeof nb);
+    memcpy(P->bk, bk, sizeof bk);
+    memcpy(P->ef, ef, sizeof ef);
     for (int f = 0; f < 6; f++) {
-        P->foff[f] = 8 * f;
-        P->flen[f] = 4;
-        P->fcp[f] = 8;
         P->ftag[f] = tag[f];
         double *q = P->fpl + 4 * f; /* x <= hi, -x <= -lo */
         q[0] = q[1] = q[2] = 0;
         q[f / 2] = (f & 1) ? 1 : -1;
         q[3] = (f & 1) ? hi[f / 2] : -lo[f / 2];
-        memcpy(P->fv + 8 * f, loops[f], sizeof loops[f]);
     }
-    P->nv = 8;
+    P->nv = P->nslot = 8;
+    P->ep = 24;
     P->nf = 6;
-    P->nl = 24;
-    P->pool = 48;
-    P->nfree = 0;
     return 0;
 }
 
-/* The largest n . x over P's vertex slots, each n . x kept in S->d for classify() (S->d holds
- * P->nv: cut_reserve() leaves room for what a cut adds). Free slots sit at the origin, which
- * every plane of a seed leaves inside; for a wall they can only cost a classification. The test
- * before a cut, cheap because most tests find nothing to cut. */
-static double poly_max(scratch *S, const double n[3])
+/* The largest of n . x - c over P's vertices, each kept in d. SSE2 two vertices at a time
+ * where the compiler has it (the same operations in the same order: the same bits). */
+static inline double plane_dist(const poly *P, const double n[3], double c, double *d)
 {
-    const double *x = S->p.x, n0 = n[0], n1 = n[1], n2 = n[2];
-    double m = -INFINITY, *dist = S->d;
-    for (int32_t k = 0, nv = S->p.nv; k < nv; k++) {
-        double d = n0 * x[3 * k] + n1 * x[3 * k + 1] + n2 * x[3 * k + 2];
-        dist[k] = d;
-        m = d > m ? d : m;
+    const double *x = P->x, *y = P->y, *z = P->z, n0 = n[0], n1 = n[1], n2 = n[2];
+    int32_t k = 0, nv = P->nv;
+    double m = -INFINITY;
+#ifdef __SSE2__
+    __m128d N0 = _mm_set1_pd(n0), N1 = _mm_set1_pd(n1), N2 = _mm_set1_pd(n2), C = _mm_set1_pd(c);
+    __m128d M = _mm_set1_pd(-INFINITY);
+    for (; k + 2 <= nv; k += 2) {
+        __m128d e = _mm_add_pd(_mm_mul_pd(N0, _mm_loadu_pd(x + k)), _mm_mul_pd(N1, _mm_loadu_pd(y + k)));
+        e = _mm_sub_pd(_mm_add_pd(e, _mm_mul_pd(N2, _mm_loadu_pd(z + k))), C);
+        _mm_storeu_pd(d + k, e);
+        M = _mm_max_pd(e, M);
+    }
+    double h[2];
+    _mm_storeu_pd(h, M);
+    m = h[0] > h[1] ? h[0] : h[1];
+#endif
+    for (; k < nv; k++) {
+        double e = n0 * x[k] + n1 * y[k] + n2 * z[k] - c;
+        d[k] = e;
+        m = e > m ? e : m;
     }
     return m;
 }
 
-/* Signed distances (in units of |n|: poly_max()'s n . x less c) and classes of P's vertices;
- * returns the number outside, *nin the number inside. Free slots get no class. */
-static int classify(scratch *S, double c, double tol, int *nin)
+/* The largest of a[0 .. n) (0 when n is 0; the values are >= 0). */
+static double vmax(const double *a, int32_t n)
 {
-    /* locals, so that the stores (a char may alias anything) force no reloads */
-    const int32_t *ref = S->p.ref;
-    double *dist = S->d;
-    unsigned char *cls = S->cls;
-    int nout = 0, nins = 0;
-    for (int32_t k = 0, nv = S->p.nv; k < nv; k++) {
-        double d = dist[k] - c;
-        /* without branches: the classes are as good as random, a mispredicted branch costs
-         * more than the arithmetic */
-        int live = ref[k] >= 0, o = (d > tol) & live, in = (d < -tol) & live;
-        dist[k] = d;
-        cls[k] = (unsigned char)((o * C_OUT) | (in * C_IN) | ((live & !o & !in) * C_ON));
-        nout += o;
-        nins += in;
-    }
-    *nin = nins;
-    return nout;
+    int32_t k = 0;
+    double m = 0;
+#ifdef __SSE2__
+    __m128d M = _mm_setzero_pd();
+    for (; k + 2 <= n; k += 2) M = _mm_max_pd(_mm_loadu_pd(a + k), M);
+    double h[2];
+    _mm_storeu_pd(h, M);
+    m = h[0] > h[1] ? h[0] : h[1];
+#endif
+    for (; k < n; k++) m = a[k] > m ? a[k] : m;
+    return m;
 }
 
-/* The new vertex on edge a-b (one inside, one outside), made once per edge (class ON). */
-static int32_t cross_vertex(scratch *S, int32_t a, int32_t b)
+/* A new vertex at slot nv, with edge storage (3 entries made if the slot has none; the caller
+ * reserved the room). */
+static int32_t vertex_new(poly *P)
 {
-    int32_t in = S->cls[a] == C_IN ? a : b, out = in == a ? b : a;
-    xslot *X = &S->xs[in];
-    if (X->stamp != S->cutno) X->stamp = S->cutno, X->n = 0;
-    for (int32_t q = 0; q < X->n; q++)
-        if (X->o[q] == out) return X->v[q];
-    int32_t lo = a < b ? a : b, hi = a < b ? b : a;
-    for (int32_t k = 0; k < S->nxe && X->n == 3; k++)
-        if (S->xe[k].a == lo && S->xe[k].b == hi) return S->xe[k].v;
+    int32_t v = P->nv++;
+    if (v >= P->nslot) {
+        P->off[v] = P->ep;
+        P->room[v] = 3;
+        P->ep += 3;
+        P->nslot = v + 1;
+    }
+    return v;
+}
+
+/* Vertex s moved to slot h (the slots swap their edge storage); its neighbours follow. */
+static void vertex_move(poly *P, int32_t s, int32_t h)
+{
+    P->x[h] = P->x[s];
+    P->y[h] = P->y[s];
+    P->z[h] = P->z[s];
+    P->x2[h] = P->x2[s];
+    P->deg[h] = P->deg[s];
+    int32_t o = P->off[s], r = P->room[s];
+    P->off[s] = P->off[h], P->room[s] = P->room[h];
+    P->off[h] = o, P->room[h] = r;
+    for (int32_t k = 0; k < P->deg[h]; k++) P->nb[P->off[P->nb[o + k]] + P->bk[o + k]] = h;
+}
+
+/* The new vertex on the edge from outside vertex u (its entry e) to inside vertex w, on the
+ * plane: its entries w (the face of u -> w), the cap's next vertex (the cap) and the cap's
+ * previous vertex (the face of w -> u), those two filled later; w's entry now names it, and
+ * xn[e] too. */
+static int32_t cross_vertex(scratch *S, int32_t u, int32_t e, int32_t cap)
+{
     poly *P = &S->p;
-    double t = S->d[in] / (S->d[in] - S->d[out]);
-    int32_t k = P->nfree ? P->freel[--P->nfree] : P->nv++;
-    const double *xi = P->x + 3 * in, *xo = P->x + 3 * out;
-    double *x = P->x + 3 * k;
-    for (int q = 0; q < 3; q++) x[q] = xi[q] + t * (xo[q] - xi[q]);
-    P->x2[k] = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
-    P->ref[k] = 0;
-    S->cls[k] = C_ON;
-    if (X->n < 3) {
-        X->o[X->n] = out;
-        X->v[X->n++] = k;
-    } else {
-        S->xe[S->nxe++] = (xedge){lo, hi, k};
-    }
-    return k;
+    int32_t *restrict nb = P->nb, *restrict bk = P->bk, *restrict ef = P->ef;
+    double *restrict X = P->x, *restrict Y = P->y, *restrict Z = P->z;
+    int32_t w = nb[e], j = bk[e], ew = P->off[w] + j;
+    int32_t x = vertex_new(P), ox = P->off[x];
+    double t = S->d[w] / (S->d[w] - S->d[u]);
+    double px = X[w] + t * (X[u] - X[w]), py = Y[w] + t * (Y[u] - Y[w]), pz = Z[w] + t * (Z[u] - Z[w]);
+    X[x] = px, Y[x] = py, Z[x] = pz;
+    P->x2[x] = px * px + py * py + pz * pz;
+    P->deg[x] = 3;
+    S->d[x] = 0;
+    nb[ox] = w, bk[ox] = j, ef[ox] = ef[e];
+    nb[ox + 1] = -1, ef[ox + 1] = cap;
+    nb[ox + 2] = -1, ef[ox + 2] = ef[ew];
+    nb[ew] = x, bk[ew] = 0;
+    S->xn[e] = x;
+    return x;
 }
 
-/* The loop's edges lying in the plane, reversed: edges of the new face. */
-static void note_plane_edges(scratch *S, const int32_t *L, int32_t m)
+/* The cut's new vertices, one per edge from an outside vertex to an inside one (class by
+ * d < -tol); for each, in ws, the entry after its edge in the face of inside -> outside (where
+ * the walk of run_end starts). Returns their count. */
+static int32_t cross_all(scratch *S, int32_t nout, int32_t cap, double tol)
 {
-    for (int32_t k = 0; k < m; k++) {
-        int32_t u = L[k], w = L[k + 1 < m ? k + 1 : 0];
-        if ((S->cls[u] & C_ON) && (S->cls[w] & C_ON)) {
-            S->cf[S->nce] = w;
-            S->ct[S->nce] = u;
-            S->cdead[S->nce++] = 0;
+    poly *P = &S->p;
+    const int32_t *outl = S->outl;
+    const double *d = S->d;
+    int32_t nnew = 0;
+    for (int32_t q = 0; q < nout; q++) {
+        int32_t u = outl[q], o = P->off[u], du = P->deg[u];
+        for (int32_t k = 0; k < du; k++)
+            if (d[P->nb[o + k]] < -tol) {
+                cross_vertex(S, u, o + k, cap);
+                S->ws[nnew++] = o + (k ? k : du) - 1;
+            }
+    }
+    return nnew;
+}
+
+/* From entry e of an outside vertex, along that half-edge's face through outside vertices
+ * (d > tol) to the first vertex that is not outside: the entry (of the last outside vertex)
+ * that reaches it, or -1 after `limit` steps (an inconsistent graph). */
+static int32_t run_end(const scratch *S, int32_t e, double tol, int32_t limit)
+{
+    const poly *P = &S->p;
+    const int32_t *nb = P->nb, *bk = P->bk, *off = P->off, *deg = P->deg;
+    const double *d = S->d;
+    for (int32_t step = 0; step < limit; step++) {
+        int32_t b = nb[e];
+        if (!(d[b] > tol)) return e;
+        int32_t j = bk[e];
+        e = off[b] + (j ? j : deg[b]) - 1;
+    }
+    return -1;
+}
+
+/* The cut without on vertices (the generic case). A new vertex on each edge from an outside
+ * vertex to an inside one (a crossing); from each crossing, its face (the one of inside ->
+ * outside) is followed through the outside vertices to the next crossing, whose new vertex
+ * comes before it on the cap. Everything is read first, then written: the new vertices take
+ * the outside vertices' slots (the first nout of them; the rest are appended). Returns the
+ * count of slots still to free (outl[nnew .. nout) when there are fewer new vertices), -2
+ * when the cap is not one loop through all the new vertices. */
+static int32_t cut_plain(scratch *S, int32_t nout, int32_t cap, double tol)
+{
+    poly *P = &S->p;
+    int32_t *nb = P->nb, *bk = P->bk, *ef = P->ef, *off = P->off, *deg = P->deg, *xn = S->xn;
+    const int32_t *outl = S->outl;
+    double *d = S->d; /* (run_end reads these too) */
+    int32_t nnew = 0, nv0 = P->nv;
+    struct xnew *restrict T = S->xt;
+    /* the crossings: xn of the outside vertex's entry names it (written without a branch,
+     * which would be as good as random; xn of the other entries is stale) */
+    for (int32_t q = 0; q < nout; q++) {
+        int32_t u = outl[q], o = off[u], du = deg[u];
+        for (int32_t e = o; e < o + du; e++) {
+            T[nnew].e = e;
+            T[nnew].u = u;
+            xn[e] = nnew;
+            nnew += d[nb[e]] < -tol;
         }
     }
-}
-
-static void face_drop(poly *P, int32_t f)
-{
-    const int32_t *L = P->fv + P->foff[f];
-    for (int32_t k = 0; k < P->flen[f]; k++) P->ref[L[k]]--;
-    P->nl -= P->flen[f];
-    int32_t g = --P->nf;
-    P->foff[f] = P->foff[g];
-    P->flen[f] = P->flen[g];
-    P->fcp[f] = P->fcp[g];
-    P->ftag[f] = P->ftag[g];
-    memcpy(P->fpl + 4 * f, P->fpl + 4 * g, 4 * sizeof(double));
-}
-
-/* Face f clipped to the inside, in place (moved to the pool's end if it outgrows its room). */
-static void face_clip(scratch *S, int32_t f)
-{
-    poly *P = &S->p;
-    int32_t m = P->flen[f], len = 0;
-    const int32_t *L = P->fv + P->foff[f];
-    for (int32_t k = 0; k < m; k++) {
-        int32_t a = L[k], b = L[k + 1 < m ? k + 1 : 0];
-        int out = S->cls[a] == C_OUT;
-        P->ref[a] -= out;
-        S->buf[len] = a;
-        len += !out;
-        if ((S->cls[a] | S->cls[b]) == (C_IN | C_OUT)) {
-            int32_t x = cross_vertex(S, a, b);
-            P->ref[x]++;
-            S->buf[len++] = x;
-        }
+    if (nnew < 3) return -2;
+    /* read: each new vertex's position, neighbour and faces, and its place on the cap (from
+     * the entry after its edge in the face of inside -> outside) */
+    double *restrict X = P->x, *restrict Y = P->y, *restrict Z = P->z;
+    for (int32_t q = 0; q < nnew; q++) { /* no branch here: the divisions overlap */
+        int32_t e = T[q].e, u = T[q].u, w = nb[e], j = bk[e];
+        double t = d[w] / (d[w] - d[u]);
+        T[q].x = X[w] + t * (X[u] - X[w]);
+        T[q].y = Y[w] + t * (Y[u] - Y[w]);
+        T[q].z = Z[w] + t * (Z[u] - Z[w]);
+        T[q].w = w, T[q].j = j, T[q].f1 = ef[e], T[q].f2 = ef[off[w] + j];
+        T[q].next = -1;
     }
-    if (len > P->fcp[f]) {
-        P->foff[f] = P->pool;
-        P->fcp[f] = len + 4;
-        P->pool += len + 4;
+    for (int32_t q = 0; q < nnew; q++) {
+        int32_t e = T[q].e, u = T[q].u, k = e - off[u];
+        int32_t r = run_end(S, e + (k ? 0 : deg[u]) - 1, tol, P->ep), p = r < 0 ? -1 : xn[r];
+        if (p < 0 || p >= nnew || T[p].e != r) return -2; /* (xn holds stale values elsewhere) */
+        T[q].prev = p;
     }
-    memcpy(P->fv + P->foff[f], S->buf, (size_t)len * sizeof(int32_t));
-    P->nl += len - m;
-    P->flen[f] = len;
-    note_plane_edges(S, S->buf, len);
-}
-
-/* Face f against the classified plane: kept, dropped or clipped. */
-static void face_cut(scratch *S, int32_t f)
-{
-    poly *P = &S->p;
-    const int32_t *L = P->fv + P->foff[f];
-    int32_t m = P->flen[f];
-    unsigned mask = 0;
-    for (int32_t k = 0; k < m; k++) mask |= S->cls[L[k]];
-    if (!(mask & C_OUT)) {
-        if (mask & C_ON) note_plane_edges(S, L, m);
-    } else if (!(mask & C_IN)) {
-        face_drop(P, f);
-    } else {
-        face_clip(S, f);
-    }
-}
-
-/* The new face from the recorded edges: pairs met in both directions cancel (two kept faces
- * meeting on the plane), the rest must chain into one loop. -2 when they do not. */
-static int cap_face(scratch *S, const double n[3], double c, int32_t tag)
-{
-    for (int32_t e = 0; e < S->nce; e++)
-        for (int32_t g = e + 1; g < S->nce && !S->cdead[e]; g++)
-            if (!S->cdead[g] && S->cf[g] == S->ct[e] && S->ct[g] == S->cf[e])
-                S->cdead[e] = S->cdead[g] = 1;
-    int32_t m = 0, e0 = -1;
-    for (int32_t e = 0; e < S->nce; e++)
-        if (!S->cdead[e]) {
-            m++;
-            if (e0 < 0) e0 = e;
-        }
-    if (m < 3) return -2;
-    poly *P = &S->p;
-    int32_t *L = P->fv + P->pool, cnt = 0, cur = e0;
+    for (int32_t q = 0; q < nnew; q++) T[T[q].prev].next = q; /* a permutation if one loop */
+    int32_t cnt = 0, q = 0;
     do {
-        L[cnt++] = S->cf[cur];
-        P->ref[S->cf[cur]]++;
-        S->cdead[cur] = 1;
-        int32_t to = S->ct[cur], nx = -1;
-        for (int32_t g = 0; g < S->nce && nx < 0; g++)
-            if (!S->cdead[g] && S->cf[g] == to) nx = g;
-        if (nx < 0) {
-            if (to != S->cf[e0]) return -2;
-            break;
+        q = T[q].next;
+        cnt++;
+    } while (q > 0 && cnt < nnew);
+    if (q != 0 || cnt != nnew) return -2;
+    /* write: the new vertices into the outside vertices' slots, then after the live ones */
+    int32_t nslot = P->nslot, ep = P->ep;
+    double *restrict X2 = P->x2;
+#define NEW_ID(q) ((q) < nout ? outl[q] : nv0 + ((q) - nout))
+    for (int32_t q = 0; q < nnew; q++) {
+        int32_t x = NEW_ID(q), w = T[q].w, j = T[q].j;
+        if (x >= nslot) {
+            off[x] = ep;
+            P->room[x] = 3;
+            ep += 3;
+            nslot = x + 1;
         }
-        cur = nx;
-    } while (cnt <= m);
-    if (cnt != m) return -2;
-    int32_t f = P->nf++;
-    P->foff[f] = P->pool;
-    P->flen[f] = m;
-    P->fcp[f] = m + 4;
-    P->ftag[f] = tag;
-    double *q = P->fpl + 4 * f;
-    q[0] = n[0], q[1] = n[1], q[2] = n[2], q[3] = c;
-    P->pool += m + 4;
-    P->nl += m;
-    return 0;
-}
-
-/* The pool rewritten with each face's loop and a little room, in face order. */
-static void pool_compact(scratch *S)
-{
-    poly *P = &S->p;
-    int32_t at = 0;
-    for (int32_t f = 0; f < P->nf; f++) {
-        memcpy(S->buf + at, P->fv + P->foff[f], (size_t)P->flen[f] * sizeof(int32_t));
-        P->foff[f] = at;
-        P->fcp[f] = P->flen[f] + 4;
-        at += P->fcp[f];
+        int32_t ox = off[x], nx = T[q].next, pv = T[q].prev;
+        double px = T[q].x, py = T[q].y, pz = T[q].z;
+        X[x] = px, Y[x] = py, Z[x] = pz;
+        X2[x] = px * px + py * py + pz * pz;
+        deg[x] = 3;
+        d[x] = 0;
+        nb[ox] = w, bk[ox] = j, ef[ox] = T[q].f1;
+        nb[ox + 1] = NEW_ID(nx), bk[ox + 1] = 2, ef[ox + 1] = cap;
+        nb[ox + 2] = NEW_ID(pv), bk[ox + 2] = 1, ef[ox + 2] = T[q].f2;
+        nb[off[w] + j] = x, bk[off[w] + j] = 0;
     }
-    memcpy(P->fv, S->buf, (size_t)at * sizeof(int32_t));
-    P->pool = at;
-}
-
-/* Room for a cut of p: every face may move to the pool's end, a new face, new vertices (at
- * most one per edge). */
-static int cut_reserve(scratch *S)
-{
-    poly *P = &S->p;
-    int32_t room = P->nl + 5 * P->nf + 8, nv = P->nv + P->nl / 2 + 4;
-    if (grow((void **)&S->buf, &S->bufcap, room + P->nl + 2 * P->nv, sizeof(int32_t))) return -1;
-    if (P->pool > 2 * P->nl + 64) pool_compact(S); /* into buf: needs nl + 4 nf */
-    /* the common case: everything already fits (the checks below, at once) */
-    if (nv <= P->vcap && nv <= S->dcap && P->nf + 2 <= P->fcap &&
-        P->pool + room + P->nl + nv <= P->lcap && P->nl / 2 + 4 <= S->xecap && room <= S->cecap)
+#undef NEW_ID
+    P->nslot = nslot;
+    P->ep = ep;
+    if (nnew >= nout) {
+        P->nv = nv0 + nnew - nout;
         return 0;
-    if (poly_reserve(S, nv, P->nf + 2, P->pool + room + P->nl + nv)) return -1;
-    if (grow((void **)&S->xe, &S->xecap, P->nl / 2 + 4, sizeof(xedge))) return -1;
-    int32_t c1 = S->cecap, c2 = S->cecap, c3 = S->cecap; /* cf, ct, cdead: one capacity */
-    if (grow((void **)&S->cf, &c1, room, sizeof(int32_t))) return -1;
-    if (grow((void **)&S->ct, &c2, room, sizeof(int32_t))) return -1;
-    if (grow((void **)&S->cdead, &c3, room, 1)) return -1;
-    S->cecap = c1;
+    }
+    return nout - nnew;
+}
+
+/* The cap's edge a -> b; -1 when a already leaves or b is already reached (not one loop). */
+static int cap_edge(scratch *S, int32_t a, int32_t b)
+{
+    if (a < 0 || S->cnext[a] >= 0 || S->cprev[b] >= 0) return -1;
+    S->cnext[a] = b;
+    S->cprev[b] = a;
     return 0;
 }
 
-/* Slots no loop names any more become free; r2 from the rest. */
-static void free_dead(poly *P)
+/* The end of the run reached by entry e (see run_end), from start: the new vertex on that
+ * edge, or the on vertex itself (which keeps the start for the face's entry there). */
+static int32_t run_target(scratch *S, int32_t e, int32_t start)
 {
-    P->r2 = 0;
-    for (int32_t k = 0; k < P->nv; k++) {
-        if (P->ref[k] == 0) {
-            double *x = P->x + 3 * k;
-            P->ref[k] = -1;
-            x[0] = x[1] = x[2] = 0;
-            P->x2[k] = 0;
-            P->freel[P->nfree++] = k;
-        }
-        P->r2 = P->x2[k] > P->r2 ? P->x2[k] : P->r2;
-    }
+    const poly *P = &S->p;
+    int32_t q = P->nb[e];
+    if (S->cls[q] == C_IN) return S->xn[e];
+    int32_t j = P->bk[e];
+    S->rs[P->off[q] + (j ? j : P->deg[q]) - 1] = start;
+    return q;
 }
 
-/* Cuts p by n . x <= c (tol in the units of n . x; the new face tagged tag). Returns 0 when no
- * vertex is outside (p unchanged), 1 when cut, -1 out of memory, -2 inconsistent (nothing
- * inside, or a new face that does not close). */
-static int poly_cut(scratch *S, const double n[3], double c, double tol, int32_t tag)
+/* The cut with on vertices (degenerate input), by the rules of one classification: a face
+ * with an outside vertex and no inside one goes (dropped), one with both is clipped (each
+ * run of outside vertices replaced by its ends: a new vertex on a crossing edge, or the on
+ * vertex before or after it), one without an outside vertex stays. The cap is the loop of
+ * the clipped runs' ends and of the edges between on vertices that have a dropped face on
+ * one side and a face that stays on the other; the on vertices' edges are rebuilt around
+ * their faces that stay (a vertex left with none goes: d = +inf). Returns the count of dead
+ * vertices, listed ascending in outl; -1 out of memory, -2 when the cap is not one loop or a
+ * vertex's faces do not close. */
+static int32_t cut_degenerate(scratch *S, int32_t nout, int32_t cap, double tol)
 {
     poly *P = &S->p;
-    if (poly_max(S, n) - c <= tol) return 0;
-    if (cut_reserve(S)) return -1;
-    int nin, nout = classify(S, c, tol, &nin);
-    if (nout == 0) return 0;
-    if (nin == 0) return -2;
-    S->nxe = S->nce = 0;
-    if (++S->cutno == 0) { /* wrapped: no stamp may look current */
-        memset(S->xs, 0, (size_t)S->dcap * sizeof(xslot));
-        S->cutno = 1;
+    int32_t nv0 = P->nv, extra = 0, maxd = 0;
+    for (int32_t v = 0; v < nv0; v++) {
+        double e = S->d[v];
+        S->cls[v] = (unsigned char)(e > tol ? C_OUT : (e < -tol ? C_IN : C_ON));
+        if (S->cls[v] == C_OUT) extra += 3 * P->deg[v];
+        if (S->cls[v] == C_ON) {
+            extra += P->deg[v] + 1;
+            maxd = P->deg[v] > maxd ? P->deg[v] : maxd;
+        }
     }
-    for (int32_t f = P->nf - 1; f >= 0; f--) face_cut(S, f); /* backwards: drops swap in done faces */
-    int rc = cap_face(S, n, c, tag);
-    if (rc) return rc;
-    free_dead(P);
+    slab t[] = {{(void **)&S->tnb, sizeof(int32_t)}, {(void **)&S->tef, sizeof(int32_t)}};
+    if (eslots(S, P->ep + extra) || grow((void **)&S->fmask, &S->fmcap, P->nf, 1) ||
+        grow_set(t, 2, &S->tcap, maxd + 1))
+        return -1;
+    unsigned char *fm = S->fmask;
+    memset(fm, 0, (size_t)P->nf);
+    for (int32_t v = 0; v < nv0; v++)
+        for (int32_t k = 0, o = P->off[v]; k < P->deg[v]; k++) fm[P->ef[o + k]] |= S->cls[v];
+#define DROPPED(f) ((fm[f] & (C_OUT | C_IN)) == C_OUT)
+    int32_t nnew = cross_all(S, nout, cap, tol), nall = nv0 + nnew;
+    for (int32_t x = nv0; x < nall; x++) S->cls[x] = C_ON;
+    for (int32_t v = 0; v < nall; v++) S->cnext[v] = S->cprev[v] = -1;
+    for (int32_t v = 0; v < nv0; v++)
+        if (S->cls[v] == C_ON)
+            for (int32_t k = 0, o = P->off[v]; k < P->deg[v]; k++) S->rs[o + k] = S->re[o + k] = -1;
+    /* the clipped runs: from a new vertex (its face inside -> outside is clipped) */
+    for (int32_t q = 0; q < nnew; q++) {
+        int32_t e = run_end(S, S->ws[q], tol, P->ep);
+        if (e < 0 || cap_edge(S, run_target(S, e, nv0 + q), nv0 + q)) return -2;
+    }
+    /* ... and from an on vertex into a clipped face */
+    for (int32_t p = 0; p < nv0; p++) {
+        if (S->cls[p] != C_ON) continue;
+        for (int32_t k = 0, o = P->off[p]; k < P->deg[p]; k++) {
+            int32_t u = P->nb[o + k], j = P->bk[o + k];
+            if (S->cls[u] != C_OUT || DROPPED(P->ef[o + k])) continue;
+            int32_t e = run_end(S, P->off[u] + (j ? j : P->deg[u]) - 1, tol, P->ep);
+            if (e < 0) return -2;
+            S->re[o + k] = run_target(S, e, p);
+            if (cap_edge(S, S->re[o + k], p)) return -2;
+        }
+    }
+    /* edges between on vertices with a dropped face on one side only */
+    for (int32_t a = 0; a < nv0; a++) {
+        if (S->cls[a] != C_ON) continue;
+        for (int32_t k = 0, o = P->off[a]; k < P->deg[a]; k++) {
+            int32_t b = P->nb[o + k];
+            if (S->cls[b] == C_ON && DROPPED(P->ef[o + k]) &&
+                !DROPPED(P->ef[P->off[b] + P->bk[o + k]]) && cap_edge(S, a, b))
+                return -2;
+        }
+    }
+    /* the cap: one loop through all its vertices */
+    int32_t ncap = nnew, start = nnew ? nv0 : -1;
+    for (int32_t v = 0; v < nv0; v++)
+        if (S->cnext[v] >= 0) {
+            ncap++;
+            start = start < 0 ? v : start;
+        }
+    if (ncap < 3) return -2;
+    int32_t cnt = 0, v = start;
+    do {
+        v = S->cnext[v];
+        cnt++;
+    } while (v >= 0 && v != start && cnt < ncap);
+    if (v != start || cnt != ncap) return -2;
+    /* the on vertices' edges around their faces that stay, the cap between two of them */
+    int32_t nre = 0;
+    for (int32_t v = 0; v < nv0; v++) {
+        if (S->cls[v] != C_ON) continue;
+        int32_t D = P->deg[v], o = P->off[v], change = S->cnext[v] >= 0, first = -1;
+        for (int32_t k = 0; k < D; k++) {
+            int drop = DROPPED(P->ef[o + k]);
+            change |= drop | (S->cls[P->nb[o + k]] == C_OUT);
+            first = first < 0 && !drop ? k : first;
+        }
+        if (!change) continue;
+        if (first < 0) { /* no face stays: the vertex goes */
+            if (S->cnext[v] >= 0 || S->cprev[v] >= 0) return -2;
+            S->cls[v] = C_DEAD;
+            continue;
+        }
+        int32_t m = 0, gaps = 0, gt = -1, gs = -1, s0 = -1, tprev = -1;
+        for (int32_t i = 0; i < D; i++) {
+            int32_t k = (first + i) % D, k1 = k + 1 < D ? k + 1 : 0;
+            if (DROPPED(P->ef[o + k])) continue;
+            int32_t ek = P->nb[o + k], ek1 = P->nb[o + k1];
+            int32_t s = S->cls[ek] == C_OUT ? S->re[o + k] : ek;
+            int32_t t = S->cls[ek1] == C_OUT ? S->rs[o + k] : ek1;
+            if (s < 0 || t < 0) return -2;
+            if (i == 0) s0 = s;
+            else if (tprev != s) {
+                S->tnb[m] = tprev, S->tef[m++] = cap;
+                gaps++, gt = tprev, gs = s;
+            }
+            S->tnb[m] = s, S->tef[m++] = P->ef[o + k];
+            tprev = t;
+        }
+        if (tprev != s0) {
+            S->tnb[m] = tprev, S->tef[m++] = cap;
+            gaps++, gt = tprev, gs = s0;
+        }
+        if (gaps > 1 || (gaps == 1 && (S->cnext[v] != gt || S->cprev[v] != gs)) ||
+            (gaps == 0 && S->cnext[v] >= 0))
+            return -2;
+        if (m > P->room[v]) {
+            P->off[v] = P->ep;
+            P->room[v] = m;
+            P->ep += m;
+        }
+        memcpy(P->nb + P->off[v], S->tnb, (size_t)m * sizeof(int32_t));
+        memcpy(P->ef + P->off[v], S->tef, (size_t)m * sizeof(int32_t));
+        P->deg[v] = m;
+        S->wl[nre++] = v;
+    }
+#undef DROPPED
+    /* the new vertices' cap edges, then the back indices around the rebuilt vertices */
+    for (int32_t x = nv0; x < nall; x++) {
+        int32_t ox = P->off[x];
+        P->nb[ox + 1] = S->cnext[x], P->bk[ox + 1] = 2;
+        P->nb[ox + 2] = S->cprev[x], P->bk[ox + 2] = 1;
+    }
+    for (int32_t q = 0; q < nre; q++) {
+        int32_t v = S->wl[q], o = P->off[v];
+        for (int32_t k = 0; k < P->deg[v]; k++) {
+            int32_t w = P->nb[o + k], ow = P->off[w], i = 0;
+            while (i < P->deg[w] && P->nb[ow + i] != v) i++;
+            if (i == P->deg[w]) return -2;
+            P->bk[o + k] = i;
+            P->bk[ow + i] = k;
+        }
+    }
+    /* the dead: outside vertices and on vertices left without a face, ascending */
+    int32_t nd = 0;
+    for (int32_t v = 0; v < nv0; v++)
+        if (S->cls[v] & (C_OUT | C_DEAD)) {
+            S->d[v] = INFINITY;
+            S->outl[nd++] = v;
+        }
+    return nd;
+}
+
+/* Removes the dead vertices (dead[0 .. nd), ascending; the dead have d > tol, the others,
+ * new ones included, not) by moving the last live ones into their slots; r2 anew. */
+static void poly_compact(scratch *S, const int32_t *dead, int32_t nd, double tol)
+{
+    poly *P = &S->p;
+    const double *d = S->d;
+    int32_t live = P->nv - nd, last = P->nv - 1;
+    for (int32_t q = 0; q < nd && dead[q] < live; q++) {
+        while (d[last] > tol) last--;
+        vertex_move(P, last--, dead[q]);
+    }
+    P->nv = live;
+    P->r2 = vmax(P->x2, live);
+}
+
+/* Cuts p by n . x <= c (tol in the units of n . x; the new face tagged tag). Every vertex is
+ * classified once by its signed distance: outside (> tol), inside (< -tol) or on. Returns 0
+ * when no vertex is outside (p unchanged), 1 when cut, -1 out of memory, -2 inconsistent
+ * (nothing inside, or a cap that does not close). The plane test comes first (poly_cut;
+ * poly_cut_found once plane_dist has found a vertex outside): most planes tested cut
+ * nothing. */
+static int poly_cut_found(scratch *S, const double n[3], double c, double tol, int32_t tag)
+{
+    poly *P = &S->p;
+    double *d = S->d;
+    int32_t nv = P->nv;
+    int32_t *outl = S->outl, nout = 0, nin = 0, grow_by = 0, k = 0;
+#ifdef __SSE2__
+    __m128d T = _mm_set1_pd(tol), NT = _mm_set1_pd(-tol);
+    for (; k + 2 <= nv; k += 2) {
+        __m128d e = _mm_loadu_pd(d + k);
+        int o = _mm_movemask_pd(_mm_cmpgt_pd(e, T)), in = _mm_movemask_pd(_mm_cmplt_pd(e, NT));
+        nin += (in & 1) + (in >> 1);
+        outl[nout] = k;
+        nout += o & 1;
+        outl[nout] = k + 1;
+        nout += o >> 1;
+    }
+#endif
+    for (; k < nv; k++) {
+        double e = d[k];
+        outl[nout] = k;
+        nout += e > tol;
+        nin += e < -tol;
+    }
+    if (nin == 0) return -2;
+    for (int32_t q = 0; q < nout; q++) grow_by += P->deg[outl[q]];
+    if (nv + grow_by + 1 > P->vcap || nv + grow_by + 1 > S->scap || P->ep + 3 * grow_by > P->ecap ||
+        P->ep + 3 * grow_by > S->xcap || P->nf + 1 > P->fcap || grow_by + 1 > S->wcap) {
+        slab w[] = {{(void **)&S->ws, sizeof(int32_t)}, {(void **)&S->xt, sizeof(struct xnew)}};
+        if (vslots(S, nv + grow_by) || eslots(S, P->ep + 3 * grow_by) || fslots(S, P->nf + 1) ||
+            grow_set(w, 2, &S->wcap, grow_by + 1))
+            return -1;
+    }
+    int32_t cap = P->nf++;
+    P->ftag[cap] = tag;
+    double *q = P->fpl + 4 * cap;
+    q[0] = n[0], q[1] = n[1], q[2] = n[2], q[3] = c;
+    if (nout + nin == nv) {
+        int32_t rest = cut_plain(S, nout, cap, tol);
+        if (rest < 0) return rest;
+        poly_compact(S, S->outl + nout - rest, rest, tol);
+    } else {
+        nout = cut_degenerate(S, nout, cap, tol);
+        if (nout < 0) return nout;
+        poly_compact(S, S->outl, nout, tol);
+    }
     return 1;
 }
 
-/* Adds the tetrahedra (origin, fan triangles from L[0] of the loop L of m vertices of x) to
- * s: 6 V, then 24 V g, then 120 times the integral of x x^T (xx xy xz yy yz zz). */
-static void loop_moments(const double *x, const int32_t *L, int32_t m, double s[10])
+static int poly_cut(scratch *S, const double n[3], double c, double tol, int32_t tag)
 {
-    const double *a = x + 3 * L[0];
+    return plane_dist(&S->p, n, c, S->d) <= tol ? 0 : poly_cut_found(S, n, c, tol, tag);
+}
+
+/* Adds the tetrahedra (origin, fan triangles from L[0] of the loop L of m vertices of x) to
+ * s: 6 V, then 24 V g, then 120 times the integral of x x^T (xx xy xz yy yz zz); pp holds
+ * each vertex's products x_p x_q in that order. */
+static void loop_moments(const double *x, const double *pp, const int32_t *L, int32_t m,
+                         double s[10])
+{
+    const double *a = x + 3 * L[0], *pa = pp + 6 * L[0];
+#ifdef __SSE2__
+    /* the same operations as below, two sums at a time (det * 1 is det) */
+    __m128d U[5], A01 = _mm_loadu_pd(a), PA[3], one = _mm_set_sd(1.0);
+    one = _mm_unpacklo_pd(one, one);
+    for (int q = 0; q < 5; q++) U[q] = _mm_loadu_pd(s + 2 * q);
+    for (int q = 0; q < 3; q++) PA[q] = _mm_loadu_pd(pa + 2 * q);
+    for (int32_t k = 1; k + 1 < m; k++) {
+        const double *b = x + 3 * L[k], *c = x + 3 * L[k + 1];
+        const double *pb = pp + 6 * L[k], *pc = pp + 6 * L[k + 1];
+        double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                     a[2] * (b[0] * c[1] - b[1] * c[0]);
+        __m128d T01 = _mm_add_pd(_mm_add_pd(A01, _mm_loadu_pd(b)), _mm_loadu_pd(c));
+        double t2 = a[2] + b[2] + c[2];
+        __m128d T2 = _mm_set1_pd(t2), D = _mm_set1_pd(det);
+        __m128d T0 = _mm_unpacklo_pd(T01, T01), T1 = _mm_unpackhi_pd(T01, T01);
+        __m128d TT[3] = {_mm_mul_pd(T0, T01), _mm_mul_pd(T01, _mm_unpacklo_pd(T2, T1)),
+                         _mm_mul_pd(_mm_unpacklo_pd(T1, T2), T2)};
+        U[0] = _mm_add_pd(U[0], _mm_mul_pd(D, _mm_unpacklo_pd(one, T01)));
+        U[1] = _mm_add_pd(U[1], _mm_mul_pd(D, _mm_unpacklo_pd(T1, T2)));
+        for (int q = 0; q < 3; q++) {
+            __m128d e = _mm_add_pd(_mm_add_pd(PA[q], _mm_loadu_pd(pb + 2 * q)), _mm_loadu_pd(pc + 2 * q));
+            U[2 + q] = _mm_add_pd(U[2 + q], _mm_mul_pd(D, _mm_add_pd(e, TT[q])));
+        }
+    }
+    for (int q = 0; q < 5; q++) _mm_storeu_pd(s + 2 * q, U[q]);
+#else
     double u[10]; /* the face's sums in registers (s may alias x for all the compiler knows) */
     memcpy(u, s, sizeof u);
     for (int32_t k = 1; k + 1 < m; k++) {
         const double *b = x + 3 * L[k], *c = x + 3 * L[k + 1];
+        const double *pb = pp + 6 * L[k], *pc = pp + 6 * L[k + 1];
         double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
                      a[2] * (b[0] * c[1] - b[1] * c[0]);
         double t[3] = {a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2]};
+        double tt[6] = {t[0] * t[0], t[0] * t[1], t[0] * t[2], t[1] * t[1], t[1] * t[2], t[2] * t[2]};
         u[0] += det;
         for (int q = 0; q < 3; q++) u[1 + q] += det * t[q];
-        int idx = 4;
-        for (int p = 0; p < 3; p++)
-            for (int q = p; q < 3; q++)
-                u[idx++] += det * (a[p] * a[q] + b[p] * b[q] + c[p] * c[q] + t[p] * t[q]);
+        for (int q = 0; q < 6; q++) u[4 + q] += det * (pa[q] + pb[q] + pc[q] + tt[q]);
     }
     memcpy(s, u, sizeof u);
+#endif
 }
 
 /* Volume, centroid and second moments about the frame's origin from loop_moments' sums. */
@@ -487,14 +762,6 @@ static void moments_finish(const double s[10], double *vol, double g[3], double 
     *vol = s[0] / 6;
     for (int q = 0; q < 3; q++) g[q] = s[0] != 0 ? s[1 + q] / (4 * s[0]) : 0;
     for (int q = 0; q < 6; q++) m[q] = s[4 + q] / 120;
-}
-
-/* Volume, centroid and second moments (about the frame's origin) of P. */
-static void poly_moments(const poly *P, double *vol, double g[3], double m[6])
-{
-    double s[10] = {0};
-    for (int32_t f = 0; f < P->nf; f++) loop_moments(P->x, P->fv + P->foff[f], P->flen[f], s);
-    moments_finish(s, vol, g, m);
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -533,6 +800,7 @@ struct gp_voronoi3d {
      * bound of their distance from any point of that bin (lb), in batches of equal lb */
     int32_t reach, nbatch;
     int32_t *off;       /* dx dy dz per offset */
+    int32_t *offl;      /* per offset: its bin index offset (dz gn[1] + dy) gn[0] + dx */
     int32_t *batch;     /* nbatch + 1 starts into off */
     double *blb;        /* per batch: the lower bound, squared */
     vbin *bins;
@@ -600,38 +868,6 @@ static int cand_less(const cand *a, const cand *b)
     return a->d2 < b->d2 || (a->d2 == b->d2 && a->j < b->j);
 }
 
-/* Candidates by (distance, index): a counting sort on the distance into about one bucket per
- * candidate, then an insertion pass (cheap on the nearly sorted result) that makes the order
- * exact. -1 out of memory. */
-static int cand_sort(scratch *S)
-{
-    int32_t n = S->ncd;
-    cand *c = S->cd;
-    if (n > 24) {
-        if (grow((void **)&S->cd2, &S->cd2cap, n, sizeof(cand)) ||
-            grow((void **)&S->cnt, &S->cntcap, n + 1, sizeof(int32_t)))
-            return -1;
-        double mx = 0;
-        for (int32_t k = 0; k < n; k++) mx = c[k].d2 > mx ? c[k].d2 : mx;
-        double sc = (n - 1) / (mx > 0 ? mx : 1);
-        memset(S->cnt, 0, (size_t)(n + 1) * sizeof(int32_t));
-        for (int32_t k = 0; k < n; k++) S->cnt[(int32_t)(c[k].d2 * sc) + 1]++;
-        for (int32_t k = 0; k < n; k++) S->cnt[k + 1] += S->cnt[k];
-        for (int32_t k = 0; k < n; k++) S->cd2[S->cnt[(int32_t)(c[k].d2 * sc)]++] = c[k];
-        memcpy(c, S->cd2, (size_t)n * sizeof(cand));
-    }
-    for (int32_t k = 1; k < n; k++) {
-        cand t = c[k];
-        int32_t m = k;
-        while (m > 0 && cand_less(&t, &c[m - 1])) {
-            c[m] = c[m - 1];
-            m--;
-        }
-        c[m] = t;
-    }
-    return 0;
-}
-
 /* Squared distance from p to bin b (indices per axis). */
 static double bin_dist2(const gp_voronoi3d *v, const double p[3], const int32_t b[3])
 {
@@ -644,24 +880,38 @@ static double bin_dist2(const gp_voronoi3d *v, const double p[3], const int32_t 
     return s;
 }
 
+/* The seeds of bin b (but seed i at si) nearer than sqrt(lim) into the candidates. */
+static inline int gather_seeds(scratch *S, const vbin *b, uint32_t i, const double si[3], double lim)
+{
+    if (S->ncd + b->cnt > S->cdcap && grow((void **)&S->cd, &S->cdcap, S->ncd + b->cnt, sizeof(cand)))
+        return -1;
+    cand *cd = S->cd;
+    int32_t n = S->ncd;
+    double mx = S->cdmax;
+    for (int32_t k = 0; k < b->cnt; k++) { /* without a branch: kept or not is random */
+        int32_t j = b->e[k].j;
+        const double *sj = b->e[k].p;
+        double r[3] = {sj[0] - si[0], sj[1] - si[1], sj[2] - si[2]};
+        double d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        int keep = (d2 < lim) & ((uint32_t)j != i);
+        cd[n] = (cand){{r[0], r[1], r[2]}, d2, j};
+        n += keep;
+        mx = keep && d2 > mx ? d2 : mx;
+    }
+    S->ncd = n;
+    S->cdmax = mx;
+    return 0;
+}
+
 /* Adds the seeds of bin bb that may cut cell i (nearer than 2 R) to the candidates. */
 static int gather_bin(gp_voronoi3d *v, uint32_t i, const int32_t bb[3])
 {
     scratch *S = &v->s;
-    const double *si = v->seed + 3 * i;
+    const double *si = S->si;
     double lim = 4 * S->p.r2 * V3_SLACK;
     if (bin_dist2(v, si, bb) > lim) return 0;
-    vbin *b = &v->bins[((size_t)bb[2] * v->gn[1] + (size_t)bb[1]) * v->gn[0] + (size_t)bb[0]];
-    if (grow((void **)&S->cd, &S->cdcap, S->ncd + b->cnt, sizeof(cand))) return -1;
-    for (int32_t k = 0; k < b->cnt; k++) {
-        int32_t j = b->e[k].j;
-        if ((uint32_t)j == i) continue;
-        const double *sj = b->e[k].p;
-        double r[3] = {sj[0] - si[0], sj[1] - si[1], sj[2] - si[2]};
-        double d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        if (d2 < lim) S->cd[S->ncd++] = (cand){{r[0], r[1], r[2]}, d2, j};
-    }
-    return 0;
+    const vbin *b = &v->bins[((size_t)bb[2] * v->gn[1] + (size_t)bb[1]) * v->gn[0] + (size_t)bb[0]];
+    return gather_seeds(S, b, i, si, lim);
 }
 
 /* The bins at Chebyshev distance k0..k from bin c into the candidates. */
@@ -692,17 +942,63 @@ static int note_cutter(scratch *S, int32_t j)
     return 0;
 }
 
-/* Cuts cell i by the candidates, nearest first, while they are nearer than 2 R. */
+/* Cuts by the candidates c[o[0]], c[o[1]] ... c[o[n - 1]] (o NULL: c[0 .. n)) in that order: 1
+ * at a candidate farther than 2 R (so is the rest), else 0; or poly_cut's error. */
+static int cut_run(scratch *S, const cand *c, const int32_t *o, int32_t n)
+{
+    for (int32_t k = 0; k < n; k++) {
+        const cand *q = c + (o ? o[k] : k);
+        double d2 = q->d2;
+        if (d2 > 4 * S->p.r2 * V3_SLACK) return 1;
+        double m = plane_dist(&S->p, q->r, 0.5 * d2, S->d), tol;
+        if (m <= 0 || m <= (tol = V3_EPS * sqrt(S->p.r2 * d2))) continue; /* tol >= 0 */
+        int rc = poly_cut_found(S, q->r, 0.5 * d2, tol, q->j);
+        if (rc < 0) return rc;
+        if (rc == 1 && note_cutter(S, q->j)) return -1;
+    }
+    return 0;
+}
+
+/* Cuts cell i by the candidates in increasing (distance, index) while they are nearer than
+ * 2 R. Beyond 24 of them, a counting sort of their indices on the distance into about one
+ * bucket per candidate, each bucket put in exact order (insertion) only when the cutting
+ * reaches it: the buckets beyond the security radius are never sorted. */
 static int cut_candidates(scratch *S)
 {
-    if (cand_sort(S)) return -1;
-    for (int32_t k = 0; k < S->ncd; k++) {
-        double d2 = S->cd[k].d2;
-        if (d2 > 4 * S->p.r2 * V3_SLACK) break;
-        double tol = V3_EPS * sqrt(S->p.r2 * d2);
-        int rc = poly_cut(S, S->cd[k].r, 0.5 * d2, tol, S->cd[k].j);
-        if (rc < 0) return rc;
-        if (rc == 1 && note_cutter(S, S->cd[k].j)) return -1;
+    int32_t n = S->ncd;
+    cand *c = S->cd;
+    if (n <= 24) {
+        for (int32_t k = 1; k < n; k++) {
+            cand t = c[k];
+            int32_t m = k;
+            for (; m > 0 && cand_less(&t, &c[m - 1]); m--) c[m] = c[m - 1];
+            c[m] = t;
+        }
+        if (n > 0) S->near_d2 = c[0].d2, S->near_j = c[0].j;
+        int rc = cut_run(S, c, NULL, n);
+        return rc < 0 ? rc : 0;
+    }
+    slab a[] = {{(void **)&S->ord, sizeof(int32_t)}, {(void **)&S->bkt, sizeof(int32_t)}};
+    if (grow_set(a, 2, &S->ordcap, n) || grow((void **)&S->cnt, &S->cntcap, n + 1, sizeof(int32_t)))
+        return -1;
+    double mx = S->cdmax, sc = (n - 1) / (mx > 0 ? mx : 1);
+    int32_t *cnt = S->cnt, *ord = S->ord, *bkt = S->bkt;
+    memset(cnt, 0, (size_t)(n + 1) * sizeof(int32_t));
+    for (int32_t k = 0; k < n; k++) cnt[(bkt[k] = (int32_t)(c[k].d2 * sc)) + 1]++;
+    for (int32_t k = 0; k < n; k++) cnt[k + 1] += cnt[k];
+    for (int32_t k = 0; k < n; k++) ord[cnt[bkt[k]]++] = k;
+    /* bucket b is now ord[cnt[b - 1] .. cnt[b]) */
+    for (int32_t b = 0, lo = 0; b < n; lo = cnt[b++]) {
+        int32_t m = cnt[b] - lo, *o = ord + lo;
+        if (m == 0) continue;
+        for (int32_t k = 1; k < m; k++) {
+            int32_t t = o[k], q = k;
+            for (; q > 0 && cand_less(&c[t], &c[o[q - 1]]); q--) o[q] = o[q - 1];
+            o[q] = t;
+        }
+        if (lo == 0) S->near_d2 = c[o[0]].d2, S->near_j = c[o[0]].j;
+        int rc = cut_run(S, c, o, m);
+        if (rc) return rc < 0 ? rc : 0;
     }
     return 0;
 }
@@ -711,7 +1007,7 @@ static int cut_candidates(scratch *S)
 static int cut_walls(gp_voronoi3d *v, uint32_t i)
 {
     scratch *S = &v->s;
-    const double *si = v->seed + 3 * i;
+    const double *si = S->si;
     for (int32_t k = 0; k < v->nplanes; k++) {
         const double *pl = v->pl + 4 * k;
         double h = pl[3] - (pl[0] * si[0] + pl[1] * si[1] + pl[2] * si[2]);
@@ -725,7 +1021,7 @@ static int cut_walls(gp_voronoi3d *v, uint32_t i)
 /* The starting polyhedron of cell i in its seed's frame. */
 static int cell_start(gp_voronoi3d *v, uint32_t i)
 {
-    const double *si = v->seed + 3 * i;
+    const double *si = v->s.si;
     double lo[3], hi[3];
     int32_t tag[6];
     int box = v->kind == GP_VORONOI3D_BOX;
@@ -748,18 +1044,42 @@ static double offset_lb(const gp_voronoi3d *v, const int32_t d[3])
     return s;
 }
 
-/* Candidates of one batch of offsets around bin c, then the cuts. */
-static int search_batch(gp_voronoi3d *v, uint32_t i, const int32_t c[3], int32_t bt)
+/* Per axis a, the squared gap from p to the bins c[a] + d, d = -reach .. reach, into
+ * g2[a * (2 reach + 1) + d + reach] (as bin_dist2's terms; INFINITY outside the grid). */
+static void gap_table(const gp_voronoi3d *v, const double p[3], const int32_t c[3], double *g2)
+{
+    int32_t R = v->reach;
+    for (int a = 0; a < 3; a++)
+        for (int32_t d = -R; d <= R; d++) {
+            int32_t b = c[a] + d;
+            double g = INFINITY;
+            if (b >= 0 && b < (int32_t)v->gn[a]) {
+                double lo = b * v->gh[a], hi = lo + v->gh[a];
+                g = p[a] < lo ? lo - p[a] : (p[a] > hi ? p[a] - hi : 0);
+                g *= g;
+            }
+            g2[a * (2 * R + 1) + d + R] = g;
+        }
+}
+
+/* Candidates of batch bt of the offsets around bin c (linear index cl), then the cuts: a bin
+ * within 2 R of the seed (its squared gaps from the table g2) gives its seeds within 2 R. */
+static int search_batch(gp_voronoi3d *v, uint32_t i, int32_t cl, const double *g2, int32_t bt)
 {
     scratch *S = &v->s;
-    S->ncd = 0;
+    const double *si = S->si, *gx = g2 + v->reach, *gy = gx + 2 * v->reach + 1,
+                 *gz = gy + 2 * v->reach + 1;
+    double lim = 4 * S->p.r2 * V3_SLACK;
+    int32_t nb = 0, *bl = S->bl; /* the bins in reach, listed without a branch */
     for (int32_t k = v->batch[bt]; k < v->batch[bt + 1]; k++) {
         const int32_t *d = v->off + 3 * k;
-        int32_t bb[3] = {c[0] + d[0], c[1] + d[1], c[2] + d[2]};
-        int ok = 1;
-        for (int a = 0; a < 3; a++) ok &= bb[a] >= 0 && bb[a] < (int32_t)v->gn[a];
-        if (ok && gather_bin(v, i, bb)) return -1;
+        bl[nb] = cl + v->offl[k];
+        nb += gx[d[0]] + gy[d[1]] + gz[d[2]] <= lim;
     }
+    S->ncd = 0;
+    S->cdmax = 0;
+    for (int32_t q = 0; q < nb; q++)
+        if (gather_seeds(S, &v->bins[bl[q]], i, si, lim)) return -1;
     return cut_candidates(&v->s);
 }
 
@@ -770,15 +1090,15 @@ static int search_batch(gp_voronoi3d *v, uint32_t i, const int32_t c[3], int32_t
 static int cell_search(gp_voronoi3d *v, uint32_t i)
 {
     scratch *S = &v->s;
-    int32_t c[3];
-    bin_of(v, v->seed + 3 * i, c);
-    double dup = V3_DUP * v->size;
+    int32_t c[3], cl = bin_of(v, S->si, c);
+    double dup = V3_DUP * v->size, g2[3 * 7];
+    gap_table(v, S->si, c, g2);
     for (int32_t bt = 0; bt < v->nbatch; bt++) {
         if (v->blb[bt] > 4 * S->p.r2 * V3_SLACK) break;
-        int rc = search_batch(v, i, c, bt);
+        int rc = search_batch(v, i, cl, g2, bt);
         if (rc) return rc;
-        if (bt == 0 && S->ncd > 0 && S->cd[0].d2 < dup * dup) {
-            S->dup = S->cd[0].j;
+        if (bt == 0 && S->ncd > 0 && S->near_d2 < dup * dup) {
+            S->dup = S->near_j;
             return -3;
         }
         if (bt == 0 && v->kind != GP_VORONOI3D_BOX && (rc = cut_walls(v, i))) return rc;
@@ -792,6 +1112,7 @@ static int cell_search(gp_voronoi3d *v, uint32_t i)
         double g = (k - 1) * v->ghmin;
         if (g * g > 4 * S->p.r2 * V3_SLACK) break;
         S->ncd = 0;
+        S->cdmax = 0;
         if (gather_shell(v, i, c, k, k)) return -1;
         int rc = cut_candidates(&v->s);
         if (rc) return rc;
@@ -819,7 +1140,8 @@ static gp_status build_reach(gp_voronoi3d *v)
     v->off = malloc(3 * (size_t)n * sizeof(int32_t));
     v->batch = malloc((size_t)(n + 1) * sizeof(int32_t));
     v->blb = malloc((size_t)n * sizeof(double));
-    if (!t || !v->off || !v->batch || !v->blb) {
+    v->offl = malloc((size_t)n * sizeof(int32_t));
+    if (!t || !v->off || !v->batch || !v->blb || !v->offl) {
         free(t);
         return GP_ERR_NOMEM;
     }
@@ -832,6 +1154,8 @@ static gp_status build_reach(gp_voronoi3d *v)
     v->nbatch = 0;
     for (int32_t k = 0; k < n; k++) {
         for (int q = 0; q < 3; q++) v->off[3 * k + q] = (int32_t)t[4 * k + 3 - q];
+        v->offl[k] = (int32_t)((v->off[3 * k + 2] * (int64_t)v->gn[1] + v->off[3 * k + 1]) *
+                                   (int64_t)v->gn[0] + v->off[3 * k]);
         if (k == 0 || t[4 * k] != t[4 * (k - 1)]) {
             v->blb[v->nbatch] = t[4 * k];
             v->batch[v->nbatch++] = k;
@@ -839,6 +1163,11 @@ static gp_status build_reach(gp_voronoi3d *v)
     }
     v->batch[v->nbatch] = n;
     v->reach = R;
+    v->s.bl = malloc((size_t)n * sizeof(int32_t)); /* room for any batch */
+    if (!v->s.bl) {
+        free(t);
+        return GP_ERR_NOMEM;
+    }
     free(t);
     return GP_OK;
 }
@@ -927,17 +1256,18 @@ static void vertex_canon(const poly *P, const int32_t *F, int32_t d, const doubl
 static int canon_reserve(scratch *S)
 {
     const poly *P = &S->p;
-    int32_t c[3] = {S->canv, S->canv, S->canv}, l = S->canl, f = S->canf;
-    if (grow((void **)&S->voff, &c[0], P->nv + 1, sizeof(int32_t)) ||
-        grow((void **)&S->vkey, &c[1], P->nv + 1, sizeof(vkey)) ||
-        grow((void **)&S->vord, &c[2], P->nv + 1, sizeof(int32_t)) ||
-        grow((void **)&S->vfac, &l, P->nl, sizeof(int32_t)) ||
-        grow((void **)&S->ford, &f, P->nf, sizeof(int32_t)))
-        return -1;
-    S->canv = c[0];
-    S->canl = l;
-    S->canf = f;
-    return 0;
+    int32_t nl = 0;
+    for (int32_t v = 0; v < P->nv; v++) nl += P->deg[v];
+    slab a[] = {{(void **)&S->voff, sizeof(int32_t)}, {(void **)&S->vord, sizeof(int32_t)},
+                {(void **)&S->remap, sizeof(int32_t)}, {(void **)&S->vkey, sizeof(vkey)},
+                {(void **)&S->pp, 6 * sizeof(double)}};
+    slab b[] = {{(void **)&S->vfac, sizeof(int32_t)}, {(void **)&S->lbuf, sizeof(int32_t)}};
+    slab c[] = {{(void **)&S->fent, sizeof(int32_t)}, {(void **)&S->fpres, sizeof(int32_t)},
+                {(void **)&S->ford, sizeof(int32_t)}};
+    return grow_set(a, 5, &S->canv, P->nv + 1) || grow_set(b, 2, &S->canl, nl + 1) ||
+                   grow_set(c, 3, &S->canf, P->nf + 1)
+               ? -1
+               : 0;
 }
 
 /* A tag as an unsigned key of the same order. */
@@ -959,26 +1289,28 @@ static void sort3(const int32_t *tag, int32_t F[3])
     F[0] = a, F[1] = b, F[2] = c;
 }
 
-/* Each live slot's faces, sorted by tag, into vfac[voff[k] .. voff[k + 1]), and its key (its
- * three lowest tags) into vkey[k]. -2 when a vertex has fewer than three faces (not a closed
- * polyhedron). */
-static int vertex_faces(scratch *S)
+/* Each vertex's faces, sorted by tag, into vfac[voff[v] .. voff[v + 1]) and its key (its
+ * three lowest tags) into vkey[v]; an edge entry of each present face into fent, the
+ * present faces into fpres; returns their count, -2 when a vertex has fewer than three
+ * faces (not a closed polyhedron). */
+static int32_t vertex_faces(scratch *S)
 {
     const poly *P = &S->p;
-    int32_t *fill = S->remap;
-    S->voff[0] = 0;
-    for (int32_t k = 0; k < P->nv; k++) {
-        S->voff[k + 1] = S->voff[k] + (P->ref[k] > 0 ? P->ref[k] : 0);
-        fill[k] = S->voff[k];
-    }
-    for (int32_t f = 0; f < P->nf; f++) {
-        const int32_t *L = P->fv + P->foff[f];
-        for (int32_t k = 0; k < P->flen[f]; k++) S->vfac[fill[L[k]]++] = f;
-    }
-    for (int32_t k = 0; k < P->nv; k++) {
-        if (P->ref[k] < 0) continue;
-        int32_t *F = S->vfac + S->voff[k], d = S->voff[k + 1] - S->voff[k];
+    const int32_t *ef = P->ef, *nb = P->nb, *bk = P->bk, *off = P->off, *deg = P->deg;
+    int32_t *restrict fent = S->fent, *restrict enx = S->enx, *restrict voff = S->voff;
+    for (int32_t f = 0; f < P->nf; f++) fent[f] = -1;
+    voff[0] = 0;
+    for (int32_t v = 0; v < P->nv; v++) {
+        int32_t d = deg[v], o = off[v], *F = S->vfac + voff[v];
         if (d < 3) return -2;
+        voff[v + 1] = voff[v] + d;
+        for (int32_t e = o; e < o + d; e++) {
+            int32_t f = ef[e], w = nb[e], j = bk[e];
+            *F++ = f;
+            fent[f] = e; /* any of its entries */
+            enx[e] = off[w] + (j ? j : deg[w]) - 1;
+        }
+        F -= d;
         if (d == 3) {
             sort3(P->ftag, F);
         } else {
@@ -988,10 +1320,13 @@ static int vertex_faces(scratch *S)
                 F[m] = t;
             }
         }
-        S->vkey[k] = (vkey){tag_key(P->ftag[F[0]]) << 32 | tag_key(P->ftag[F[1]]),
-                            tag_key(P->ftag[F[2]]), k};
+        S->vkey[v] = (vkey){tag_key(P->ftag[F[0]]) << 32 | tag_key(P->ftag[F[1]]),
+                            tag_key(P->ftag[F[2]]), v};
     }
-    return 0;
+    int32_t n = 0;
+    for (int32_t f = 0; f < P->nf; f++)
+        if (fent[f] >= 0) S->fpres[n++] = f;
+    return n;
 }
 
 /* Vertex a before vertex b: their tags in lexicographic order (a prefix first); equal lists
@@ -1007,30 +1342,47 @@ static int vertex_before(const scratch *S, const vkey *a, const vkey *b)
     return na != nb ? na < nb : a->slot < b->slot;
 }
 
-/* The faces by tag into ford: each face's rank is the count of smaller tags (one face per
- * plane, so the tags differ; counting has no unpredictable branch, unlike a sort). */
-static void face_order(scratch *S)
+/* The present faces by tag into ford: each face's rank is the count of smaller tags (one
+ * face per plane, so the tags differ; counting has no unpredictable branch, unlike a sort). */
+static void face_order(scratch *S, int32_t nf)
+{
+    const int32_t *F = S->fpres;
+    int32_t *tg = S->lbuf; /* the tags side by side: the inner loop vectorises */
+    for (int32_t q = 0; q < nf; q++) tg[q] = S->p.ftag[F[q]];
+    for (int32_t q = 0; q < nf; q++) {
+        int32_t r = 0, t = tg[q];
+        for (int32_t g = 0; g < nf; g++) r += tg[g] < t;
+        S->ford[r] = F[q];
+    }
+}
+
+/* The loop of face f (its vertices, counter-clockwise from outside) into lbuf; its length,
+ * or -1 when the walk does not come back within nl steps or leaves the face. */
+static int32_t face_loop(scratch *S, int32_t f, int32_t nl)
 {
     const poly *P = &S->p;
-    for (int32_t f = 0; f < P->nf; f++) {
-        int32_t r = 0, t = P->ftag[f];
-        for (int32_t g = 0; g < P->nf; g++) r += P->ftag[g] < t;
-        S->ford[r] = f;
-    }
+    int32_t e0 = S->fent[f], e = e0, m = 0;
+    do {
+        if (P->ef[e] != f || m == nl) return -1;
+        S->lbuf[m++] = P->nb[e];
+        e = S->enx[e];
+    } while (e != e0);
+    return m;
 }
 
 /* The canonical loops and tags of P into c: faces by tag, each loop from its vertex of lowest
  * key, the vertices numbered in order of first appearance along the loops so written (their
- * slots in vord, their numbers in remap). */
-static void cell_loops(scratch *S, vcell *c)
+ * slots in vord, their numbers in remap). -2 when the loops do not cover the edges once. */
+static int cell_loops(scratch *S, vcell *c)
 {
     const poly *P = &S->p;
     int32_t n = 0;
     for (int32_t k = 0; k < P->nv; k++) S->remap[k] = -1;
     c->foff[0] = 0;
-    for (int32_t q = 0; q < P->nf; q++) {
-        int32_t f = S->ford[q], m = P->flen[f], lo = 0;
-        const int32_t *L = P->fv + P->foff[f];
+    for (int32_t q = 0; q < c->nf; q++) {
+        int32_t f = S->ford[q], lo = 0, m = face_loop(S, f, c->nl - c->foff[q]);
+        const int32_t *L = S->lbuf;
+        if (m < 3) return -2;
         for (int32_t k = 1; k < m; k++) {
             const vkey *a = &S->vkey[L[k]], *b = &S->vkey[L[lo]];
             /* the keys differ but at degenerate vertices: decide those in full */
@@ -1049,6 +1401,7 @@ static void cell_loops(scratch *S, vcell *c)
         c->foff[q + 1] = c->foff[q] + m;
         c->ftag[q] = P->ftag[f];
     }
+    return c->foff[c->nf] == c->nl && n == c->nv ? 0 : -2;
 }
 
 /* The canonical positions of P's vertices into c, in vord's order. */
@@ -1058,17 +1411,23 @@ static void cell_vertices(const scratch *S, vcell *c)
     double R = sqrt(P->r2);
     for (int32_t m = 0; m < c->nv; m++) {
         int32_t k = S->vord[m];
-        vertex_canon(P, S->vfac + S->voff[k], S->voff[k + 1] - S->voff[k], P->x + 3 * k, R,
-                     c->x + 3 * m);
+        double xc[3] = {P->x[k], P->y[k], P->z[k]};
+        vertex_canon(P, S->vfac + S->voff[k], S->voff[k + 1] - S->voff[k], xc, R, c->x + 3 * m);
     }
 }
 
 /* Volume, centroid and inertia about the centroid of c from its own vertices and loops. */
-static void cell_moments(vcell *c)
+static void cell_moments(vcell *c, double *pp)
 {
     double s[10] = {0}, m[6];
+    for (int32_t v = 0; v < c->nv; v++) {
+        const double *x = c->x + 3 * v;
+        double *q = pp + 6 * v;
+        q[0] = x[0] * x[0], q[1] = x[0] * x[1], q[2] = x[0] * x[2];
+        q[3] = x[1] * x[1], q[4] = x[1] * x[2], q[5] = x[2] * x[2];
+    }
     for (int32_t f = 0; f < c->nf; f++)
-        loop_moments(c->x, c->fv + c->foff[f], c->foff[f + 1] - c->foff[f], s);
+        loop_moments(c->x, pp, c->fv + c->foff[f], c->foff[f + 1] - c->foff[f], s);
     moments_finish(s, &c->vol, c->cen, m);
     /* about the centroid: integral of r r^T less V g g^T; inertia = tr Id - that */
     const double *g = c->cen;
@@ -1085,52 +1444,59 @@ static void cell_moments(vcell *c)
 }
 
 /* The finished polyhedron, made canonical, and its cutters packed into one block: GP_OK and
- * *out, or an error status. */
+ * *out, or an error status (GP_ERR_INTERNAL also when a side of a starting box is left). */
 static gp_status cell_pack(scratch *S, vcell **out)
 {
     const poly *P = &S->p;
     if (canon_reserve(S)) return GP_ERR_NOMEM;
-    if (vertex_faces(S)) return GP_ERR_INTERNAL;
+    int32_t nf = vertex_faces(S), nnb = 0, nv = P->nv, nl = nv ? S->voff[nv] : 0;
+    if (nf < 4) return GP_ERR_INTERNAL;
+    for (int32_t q = 0; q < nf; q++) {
+        int32_t t = P->ftag[S->fpres[q]];
+        if (t <= TAG_BBOX + 5) return GP_ERR_INTERNAL;
+        nnb += t >= 0;
+    }
     sort_unique(S->cut, &S->ncut);
-    int32_t nnb = 0, nv = P->nv - P->nfree;
-    for (int32_t f = 0; f < P->nf; f++) nnb += P->ftag[f] >= 0;
-    size_t ni = (size_t)(P->nf + 1) + (size_t)P->nl + (size_t)P->nf + (size_t)nnb + (size_t)S->ncut;
+    size_t ni = (size_t)(nf + 1) + (size_t)nl + (size_t)nf + (size_t)nnb + (size_t)S->ncut;
     vcell *c = malloc(sizeof(vcell) + 3 * (size_t)nv * sizeof(double) + ni * sizeof(int32_t));
     if (!c) return GP_ERR_NOMEM;
     c->nv = nv;
-    c->nf = P->nf;
-    c->nl = P->nl;
+    c->nf = nf;
+    c->nl = nl;
     c->ncut = S->ncut;
     c->x = (double *)(c + 1);
     c->foff = (int32_t *)(c->x + 3 * nv);
-    c->fv = c->foff + P->nf + 1;
-    c->ftag = c->fv + P->nl;
-    c->nb = c->ftag + P->nf;
-    face_order(S);
-    cell_loops(S, c);
+    c->fv = c->foff + nf + 1;
+    c->ftag = c->fv + nl;
+    c->nb = c->ftag + nf;
+    face_order(S, nf);
+    if (cell_loops(S, c)) {
+        free(c);
+        return GP_ERR_INTERNAL;
+    }
     cell_vertices(S, c);
     c->nnb = 0;
-    for (int32_t f = 0; f < P->nf; f++)
+    for (int32_t f = 0; f < nf; f++)
         if (c->ftag[f] >= 0) c->nb[c->nnb++] = c->ftag[f]; /* ascending: the faces are by tag */
     c->cut = c->nb + c->nnb;
     if (S->ncut > 0) memcpy(c->cut, S->cut, (size_t)S->ncut * sizeof(int32_t)); /* NULL when 0 */
-    cell_moments(c);
+    cell_moments(c, S->pp);
     *out = c;
     return GP_OK;
 }
 
-/* Cell i computed from the current seeds: GP_OK and *out, or an error status. */
-static gp_status cell_compute(gp_voronoi3d *v, uint32_t i, vcell **out)
+/* Cell i (its seed at si, local frame) computed from the current seeds: GP_OK and *out, or
+ * an error status. */
+static gp_status cell_compute(gp_voronoi3d *v, uint32_t i, const double si[3], vcell **out)
 {
     scratch *S = &v->s;
+    memcpy(S->si, si, sizeof S->si);
     S->ncut = 0;
     if (cell_start(v, i)) return GP_ERR_NOMEM;
     int rc = cell_search(v, i);
     if (rc == -1) return GP_ERR_NOMEM;
     if (rc == -3) return GP_ERR_INVALID;
     if (rc) return GP_ERR_INTERNAL;
-    for (int32_t f = 0; f < S->p.nf; f++)
-        if (S->p.ftag[f] <= TAG_BBOX + 5) return GP_ERR_INTERNAL;
     return cell_pack(S, out);
 }
 
@@ -1164,42 +1530,58 @@ double gp_voronoi3d_cylinder_lost_volume(double r, double h, size_t facets)
     return (V3_PI - 0.5 * m * sin(2 * V3_PI / m)) * r * r * h;
 }
 
+/* The number of half-spaces of a convex or cylinder container (side facets, bottom, top), or
+ * an error for a bad one. */
+static gp_status container_count(const gp_voronoi3d_container *c, size_t *m, gp_error *err)
+{
+    *m = c->kind == GP_VORONOI3D_CONVEX ? c->nplanes : (c->facets ? c->facets : 64) + 2;
+    if (c->kind == GP_VORONOI3D_CONVEX && (*m < 4 || !c->planes))
+        return gp_error_set(err, GP_ERR_INVALID, "voronoi3d: a convex container needs >= 4 planes");
+    if (c->kind == GP_VORONOI3D_CYLINDER &&
+        (!(c->radius > 0) || !(c->z1 > c->z0) || *m < 5 || !isfinite(c->radius + c->z0 + c->z1 +
+                                                                       c->axis[0] + c->axis[1])))
+        return gp_error_set(err, GP_ERR_INVALID,
+                            "voronoi3d: a cylinder needs radius > 0, z1 > z0, facets >= 3");
+    if (*m > 100000) return gp_error_set(err, GP_ERR_INVALID, "voronoi3d: too many planes");
+    return GP_OK;
+}
+
+/* Half-space k of the m of a convex or cylinder container, unit normal, caller frame, into
+ * p; -1 when it is not a half-space. */
+static int container_plane(const gp_voronoi3d_container *c, size_t m, size_t k, double p[4])
+{
+    if (c->kind == GP_VORONOI3D_CONVEX) {
+        memcpy(p, c->planes + 4 * k, 4 * sizeof(double));
+    } else if (k + 2 < m) {
+        double t = 2 * V3_PI * ((double)k + 0.5) / (double)(m - 2);
+        p[0] = cos(t);
+        p[1] = sin(t);
+        p[2] = 0;
+        p[3] = p[0] * c->axis[0] + p[1] * c->axis[1] + c->radius * cos(V3_PI / (double)(m - 2));
+    } else {
+        int top = k + 1 == m;
+        p[0] = p[1] = 0;
+        p[2] = top ? 1 : -1;
+        p[3] = top ? c->z1 : -c->z0;
+    }
+    double nn = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    if (!(nn > 0) || !isfinite(nn) || !isfinite(p[3])) return -1;
+    for (int q = 0; q < 4; q++) p[q] /= nn;
+    return 0;
+}
+
 /* The half-spaces of a convex or cylinder container, unit normals, into v->pl (caller frame). */
 static gp_status container_planes(gp_voronoi3d *v, const gp_voronoi3d_container *c, gp_error *err)
 {
-    size_t m = c->kind == GP_VORONOI3D_CONVEX ? c->nplanes : (c->facets ? c->facets : 64) + 2;
-    if (c->kind == GP_VORONOI3D_CONVEX && (m < 4 || !c->planes))
-        return gp_error_set(err, GP_ERR_INVALID, "voronoi3d: a convex container needs >= 4 planes");
-    if (c->kind == GP_VORONOI3D_CYLINDER &&
-        (!(c->radius > 0) || !(c->z1 > c->z0) || m < 5 || !isfinite(c->radius + c->z0 + c->z1 +
-                                                                      c->axis[0] + c->axis[1])))
-        return gp_error_set(err, GP_ERR_INVALID,
-                            "voronoi3d: a cylinder needs radius > 0, z1 > z0, facets >= 3");
-    if (m > 100000) return gp_error_set(err, GP_ERR_INVALID, "voronoi3d: too many planes");
+    size_t m;
+    gp_status st = container_count(c, &m, err);
+    if (st) return st;
     v->pl = malloc(4 * m * sizeof(double));
     if (!v->pl) return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
     v->nplanes = (int32_t)m;
-    for (size_t k = 0; k < m; k++) {
-        double *p = v->pl + 4 * k;
-        if (c->kind == GP_VORONOI3D_CONVEX) {
-            memcpy(p, c->planes + 4 * k, 4 * sizeof(double));
-        } else if (k + 2 < m) {
-            double t = 2 * V3_PI * ((double)k + 0.5) / (double)(m - 2);
-            p[0] = cos(t);
-            p[1] = sin(t);
-            p[2] = 0;
-            p[3] = p[0] * c->axis[0] + p[1] * c->axis[1] + c->radius * cos(V3_PI / (double)(m - 2));
-        } else {
-            int top = k + 1 == m;
-            p[0] = p[1] = 0;
-            p[2] = top ? 1 : -1;
-            p[3] = top ? c->z1 : -c->z0;
-        }
-        double nn = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-        if (!(nn > 0) || !isfinite(nn) || !isfinite(p[3]))
+    for (size_t k = 0; k < m; k++)
+        if (container_plane(c, m, k, v->pl + 4 * k))
             return gp_error_set(err, GP_ERR_INVALID, "voronoi3d: plane %zu is not a half-space", k);
-        for (int q = 0; q < 4; q++) p[q] /= nn;
-    }
     return GP_OK;
 }
 
@@ -1218,8 +1600,10 @@ static int container_cut(gp_voronoi3d *v, const double ctr[3], double B)
         int rc = poly_cut(S, p, h, V3_EPS * sqrt(S->p.r2), -1 - k);
         if (rc < 0) return rc;
     }
-    for (int32_t f = 0; f < S->p.nf; f++)
-        if (S->p.ftag[f] <= TAG_BBOX + 5) return 1;
+    const poly *P = &S->p;
+    for (int32_t k = 0; k < P->nv; k++)
+        for (int32_t q = 0; q < P->deg[k]; q++)
+            if (P->ftag[P->ef[P->off[k] + q]] <= TAG_BBOX + 5) return 1;
     return 0;
 }
 
@@ -1241,8 +1625,8 @@ static gp_status container_bbox(gp_voronoi3d *v, double lo[3], double hi[3], gp_
         const poly *P = &v->s.p;
         for (int a = 0; a < 3; a++) lo[a] = INFINITY, hi[a] = -INFINITY;
         for (int32_t k = 0; k < P->nv; k++)
-            for (int a = 0; a < 3 && P->ref[k] >= 0; a++) {
-                double x = P->x[3 * k + a] + ctr[a];
+            for (int a = 0; a < 3; a++) {
+                double x = (a == 0 ? P->x : (a == 1 ? P->y : P->z))[k] + ctr[a];
                 lo[a] = x < lo[a] ? x : lo[a];
                 hi[a] = x > hi[a] ? x : hi[a];
             }
@@ -1260,17 +1644,18 @@ static gp_status container_bbox(gp_voronoi3d *v, double lo[3], double hi[3], gp_
     return GP_OK;
 }
 
-/* v's frame, planes, volume and starting box from the caller's container. */
-static gp_status container_setup(gp_voronoi3d *v, const gp_voronoi3d_container *c, gp_error *err)
+/* The container's bounding box (caller frame; for a convex or cylinder one, its planes into
+ * v->pl, caller frame too). */
+static gp_status container_bounds(gp_voronoi3d *v, const gp_voronoi3d_container *c, double lo[3],
+                                  double hi[3], gp_error *err)
 {
     v->kind = c->kind;
-    double lo[3], hi[3];
     if (c->kind == GP_VORONOI3D_BOX) {
         for (int a = 0; a < 3; a++)
             if (!(c->hi[a] > c->lo[a]) || !isfinite(c->hi[a] - c->lo[a]))
                 return gp_error_set(err, GP_ERR_INVALID, "voronoi3d: box needs lo < hi (axis %d)", a);
-        memcpy(lo, c->lo, sizeof lo);
-        memcpy(hi, c->hi, sizeof hi);
+        memcpy(lo, c->lo, 3 * sizeof(double));
+        memcpy(hi, c->hi, 3 * sizeof(double));
     } else if (c->kind == GP_VORONOI3D_CONVEX || c->kind == GP_VORONOI3D_CYLINDER) {
         gp_status st = container_planes(v, c, err);
         if (!st) st = container_bbox(v, lo, hi, err);
@@ -1278,6 +1663,15 @@ static gp_status container_setup(gp_voronoi3d *v, const gp_voronoi3d_container *
     } else {
         return gp_error_set(err, GP_ERR_INVALID, "voronoi3d: unknown container kind");
     }
+    return GP_OK;
+}
+
+/* v's frame, planes, volume and starting box from the caller's container. */
+static gp_status container_setup(gp_voronoi3d *v, const gp_voronoi3d_container *c, gp_error *err)
+{
+    double lo[3], hi[3];
+    gp_status st = container_bounds(v, c, lo, hi, err);
+    if (st) return st;
     double s2 = 0;
     for (int a = 0; a < 3; a++) {
         v->origin[a] = lo[a];
@@ -1295,11 +1689,14 @@ static gp_status container_setup(gp_voronoi3d *v, const gp_voronoi3d_container *
         double *p = v->pl + 4 * k;
         p[3] -= p[0] * lo[0] + p[1] * lo[1] + p[2] * lo[2];
     }
-    double ctr[3] = {0.5 * v->L[0], 0.5 * v->L[1], 0.5 * v->L[2]}, g[3], m[6];
+    double ctr[3] = {0.5 * v->L[0], 0.5 * v->L[1], 0.5 * v->L[2]};
     int rc = container_cut(v, ctr, 0.6 * fmax(v->L[0], fmax(v->L[1], v->L[2])));
-    if (rc) return gp_error_set(err, rc == -1 ? GP_ERR_NOMEM : GP_ERR_INTERNAL,
-                                "voronoi3d: the container could not be rebuilt");
-    poly_moments(&v->s.p, &v->cvol, g, m);
+    vcell *cc = NULL;
+    v->s.ncut = 0;
+    st = rc == -1 ? GP_ERR_NOMEM : (rc ? GP_ERR_INTERNAL : cell_pack(&v->s, &cc));
+    if (st) return gp_error_set(err, st, "voronoi3d: the container could not be rebuilt");
+    v->cvol = cc->vol; /* canonical, as a cell's */
+    free(cc);
     if (c->kind == GP_VORONOI3D_CYLINDER)
         v->lost = V3_PI * c->radius * c->radius * (c->z1 - c->z0) - v->cvol;
     return GP_OK;
@@ -1316,6 +1713,73 @@ static int contains_local(const gp_voronoi3d *v, const double p[3])
     for (int32_t k = 0; k < v->nplanes; k++) {
         const double *q = v->pl + 4 * k;
         if (!(q[0] * p[0] + q[1] * p[1] + q[2] * p[2] <= q[3] + tol)) return 0;
+    }
+    return 1;
+}
+
+gp_status gp_voronoi3d_container_bounds(const gp_voronoi3d_container *c, double lo[3], double hi[3],
+                                        gp_error *err)
+{
+    if (!c || !lo || !hi) return gp_error_set(err, GP_ERR_INVALID, "voronoi3d: need a container");
+    gp_voronoi3d *v = calloc(1, sizeof *v);
+    if (!v) return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    double l[3], h[3];
+    gp_status st = container_bounds(v, c, l, h, err);
+    gp_voronoi3d_destroy(v);
+    if (st) return st;
+    memcpy(lo, l, sizeof l);
+    memcpy(hi, h, sizeof h);
+    return GP_OK;
+}
+
+/* The test of contains_local() on the frame gp_voronoi3d_create() would set up: origin lo, size
+ * |hi - lo|, the planes made by the same function and moved to that frame the same way. */
+int gp_voronoi3d_container_inside(const gp_voronoi3d_container *c, const double lo[3],
+                                  const double hi[3], const double p[3])
+{
+    if (!c || !lo || !hi || !p || !isfinite(p[0] + p[1] + p[2])) return 0;
+    double L[3], q[3], s2 = 0;
+    for (int a = 0; a < 3; a++) {
+        L[a] = hi[a] - lo[a];
+        s2 += L[a] * L[a];
+        q[a] = p[a] - lo[a];
+    }
+    double tol = V3_INSIDE * sqrt(s2);
+    if (c->kind == GP_VORONOI3D_BOX) {
+        for (int a = 0; a < 3; a++)
+            if (!(q[a] >= -tol && q[a] <= L[a] + tol)) return 0;
+        return 1;
+    }
+    size_t m, sides;
+    if ((c->kind != GP_VORONOI3D_CONVEX && c->kind != GP_VORONOI3D_CYLINDER) ||
+        container_count(c, &m, NULL))
+        return 0;
+    if (c->kind == GP_VORONOI3D_CYLINDER) {
+        /* the bottom and the top first; then a point well inside the facets' inscribed circle
+         * passes them all, one well outside their circumscribed circle fails the facet nearest
+         * its direction: the margins (1e-12 of the magnitudes in play, and 4 tol outside) are
+         * far above the rounding of their tests (a few 1e-16 of those), so they need not be
+         * computed (the cos and the sin of each) */
+        for (size_t k = m - 2; k < m; k++) {
+            double pl[4];
+            container_plane(c, m, k, pl);
+            pl[3] -= pl[0] * lo[0] + pl[1] * lo[1] + pl[2] * lo[2];
+            if (!(pl[0] * q[0] + pl[1] * q[1] + pl[2] * q[2] <= pl[3] + tol)) return 0;
+        }
+        double dx = p[0] - c->axis[0], dy = p[1] - c->axis[1];
+        double M = fabs(lo[0]) + fabs(lo[1]) + fabs(p[0]) + fabs(p[1]) + fabs(c->axis[0]) +
+                   fabs(c->axis[1]) + c->radius;
+        double a = c->radius * cos(V3_PI / (double)(m - 2)) - 1e-12 * M, r2 = dx * dx + dy * dy;
+        double b = c->radius + 4 * tol + 1e-12 * M;
+        if (a > 0 && r2 <= a * a) return 1;
+        if (r2 > b * b) return 0;
+    }
+    sides = c->kind == GP_VORONOI3D_CYLINDER ? m - 2 : m;
+    for (size_t k = 0; k < sides; k++) {
+        double pl[4];
+        if (container_plane(c, m, k, pl)) return 0;
+        pl[3] -= pl[0] * lo[0] + pl[1] * lo[1] + pl[2] * lo[2];
+        if (!(pl[0] * q[0] + pl[1] * q[1] + pl[2] * q[2] <= pl[3] + tol)) return 0;
     }
     return 1;
 }
@@ -1408,7 +1872,7 @@ static gp_status build_cells(gp_voronoi3d *v, const volatile int *cancel, gp_err
             uint32_t i = (uint32_t)v->bins[b].e[k].j;
             if (++done % CANCEL_EVERY == 0 && cancel_raised(cancel))
                 return gp_error_set(err, GP_ERR_CANCELLED, "voronoi3d: cancelled");
-            gp_status st = cell_compute(v, i, &v->cell[i]);
+            gp_status st = cell_compute(v, i, v->bins[b].e[k].p, &v->cell[i]); /* in cache */
             uint32_t j = (uint32_t)v->s.dup;
             if (st == GP_ERR_INVALID)
                 return gp_error_set(err, st, "voronoi3d: seeds %u and %u coincide", i < j ? i : j,
@@ -1461,24 +1925,11 @@ gp_voronoi3d *gp_voronoi3d_create_ex(const gp_voronoi3d_container *c, const doub
 static void scratch_free(scratch *S)
 {
     poly_free(&S->p);
-    free(S->buf);
-    free(S->d);
-    free(S->cls);
-    free(S->remap);
-    free(S->xe);
-    free(S->xs);
-    free(S->cf);
-    free(S->ct);
-    free(S->cdead);
-    free(S->cd);
-    free(S->cd2);
-    free(S->cnt);
-    free(S->cut);
-    free(S->voff);
-    free(S->vkey);
-    free(S->vfac);
-    free(S->vord);
-    free(S->ford);
+    void *a[] = {S->d,    S->cls,  S->outl, S->ws, S->xt,    S->cnext, S->cprev, S->wl,
+                 S->xn,   S->rs,   S->re, S->enx,   S->tnb,  S->tef,   S->fmask, S->cd,    S->ord, S->bkt,
+                 S->cnt,  S->cut,  S->voff, S->vfac, S->vord,  S->remap, S->fent,  S->fpres,
+                 S->ford, S->lbuf, S->vkey, S->pp, S->bl};
+    for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) free(a[k]);
 }
 
 void gp_voronoi3d_destroy(gp_voronoi3d *v)
@@ -1504,6 +1955,7 @@ void gp_voronoi3d_destroy(gp_voronoi3d *v)
     free(v->off);
     free(v->batch);
     free(v->blb);
+    free(v->offl);
     scratch_free(&v->s);
     free(v);
 }
@@ -1565,7 +2017,7 @@ static gp_status recompute(gp_voronoi3d *v, uint32_t k)
 {
     uint32_t j = v->chg[k];
     vcell *c;
-    gp_status st = cell_compute(v, j, &c);
+    gp_status st = cell_compute(v, j, v->seed + 3 * (size_t)j, &c);
     if (st) return st;
     v->chg_old[k] = v->cell[j];
     v->cell[j] = c;

@@ -34,18 +34,24 @@
  * With seeds spread through the container a cell costs O(1), the build O(N). The nearest seed
  * of the first batch also tells a duplicate.
  *
- * Plane cutting. The polyhedron is kept as vertices and faces (vertex loops, outward), in
- * coordinates relative to its seed, and cut in place (faces the plane does not reach are not
- * touched). A cut classifies every vertex once by its signed distance to the plane: outside
- * (> tol), inside (< -tol) or on; tol = 1e-12 R (relative to the cell's size, so scaling all
- * coordinates changes nothing). Faces without an inside vertex go; the others are clipped (an
- * edge from inside to outside gets one new vertex, shared by its two faces); the new face is
- * chained from the clipped faces' edges that lie in the plane, an edge met in both directions
- * (two kept faces meeting on the plane) dropping out. Every decision comes from the one
- * classification, so the result is a closed polyhedron whatever the degeneracy: a plane
- * through vertices or along edges (lattices, co-spherical seeds) cuts nothing it should not,
- * and the volumes stay exact. A cell whose cutting goes wrong anyway is reported
- * (GP_ERR_INTERNAL), never guessed.
+ * Plane cutting. The polyhedron is kept as its vertex graph (voro++'s representation: each
+ * vertex with its edges in order around it, each edge with the face on its left), in
+ * coordinates relative to its seed, and cut in place. A plane is first tested against every
+ * vertex (most planes tested cut nothing); a plane that cuts classifies every vertex once by
+ * its signed distance: outside (> tol), inside (< -tol) or on; tol = 1e-12 R (relative to the
+ * cell's size, so scaling all coordinates changes nothing). An edge from inside to outside
+ * gets one new vertex; the new face (the cap) is found by walking, from each new vertex, its
+ * face through the outside vertices to the next crossing; only the outside vertices and their
+ * edges are visited, and the new vertices take the outside ones' places. With on vertices
+ * (degenerate input) the same rules of the one classification decide everything: a face with
+ * an outside vertex and no inside one goes, one with both is clipped (each run of outside
+ * vertices replaced by its ends, a new vertex or an on vertex), the cap is the loop of those
+ * ends and of the edges between on vertices with a face that goes on one side only, and the
+ * on vertices' edges are rebuilt around the faces that stay. So the result is a closed
+ * polyhedron whatever the degeneracy: a plane through vertices or along edges (lattices,
+ * co-spherical seeds) cuts nothing it should not, and the volumes stay exact. A cell whose
+ * cutting goes wrong anyway (a cap that is not one loop) is reported (GP_ERR_INTERNAL), never
+ * guessed.
  *
  * Faces and neighbours. A face is kept only with a vertex strictly inside the cutting plane,
  * so it has positive area; j is a neighbour of i when cell i has a face on the bisector of i
@@ -76,10 +82,8 @@
  * recomputed vertex lies within about 1e-16 R / conditioning of the cut's (7e-13 R at most
  * on random seeds, 2.4e-10 R with lattices, co-spherical seeds and scaled containers); one
  * farther than 1e-6 R, or not finite, would keep the cut's position (a guard, never met in
- * the tests). Cost: about 10 % of a cell's instructions, a third of it bought back in the
- * cuts (the plane test's dot products reused by the classification; an edge's new vertex
- * found from its inside vertex, not by a search; |x|^2 kept per vertex): 7 % more
- * instructions per cell in all (docs/design/voronoi3d.md has the times).
+ * the tests). Cost: about a third of a cell's time (docs/design/voronoi3d.md has the
+ * times).
  *
  * Local updates. Lemma: cell j (j != i) changes when seed i moves from a to b only if i is a
  * neighbour of j before or after the move. Proof: V_j = W_j intersected with H_ji, with
@@ -211,5 +215,28 @@ size_t gp_voronoi3d_changed(const gp_voronoi3d *v, const uint32_t **cells);
 
 /* 1 if p lies in the closed container (within 1e-12 of its size). */
 int gp_voronoi3d_contains(const gp_voronoi3d *v, const double p[3]);
+
+/* Container-only queries (no tessellation needed), for placing seeds before a build.
+ *
+ * gp_voronoi3d_container_bounds(): the container's bounding box as gp_voronoi3d_create() sets
+ * it up: a box's lo and hi; a cylinder's prism or a convex polyhedron's vertices' extent
+ * (computed by cutting, within rounding of the exact one). Fails as create would for the
+ * container (GP_ERR_INVALID: a bad box or cylinder, fewer than 4 planes, an empty or
+ * unbounded polyhedron; GP_ERR_NOMEM); then lo and hi are left alone.
+ *
+ * gp_voronoi3d_container_inside(): 1 if p lies in the closed container within 1e-12 of its
+ * size, else 0 (also for p not finite, and for a cylinder or a polyhedron with a bad
+ * parameter; half-spaces that bound nothing only gp_voronoi3d_container_bounds() tells),
+ * given lo and hi from gp_voronoi3d_container_bounds() (for a box, the test uses them, not
+ * c->lo and c->hi): the very test gp_voronoi3d_create() and the moves apply to a seed (the
+ * same frame and arithmetic, the same answer), so a point it accepts is never refused as
+ * outside. Cost: O(1) for a box and for a cylinder's point not near the facets (decided by
+ * the inscribed and circumscribed circles, with margins far above the facet tests'
+ * rounding); O(planes) for a polyhedron and near a cylinder's rim (its facet planes computed
+ * each call, a cos and a sin each). */
+gp_status gp_voronoi3d_container_bounds(const gp_voronoi3d_container *c, double lo[3], double hi[3],
+                                        gp_error *err);
+int gp_voronoi3d_container_inside(const gp_voronoi3d_container *c, const double lo[3],
+                                  const double hi[3], const double p[3]);
 
 #endif /* GP_VORONOI3D_H */

@@ -1,6 +1,7 @@
 /* test_voronoi3d.c -- the bounded 3D Voronoi tessellation: exact cells on a lattice, volumes
- * that sum to the container (box, convex polyhedra, cylinder prism), scale invariance, bad
- * inputs, and local moves against full rebuilds: on random seeds (box, cylinder) every cell
+ * that sum to the container (box, convex polyhedra, cylinder prism), the container queries
+ * (bounds, inside) against the tessellation's own test, scale invariance, bad inputs, and
+ * local moves against full rebuilds: on random seeds (box, cylinder) every cell
  * bit for bit after every move (memcmp of vertices, loops, neighbour ids, volume, centroid
  * and inertia); on a lattice kept degenerate, to 1e-12 (gp_voronoi3d.h, "Local updates"). */
 #include <math.h>
@@ -308,6 +309,155 @@ static void test_containers(void)
     CHECK(lost > 0.0015 && lost < 0.0017);
 }
 
+/* test_container_queries()' own random numbers (the other tests' stay as they were) */
+static uint64_t rngq_state = 0x9E3779B97F4A7C15ull;
+
+static double u01q(void)
+{
+    rngq_state ^= rngq_state << 13;
+    rngq_state ^= rngq_state >> 7;
+    rngq_state ^= rngq_state << 17;
+    return (double)(rngq_state >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* One container for test_container_queries(): its bounds are checked against want_lo and
+ * want_hi (to rel of its size; skipped when want_lo is NULL), then gp_voronoi3d_container_inside()
+ * against gp_voronoi3d_contains() of a tessellation of the container (the test create applies)
+ * on points spread over the bounds and on points within a few tolerances of its faces. */
+static void container_query(const char *name, const gp_voronoi3d_container *c, const double *want_lo,
+                            const double *want_hi, double rel)
+{
+    double lo[3], hi[3];
+    gp_error err;
+    CHECK(gp_voronoi3d_container_bounds(c, lo, hi, &err) == GP_OK);
+    double L[3], size = 0;
+    for (int a = 0; a < 3; a++) {
+        L[a] = hi[a] - lo[a];
+        size += L[a] * L[a];
+    }
+    size = sqrt(size);
+    for (int a = 0; a < 3 && want_lo; a++) {
+        CHECK_NEAR(lo[a], want_lo[a], rel * size);
+        CHECK_NEAR(hi[a], want_hi[a], rel * size);
+    }
+    /* a tessellation of one seed found by the query, to ask gp_voronoi3d_contains() */
+    gp_voronoi3d *probe = NULL;
+    for (int t = 0; t < 1000 && !probe; t++) {
+        double p[3];
+        for (int a = 0; a < 3; a++) p[a] = lo[a] + L[a] * u01q();
+        if (gp_voronoi3d_container_inside(c, lo, hi, p)) probe = gp_voronoi3d_create(c, p, 1, NULL);
+    }
+    CHECK(probe != NULL);
+    if (!probe) return;
+    /* the faces' planes (unit normals), to put points near them */
+    size_t m = c->kind == GP_VORONOI3D_BOX ? 6
+               : c->kind == GP_VORONOI3D_CONVEX ? c->nplanes
+                                                : (c->facets ? c->facets : 64) + 2;
+    double *pl = malloc(4 * m * sizeof(double));
+    for (size_t k = 0; k < m; k++) {
+        double *q = pl + 4 * k;
+        if (c->kind == GP_VORONOI3D_BOX) {
+            q[0] = q[1] = q[2] = 0;
+            q[k / 2] = k & 1 ? 1 : -1;
+            q[3] = k & 1 ? c->hi[k / 2] : -c->lo[k / 2];
+        } else if (c->kind == GP_VORONOI3D_CONVEX) {
+            double nn = sqrt(c->planes[4 * k] * c->planes[4 * k] + c->planes[4 * k + 1] * c->planes[4 * k + 1] +
+                             c->planes[4 * k + 2] * c->planes[4 * k + 2]);
+            for (int a = 0; a < 4; a++) q[a] = c->planes[4 * k + a] / nn;
+        } else if (k + 2 < m) {
+            double t = 2 * M_PI * ((double)k + 0.5) / (double)(m - 2);
+            q[0] = cos(t), q[1] = sin(t), q[2] = 0;
+            q[3] = q[0] * c->axis[0] + q[1] * c->axis[1] + c->radius * cos(M_PI / (double)(m - 2));
+        } else {
+            q[0] = q[1] = 0, q[2] = k + 1 == m ? 1 : -1;
+            q[3] = k + 1 == m ? c->z1 : -c->z0;
+        }
+    }
+    const double off[7] = {-3, -1.5, -0.5, 0, 0.5, 1.5, 3}; /* in tolerances (1e-12 size) */
+    size_t n = 20000, same = 0, in = 0, near = 0;
+    for (size_t t = 0; t < n; t++) {
+        double p[3];
+        for (int a = 0; a < 3; a++) p[a] = lo[a] + L[a] * (1.02 * u01q() - 0.01);
+        if (t & 1) { /* onto a face's plane, then off it by a few tolerances */
+            const double *q = pl + 4 * (size_t)(u01q() * (double)m);
+            double h = q[0] * p[0] + q[1] * p[1] + q[2] * p[2] - q[3] - off[t / 2 % 7] * 1e-12 * size;
+            for (int a = 0; a < 3; a++) p[a] -= h * q[a];
+            near++;
+        }
+        int a = gp_voronoi3d_container_inside(c, lo, hi, p), b = gp_voronoi3d_contains(probe, p);
+        same += a == b;
+        in += a;
+    }
+    printf("container queries (%s): %zu of %zu points (%zu within 3e-12 of a face's plane) agree "
+           "with gp_voronoi3d_contains, %zu inside\n", name, same, n, near, in);
+    CHECK(same == n);
+    CHECK(in > n / 20 && in < n - n / 100);
+    double nan[3] = {NAN, 0, 0}, inf[3] = {INFINITY, lo[1], lo[2]};
+    CHECK(!gp_voronoi3d_container_inside(c, lo, hi, nan));
+    CHECK(!gp_voronoi3d_container_inside(c, lo, hi, inf));
+    free(pl);
+    gp_voronoi3d_destroy(probe);
+}
+
+/* gp_voronoi3d_container_bounds() and gp_voronoi3d_container_inside(), which need no
+ * tessellation: the bounds of every kind of container, near the origin and far from it, and
+ * the inside test equal to the one create applies; bad containers refused. */
+static void test_container_queries(void)
+{
+    double blo[3] = {-1, 0, 2}, bhi[3] = {2, 1, 4};
+    gp_voronoi3d_container box = gp_voronoi3d_box(blo, bhi);
+    container_query("box", &box, blo, bhi, 0);
+    double flo[3] = {1e6, -2e6, 3e6}, fhi[3] = {1e6 + 1, -2e6 + 0.5, 3e6 + 2};
+    gp_voronoi3d_container far = gp_voronoi3d_box(flo, fhi);
+    container_query("box at 1e6", &far, flo, fhi, 0);
+    /* tetrahedron x, y, z >= 0, x + y + z <= 1, scaled planes and a redundant one */
+    const double tet[5 * 4] = {-2, 0, 0, 0, 0, -1, 0, 0, 0, 0, -3, 0, 1, 1, 1, 1, 1, 1, 1, 5};
+    gp_voronoi3d_container ct = gp_voronoi3d_convex(tet, 5);
+    double tlo[3] = {0, 0, 0}, thi[3] = {1, 1, 1};
+    container_query("tetrahedron", &ct, tlo, thi, 1e-14);
+    /* octahedron |x| + |y| + |z| <= 2 around (10, -5, 3), and around (1e6, -1e6, 1e6) */
+    for (int shift = 0; shift < 2; shift++) {
+        double ctr[3] = {10, -5, 3}, oct[8 * 4], olo[3], ohi[3];
+        for (int a = 0; a < 3 && shift; a++) ctr[a] = a == 1 ? -1e6 : 1e6;
+        for (int k = 0; k < 8; k++) {
+            double nrm[3] = {k & 1 ? -1 : 1, k & 2 ? -1 : 1, k & 4 ? -1 : 1};
+            memcpy(oct + 4 * k, nrm, sizeof nrm);
+            oct[4 * k + 3] = 2 + nrm[0] * ctr[0] + nrm[1] * ctr[1] + nrm[2] * ctr[2];
+        }
+        for (int a = 0; a < 3; a++) olo[a] = ctr[a] - 2, ohi[a] = ctr[a] + 2;
+        gp_voronoi3d_container co = gp_voronoi3d_convex(oct, 8);
+        container_query(shift ? "octahedron at 1e6" : "octahedron", &co, olo, ohi, shift ? 1e-9 : 1e-14);
+    }
+    /* cylinders: 64 facets (a vertex at every quarter turn: the circle's bounds), 5 facets
+     * (the bounds of the pentagon's vertices at 2 pi k / 5), one far from the origin */
+    gp_voronoi3d_container cy = gp_voronoi3d_cylinder(1, 2, 0.5, -1, 1, 0);
+    double ylo[3] = {0.5, 1.5, -1}, yhi[3] = {1.5, 2.5, 1};
+    container_query("cylinder", &cy, ylo, yhi, 1e-14);
+    gp_voronoi3d_container c5 = gp_voronoi3d_cylinder(1, 2, 0.5, -1, 1, 5);
+    double plo[3] = {1 + 0.5 * cos(4 * M_PI / 5), 2 + 0.5 * sin(8 * M_PI / 5), -1};
+    double phi[3] = {1.5, 2 + 0.5 * sin(2 * M_PI / 5), 1};
+    container_query("pentagonal prism", &c5, plo, phi, 1e-14);
+    gp_voronoi3d_container cf = gp_voronoi3d_cylinder(1e6, -1e6, 2, 0, 3, 7);
+    container_query("cylinder at 1e6", &cf, NULL, NULL, 0);
+
+    /* bad containers: refused, the bounds left alone; nothing inside one with a bad parameter */
+    const double wedge[4 * 4] = {-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, -1, 0, 1, 1, 0, 1};
+    const double empty[4 * 4] = {-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, -1, 0, 1, 1, 1, -1};
+    gp_voronoi3d_container bad[5] = {gp_voronoi3d_convex(wedge, 4), gp_voronoi3d_convex(empty, 4),
+                                     gp_voronoi3d_convex(tet, 3), gp_voronoi3d_cylinder(0, 0, 0, 0, 1, 0),
+                                     gp_voronoi3d_box(bhi, blo)};
+    for (int k = 0; k < 5; k++) {
+        double lo[3] = {7, 7, 7}, hi[3] = {8, 8, 8}, p[3] = {0.1, 0.1, 0.1}, q[3] = {7.5, 7.5, 7.5};
+        gp_error err;
+        CHECK(gp_voronoi3d_container_bounds(&bad[k], lo, hi, &err) == GP_ERR_INVALID);
+        CHECK(lo[0] == 7 && lo[2] == 7 && hi[1] == 8);
+        if (k == 2 || k == 3) CHECK(!gp_voronoi3d_container_inside(&bad[k], lo, hi, k < 3 ? p : q));
+    }
+    double lo[3], hi[3];
+    CHECK(gp_voronoi3d_container_bounds(NULL, lo, hi, NULL) == GP_ERR_INVALID);
+    CHECK(!gp_voronoi3d_container_inside(NULL, blo, bhi, blo));
+}
+
 /* The same seeds scaled by 1e-6 and 1e6, and moved to 1e6: the same cells, scaled. */
 static void test_scales(void)
 {
@@ -587,6 +737,7 @@ int main(void)
     test_lattice(7, 1e6, -3e6);
     test_degenerate();
     test_containers();
+    test_container_queries();
     test_scales();
     test_one_seed();
     test_bad_inputs();
