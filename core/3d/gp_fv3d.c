@@ -95,47 +95,21 @@ static unsigned degree_of(const gp_fv3d_spec *s)
 /* ------------------------------------------------------------------------------ the cells */
 
 typedef struct cellbuf {
-    double *xyz, *planes;
-    uint32_t *loop;
-    size_t cap_v, cap_p, cap_l;
+    double *planes;
+    size_t cap;
 } cellbuf;
 
-static int grow(void **p, size_t *cap, size_t need, size_t size)
-{
-    if (need <= *cap) return 1;
-    size_t c = need < 64 ? 64 : 2 * need;
-    void *q = realloc(*p, c * size);
-    if (!q) return 0;
-    *p = q;
-    *cap = c;
-    return 1;
-}
-
-/* the outward plane (n, d) of each face of cell i, n Newell's normal of its loop */
+/* the outward planes of cell i (gp_voronoi3d_cell_planes); 0 when out of memory */
 static size_t cell_planes(const gp_voronoi3d *v, size_t i, cellbuf *b)
 {
-    size_t nv = gp_voronoi3d_cell_vertices(v, i, NULL, 0), nf = gp_voronoi3d_cell_face_count(v, i);
-    if (!grow((void **)&b->xyz, &b->cap_v, 3 * nv, sizeof(double)) ||
-        !grow((void **)&b->planes, &b->cap_p, 4 * nf, sizeof(double)))
-        return 0;
-    gp_voronoi3d_cell_vertices(v, i, b->xyz, nv);
-    for (size_t f = 0; f < nf; f++) {
-        size_t m = gp_voronoi3d_cell_face(v, i, f, NULL, 0, NULL);
-        if (!grow((void **)&b->loop, &b->cap_l, m, sizeof(uint32_t))) return 0;
-        gp_voronoi3d_cell_face(v, i, f, b->loop, m, NULL);
-        double n[3] = {0, 0, 0};
-        for (size_t e = 0; e < m; e++) {
-            const double *P = b->xyz + 3 * b->loop[e], *Q = b->xyz + 3 * b->loop[(e + 1) % m];
-            n[0] += (P[1] - Q[1]) * (P[2] + Q[2]);
-            n[1] += (P[2] - Q[2]) * (P[0] + Q[0]);
-            n[2] += (P[0] - Q[0]) * (P[1] + Q[1]);
-        }
-        const double *P = b->xyz + 3 * b->loop[0];
-        double *q = b->planes + 4 * f;
-        memcpy(q, n, sizeof n);
-        q[3] = n[0] * P[0] + n[1] * P[1] + n[2] * P[2];
+    size_t nf = gp_voronoi3d_cell_face_count(v, i);
+    if (nf > b->cap) {
+        double *q = realloc(b->planes, 4 * 2 * nf * sizeof *q);
+        if (!q) return 0;
+        b->planes = q;
+        b->cap = 2 * nf;
     }
-    return nf;
+    return gp_voronoi3d_cell_planes(v, i, b->planes, nf);
 }
 
 /* ----------------------------------------------------------------------------- one grain */
@@ -420,7 +394,7 @@ static int report_grains(job *J, int *last)
 static void grains_worker(void *ctx, int tid)
 {
     job *J = ctx;
-    worker W = {{NULL, NULL, NULL, 0, 0, 0}, malloc(3 * J->out->ndirs * sizeof(double)), NULL};
+    worker W = {{NULL, 0}, malloc(3 * J->out->ndirs * sizeof(double)), NULL};
     int last = 0;
     for (;;) {
         if (__atomic_load_n(&J->cancelled, __ATOMIC_RELAXED) || gp_progress_cancelled(J->cancel) ||
@@ -436,9 +410,7 @@ static void grains_worker(void *ctx, int tid)
     }
     gp_rng_destroy(W.rng);
     free(W.xyz);
-    free(W.cb.xyz);
     free(W.cb.planes);
-    free(W.cb.loop);
 }
 
 /* ------------------------------------------------------------------------- rank matching */

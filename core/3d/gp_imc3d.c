@@ -87,89 +87,16 @@ typedef struct shape {
     double lo[3], hi[3];
 } shape;
 
+/* the test gp_voronoi3d_create applies to a seed: a point it accepts is never refused */
 static int inside(const shape *s, const double p[3])
 {
-    const gp_voronoi3d_container *c = s->c;
-    for (int k = 0; k < 3; k++)
-        if (p[k] < s->lo[k] || p[k] > s->hi[k]) return 0;
-    if (c->kind == GP_VORONOI3D_CONVEX) {
-        for (size_t k = 0; k < c->nplanes; k++) {
-            const double *q = c->planes + 4 * k;
-            if (q[0] * p[0] + q[1] * p[1] + q[2] * p[2] > q[3]) return 0;
-        }
-    } else if (c->kind == GP_VORONOI3D_CYLINDER) {
-        size_t m = c->facets ? c->facets : 64;
-        double x = p[0] - c->axis[0], y = p[1] - c->axis[1], apothem = c->radius * cos(M_PI / (double)m);
-        for (size_t k = 0; k < m; k++) {
-            double t = 2.0 * M_PI * ((double)k + 0.5) / (double)m;
-            if (x * cos(t) + y * sin(t) > apothem) return 0;
-        }
-    }
-    return 1;
-}
-
-/* the bounding box of a convex polyhedron: its vertices, every point where three planes meet
- * that satisfies the others */
-static int convex_box(const gp_voronoi3d_container *c, double lo[3], double hi[3])
-{
-    int found = 0;
-    for (int k = 0; k < 3; k++) {
-        lo[k] = INFINITY;
-        hi[k] = -INFINITY;
-    }
-    size_t m = c->nplanes;
-    for (size_t a = 0; a < m; a++)
-        for (size_t b = a + 1; b < m; b++)
-            for (size_t d = b + 1; d < m; d++) {
-                const double *P = c->planes + 4 * a, *Q = c->planes + 4 * b, *R = c->planes + 4 * d;
-                double det = P[0] * (Q[1] * R[2] - Q[2] * R[1]) - P[1] * (Q[0] * R[2] - Q[2] * R[0]) +
-                             P[2] * (Q[0] * R[1] - Q[1] * R[0]);
-                double scale = fabs(P[0]) + fabs(P[1]) + fabs(P[2]);
-                if (fabs(det) < 1e-12 * scale * scale * scale) continue;
-                double x[3];
-                /* Cramer's rule */
-                x[0] = (P[3] * (Q[1] * R[2] - Q[2] * R[1]) - P[1] * (Q[3] * R[2] - Q[2] * R[3]) +
-                        P[2] * (Q[3] * R[1] - Q[1] * R[3])) / det;
-                x[1] = (P[0] * (Q[3] * R[2] - Q[2] * R[3]) - P[3] * (Q[0] * R[2] - Q[2] * R[0]) +
-                        P[2] * (Q[0] * R[3] - Q[3] * R[0])) / det;
-                x[2] = (P[0] * (Q[1] * R[3] - Q[3] * R[1]) - P[1] * (Q[0] * R[3] - Q[3] * R[0]) +
-                        P[3] * (Q[0] * R[1] - Q[1] * R[0])) / det;
-                int ok = 1;
-                for (size_t e = 0; ok && e < m; e++) {
-                    const double *S = c->planes + 4 * e;
-                    double sl = fabs(S[0]) + fabs(S[1]) + fabs(S[2]);
-                    ok = S[0] * x[0] + S[1] * x[1] + S[2] * x[2] <= S[3] + 1e-9 * sl * (1.0 + fabs(S[3]));
-                }
-                if (!ok) continue;
-                found = 1;
-                for (int k = 0; k < 3; k++) {
-                    lo[k] = fmin(lo[k], x[k]);
-                    hi[k] = fmax(hi[k], x[k]);
-                }
-            }
-    return found;
+    return gp_voronoi3d_container_inside(s->c, s->lo, s->hi, p);
 }
 
 static gp_status shape_init(shape *s, const gp_voronoi3d_container *c, gp_error *err)
 {
     s->c = c;
-    if (c->kind == GP_VORONOI3D_BOX) {
-        memcpy(s->lo, c->lo, sizeof s->lo);
-        memcpy(s->hi, c->hi, sizeof s->hi);
-    } else if (c->kind == GP_VORONOI3D_CYLINDER) {
-        s->lo[0] = c->axis[0] - c->radius;
-        s->hi[0] = c->axis[0] + c->radius;
-        s->lo[1] = c->axis[1] - c->radius;
-        s->hi[1] = c->axis[1] + c->radius;
-        s->lo[2] = c->z0;
-        s->hi[2] = c->z1;
-    } else if (!c->planes || c->nplanes < 4 || !convex_box(c, s->lo, s->hi)) {
-        return gp_error_set(err, GP_ERR_INVALID, "imc3d: the convex container has no vertex");
-    }
-    for (int k = 0; k < 3; k++)
-        if (!(s->hi[k] > s->lo[k]) || !isfinite(s->lo[k]) || !isfinite(s->hi[k]))
-            return gp_error_set(err, GP_ERR_INVALID, "imc3d: the container is empty or unbounded");
-    return GP_OK;
+    return gp_voronoi3d_container_bounds(c, s->lo, s->hi, err);
 }
 
 static int point_in_box(const shape *s, gp_rng *r, double p[3])
@@ -395,9 +322,8 @@ static int state_room(state *S, size_t k)
 
 /* a cell's faces as planes, for points uniform in it */
 typedef struct cellbuf {
-    size_t cap_v, cap_p, cap_l;
+    size_t cap_v, cap_p;
     double *xyz, *planes;
-    uint32_t *loop;
     size_t nb_cap;
     size_t *nb;
 } cellbuf;
@@ -406,7 +332,6 @@ static void cellbuf_free(cellbuf *b)
 {
     free(b->xyz);
     free(b->planes);
-    free(b->loop);
     free(b->nb);
 }
 
@@ -421,8 +346,8 @@ static int grow(void **p, size_t *cap, size_t need, size_t size)
     return 1;
 }
 
-/* the outward plane (n, d: n . x <= d inside) of each face of cell i (Newell's normal), and
- * the cell's box; returns the face count, 0 when out of memory */
+/* the outward planes of cell i (gp_voronoi3d_cell_planes) and the cell's box; returns the face
+ * count, 0 when out of memory */
 static size_t cell_planes(const gp_voronoi3d *v, size_t i, cellbuf *b, double lo[3], double hi[3])
 {
     size_t nv = gp_voronoi3d_cell_vertices(v, i, NULL, 0), nf = gp_voronoi3d_cell_face_count(v, i);
@@ -439,23 +364,7 @@ static size_t cell_planes(const gp_voronoi3d *v, size_t i, cellbuf *b, double lo
             lo[k] = fmin(lo[k], b->xyz[3 * j + k]);
             hi[k] = fmax(hi[k], b->xyz[3 * j + k]);
         }
-    for (size_t f = 0; f < nf; f++) {
-        size_t m = gp_voronoi3d_cell_face(v, i, f, NULL, 0, NULL);
-        if (!grow((void **)&b->loop, &b->cap_l, m, sizeof(uint32_t))) return 0;
-        gp_voronoi3d_cell_face(v, i, f, b->loop, m, NULL);
-        double n[3] = {0, 0, 0};
-        for (size_t e = 0; e < m; e++) {
-            const double *P = b->xyz + 3 * b->loop[e], *Q = b->xyz + 3 * b->loop[(e + 1) % m];
-            n[0] += (P[1] - Q[1]) * (P[2] + Q[2]);
-            n[1] += (P[2] - Q[2]) * (P[0] + Q[0]);
-            n[2] += (P[0] - Q[0]) * (P[1] + Q[1]);
-        }
-        const double *P = b->xyz + 3 * b->loop[0];
-        double *q = b->planes + 4 * f;
-        memcpy(q, n, sizeof n);
-        q[3] = n[0] * P[0] + n[1] * P[1] + n[2] * P[2];
-    }
-    return nf;
+    return gp_voronoi3d_cell_planes(v, i, b->planes, nf);
 }
 
 static int point_in_cell(const gp_voronoi3d *v, size_t i, cellbuf *b, gp_rng *r, double p[3])

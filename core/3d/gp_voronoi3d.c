@@ -2176,6 +2176,48 @@ size_t gp_voronoi3d_cell_face(const gp_voronoi3d *v, size_t i, size_t f, uint32_
     return (size_t)(e - b);
 }
 
+size_t gp_voronoi3d_cell_planes(const gp_voronoi3d *v, size_t i, double *planes, size_t cap)
+{
+    if (!v || i >= v->n) return 0;
+    const vcell *c = v->cell[i];
+    for (int32_t f = 0; f < c->nf && (size_t)f < cap; f++) {
+        int32_t b = c->foff[f], e = c->foff[f + 1];
+        double n[3] = {0, 0, 0}, m[3] = {0, 0, 0};
+        for (int32_t k = b; k < e; k++) {
+            const double *P = c->x + 3 * c->fv[k], *Q = c->x + 3 * c->fv[k + 1 < e ? k + 1 : b];
+            n[0] += (P[1] - Q[1]) * (P[2] + Q[2]);
+            n[1] += (P[2] - Q[2]) * (P[0] + Q[0]);
+            n[2] += (P[0] - Q[0]) * (P[1] + Q[1]);
+            for (int a = 0; a < 3; a++) m[a] += P[a] / (e - b);
+        }
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), *q = planes + 4 * f;
+        q[3] = 0;
+        for (int a = 0; a < 3; a++) {
+            q[a] = n[a] / len;
+            q[3] += q[a] * (m[a] + v->seed[3 * i + a] + v->origin[a]);
+        }
+    }
+    return (size_t)c->nf;
+}
+
+gp_status gp_voronoi3d_container_measure(const gp_voronoi3d_container *c, double *volume, double lo[3],
+                                         double hi[3], gp_error *err)
+{
+    if (!c || !volume) return gp_error_set(err, GP_ERR_INVALID, "voronoi3d: need a container");
+    gp_voronoi3d *v = calloc(1, sizeof *v);
+    if (!v) return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    gp_status st = container_setup(v, c, err);
+    if (!st) {
+        *volume = v->cvol;
+        for (int a = 0; a < 3; a++) {
+            if (lo) lo[a] = v->origin[a];
+            if (hi) hi[a] = v->origin[a] + v->L[a];
+        }
+    }
+    gp_voronoi3d_destroy(v);
+    return st;
+}
+
 size_t gp_voronoi3d_neighbours(const gp_voronoi3d *v, size_t i, size_t *out, size_t cap)
 {
     if (!v || i >= v->n) return 0;

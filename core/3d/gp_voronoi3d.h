@@ -194,6 +194,10 @@ size_t gp_voronoi3d_cell_face_count(const gp_voronoi3d *v, size_t i);
  * the loop's length (0 for a bad index). */
 size_t gp_voronoi3d_cell_face(const gp_voronoi3d *v, size_t i, size_t f, uint32_t *loop,
                               size_t cap, int32_t *neighbour);
+/* The outward plane of each face of cell i: planes[4 f ..] = (nx, ny, nz, d), n a unit normal
+ * (Newell's, of the face's loop) and n . x <= d inside, in the order of the faces; at most cap
+ * faces written, the count returned. */
+size_t gp_voronoi3d_cell_planes(const gp_voronoi3d *v, size_t i, double *planes, size_t cap);
 /* The neighbour seeds of cell i (ascending, no repeats) into out (at most cap); returns their
  * count. */
 size_t gp_voronoi3d_neighbours(const gp_voronoi3d *v, size_t i, size_t *out, size_t cap);
@@ -236,6 +240,11 @@ int gp_voronoi3d_contains(const gp_voronoi3d *v, const double p[3]);
  * each call, a cos and a sin each). */
 gp_status gp_voronoi3d_container_bounds(const gp_voronoi3d_container *c, double lo[3], double hi[3],
                                         gp_error *err);
+/* The container's volume as gp_voronoi3d_container_volume() gives it after a build (a
+ * cylinder: its prism's) and its bounds (lo, hi may be NULL); fails as
+ * gp_voronoi3d_container_bounds() does. */
+gp_status gp_voronoi3d_container_measure(const gp_voronoi3d_container *c, double *volume, double lo[3],
+                                         double hi[3], gp_error *err);
 int gp_voronoi3d_container_inside(const gp_voronoi3d_container *c, const double lo[3],
                                   const double hi[3], const double p[3]);
 

@@ -730,8 +730,55 @@ static void test_lattice_moves(void)
     free(s);
 }
 
+/* gp_voronoi3d_container_measure against the formulas (a box, a 64-facet prism, a tetrahedron
+ * of volume 1/6 far from the origin) and gp_voronoi3d_cell_planes against the cells' own
+ * vertices: unit normals, every vertex inside every plane, each face's vertices on its plane */
+static void test_measure_and_planes(void)
+{
+    double lo[3] = {1, 2, 3}, hi[3] = {2, 4, 3.5}, vol, blo[3], bhi[3];
+    gp_voronoi3d_container box = gp_voronoi3d_box(lo, hi);
+    CHECK(gp_voronoi3d_container_measure(&box, &vol, blo, bhi, NULL) == GP_OK);
+    CHECK(vol == 1.0 && blo[1] == 2 && bhi[2] == 3.5);
+    gp_voronoi3d_container cyl = gp_voronoi3d_cylinder(5, -1, 0.5, 0, 2, 0);
+    CHECK(gp_voronoi3d_container_measure(&cyl, &vol, NULL, NULL, NULL) == GP_OK);
+    CHECK_NEAR(vol / (32 * 0.25 * sin(2 * M_PI / 64) * 2), 1.0, 1e-14);
+    double o = 1e4, tet[16] = {-1, 0, 0, -o, 0, -1, 0, -o, 0, 0, -1, -o, 1, 1, 1, 3 * o + 1};
+    gp_voronoi3d_container t = gp_voronoi3d_convex(tet, 4);
+    CHECK(gp_voronoi3d_container_measure(&t, &vol, blo, bhi, NULL) == GP_OK);
+    CHECK_NEAR(vol * 6, 1.0, 1e-9);
+    double bad[16] = {1, 0, 0, 0, -1, 0, 0, -1, 0, 1, 0, 0, 0, -1, 0, 0};
+    gp_voronoi3d_container unb = gp_voronoi3d_convex(bad, 4);
+    CHECK(gp_voronoi3d_container_measure(&unb, &vol, NULL, NULL, NULL) == GP_ERR_INVALID);
+
+    double seeds[3 * 300], worst_in = -INFINITY, worst_on = 0, worst_n = 0, pl[4 * 128], xyz[3 * 512];
+    uint32_t loop[128];
+    for (int k = 0; k < 900; k++) seeds[k] = (k % 3 == 0 ? 5 : k % 3 == 1 ? -1 : 1) + 0.6 * (rand() / (double)RAND_MAX - 0.5);
+    gp_voronoi3d *v = gp_voronoi3d_create(&cyl, seeds, 300, NULL);
+    CHECK(v != NULL);
+    for (size_t i = 0; v && i < 300; i++) {
+        size_t nf = gp_voronoi3d_cell_planes(v, i, pl, 128), nv = gp_voronoi3d_cell_vertices(v, i, xyz, 512);
+        CHECK(nf == gp_voronoi3d_cell_face_count(v, i) && nv <= 512);
+        for (size_t f = 0; f < nf; f++) {
+            const double *q = pl + 4 * f;
+            worst_n = fmax(worst_n, fabs(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] - 1));
+            for (size_t k = 0; k < nv; k++)
+                worst_in = fmax(worst_in, q[0] * xyz[3 * k] + q[1] * xyz[3 * k + 1] + q[2] * xyz[3 * k + 2] - q[3]);
+            size_t m = gp_voronoi3d_cell_face(v, i, f, loop, 128, NULL);
+            for (size_t k = 0; k < m; k++) {
+                const double *x = xyz + 3 * loop[k];
+                worst_on = fmax(worst_on, fabs(q[0] * x[0] + q[1] * x[1] + q[2] * x[2] - q[3]));
+            }
+        }
+    }
+    printf("container volumes exact; cell planes: |n| - 1 within %.1e, vertices inside within %.1e, "
+           "on their faces within %.1e\n", worst_n, worst_in, worst_on);
+    CHECK(worst_n < 1e-14 && worst_in < 1e-12 && worst_on < 1e-12);
+    gp_voronoi3d_destroy(v);
+}
+
 int main(void)
 {
+    test_measure_and_planes();
     test_lattice(6, 1, 0);
     test_lattice(10, 1e-6, 0);
     test_lattice(7, 1e6, -3e6);
