@@ -9,6 +9,8 @@
 #include "gp_clock.h"
 #include "gp_clump3d.h"
 #include "gp_fill3d.h"
+#include "gp_fourier.h"
+#include "gp_shape.h"
 #include "gp_grain3d.h"
 #include "gp_imc3d.h"
 #include "gp_rng.h"
@@ -16,6 +18,7 @@
 
 #define FV3D_STAR_DRAWS 100      /* draws of a grain's amplitudes before its spectrum is refused */
 #define FV3D_STREAM_GRAINS 2     /* grain i draws from stream 2 + i */
+#define FV3D_STREAM_REFERENCE (1ULL << 62) /* the 2D reference grains */
 #define FV3D_PROGRESS_EVERY 64   /* grains between two progress reports */
 #define FV3D_CURVE_POINTS 64
 #define FV3D_PROBE_LEVEL 3       /* 162 directions: degrees <= FV3D_MATCH_DEGREE resolved */
@@ -533,6 +536,53 @@ static void clump_stats(gp_fv3d *S)
     }
 }
 
+/* the four 2D descriptors averaged over 2D Fourier grains of the spectrum */
+static gp_status reference2d(const gp_fv3d_spec *spec, double mean[4], gp_error *err)
+{
+    size_t np = 128, nm = spec->nmodes < gp_fourier_max_modes(np) ? spec->nmodes : gp_fourier_max_modes(np);
+    gp_rng *r = gp_rng_create(spec->seed, FV3D_STREAM_REFERENCE, err);
+    double *delta = malloc(nm * sizeof *delta);
+    gp_status st = r && delta ? GP_OK : gp_error_set(err, GP_ERR_NOMEM, "fv3d: out of memory");
+    size_t got = 0;
+    memset(mean, 0, 4 * sizeof *mean);
+    for (int t = 0; st == GP_OK && got < GP_FV3D_REFERENCE_GRAINS && t < 4 * GP_FV3D_REFERENCE_GRAINS; t++) {
+        if ((st = gp_fourier_random_phases(nm, u01, r, delta, err)) != GP_OK) break;
+        gp_shape_curve curve = {{0.0, 0.0}, 1.0, spec->D, delta, nm};
+        gp_shape_result res;
+        if (gp_shape_describe_fourier(NULL, np, &curve, NULL, &res, NULL) != GP_OK) continue;
+        double d[4] = {res.elongation, res.roundness, res.circularity, res.regularity};
+        for (int k = 0; k < 4; k++) mean[k] += d[k];
+        got++;
+    }
+    for (int k = 0; k < 4; k++) mean[k] = got ? mean[k] / (double)got : NAN;
+    gp_rng_destroy(r);
+    free(delta);
+    return st;
+}
+
+static gp_status descriptor_stats(gp_fv3d *S, const gp_fv3d_spec *spec, gp_error *err)
+{
+    gp_fv3d_descriptor_stats *d = &S->stats.descriptors;
+    memset(d, 0, sizeof *d);
+    if (!(spec->outputs & GP_OUT3_DESCRIPTORS) || S->n == 0) return GP_OK;
+    d->present = 1;
+    d->target_elongation = spec->elongation;
+    d->target_flatness = spec->flatness;
+    double s2[4] = {0, 0, 0, 0}, n = (double)S->n;
+    for (size_t i = 0; i < S->n; i++) {
+        const gp_fv3d_descriptors *g = &S->grains[i].desc;
+        double v[4] = {g->elongation, g->flatness, g->sphericity, g->convexity};
+        for (int k = 0; k < 4; k++) {
+            d->mean[k] += v[k] / n;
+            s2[k] += v[k] * v[k] / n;
+        }
+        for (int a = 0; a < 3; a++)
+            for (int k = 0; k < 4; k++) d->projection[a][k] += g->proj[a][k] / n;
+    }
+    for (int k = 0; k < 4; k++) d->sd[k] = sqrt(fmax(0.0, s2[k] - d->mean[k] * d->mean[k]));
+    return reference2d(spec, d->reference2d, err);
+}
+
 /* --------------------------------------------------------------------------------- build */
 
 static gp_status run_imc(gp_fv3d *S, const gp_fv3d_spec *spec, gp_progress_fn progress, void *user,
@@ -635,6 +685,7 @@ static gp_status build(gp_fv3d *S, const gp_fv3d_spec *spec, gp_progress_fn prog
         place_clumps(S);
         st = fit_all(S, spec, cell_law, grain_law, err);
         clump_stats(S);
+        if (st == GP_OK) st = descriptor_stats(S, spec, err);
     }
     S->stats.lost_volume = gp_voronoi3d_lost_volume(S->cells);
     gp_law_destroy(cell_law);

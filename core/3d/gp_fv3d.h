@@ -114,6 +114,22 @@ typedef struct gp_fv3d_grain {
     double clump_volume_error, clump_inertia_error;
 } gp_fv3d_grain;
 
+/* The grains' descriptors in summary (with GP_OUT3_DESCRIPTORS): the 3D ones' mean and
+ * standard deviation, the projections' 2D ones (elongation, roundness, circularity,
+ * regularity) averaged per axis, and the same four averaged over 2D Fourier grains of the
+ * spec's spectrum (GP_FV3D_REFERENCE_GRAINS contours of 128 points, random phases): what a 2D
+ * specimen of that spectrum would show, for a user who compares with 2D images. A degree-n field
+ * seen on a plane spreads its power to lower 2D modes (gp_grain3d.h), so the projections need
+ * not match the reference; the elongation and flatness asked are beside the 3D means. */
+#define GP_FV3D_REFERENCE_GRAINS 200
+typedef struct gp_fv3d_descriptor_stats {
+    int present;
+    double mean[4], sd[4];     /* elongation, flatness, sphericity, convexity */
+    double target_elongation, target_flatness;
+    double projection[3][4];   /* along the long, intermediate, short axis */
+    double reference2d[4];
+} gp_fv3d_descriptor_stats;
+
 typedef struct gp_fv3d_stats {
     gp_fit_area cell_volume, grain_volume;
     gp_fit_orient cell_orientation, grain_orientation; /* target_mean_deg unused (0) */
@@ -126,6 +142,7 @@ typedef struct gp_fv3d_stats {
     double clump_volume_error_mean, clump_volume_error_max;
     double clump_inertia_error_mean, clump_inertia_error_max;
     double lost_volume;              /* the cylinder's facets against the true cylinder */
+    gp_fv3d_descriptor_stats descriptors;
 } gp_fv3d_stats;
 
 typedef struct gp_fv3d_timings {

@@ -309,6 +309,17 @@ static void box_specimen(void)
     CHECK(t->grain_orientation.ks <= crit && t->cell_orientation.ks <= crit);
     CHECK(m.clump_out <= 1e-9 && m.spheres_over == 0);
     CHECK(t->clump_volume_error_max < 0.5);
+    /* the summary against the grains' own values; the 2D reference's elongation against a
+     * grain of mode 2 alone, (1 - D2) / (1 + D2) (modes 3 and 8 move it by a few percent) */
+    const gp_fv3d_descriptor_stats *ds = &t->descriptors;
+    double me = 0;
+    for (size_t i = 0; i < n; i++) me += gp_fv3d_grain_at(s, i)->desc.elongation / n;
+    printf("descriptors: 3D elongation %.3f (sd %.3f), flatness %.3f, sphericity %.3f, convexity %.3f; "
+           "projection along the short axis: 2D elongation %.3f roundness %.3f; 2D reference %.3f %.3f %.3f %.3f\n",
+           ds->mean[0], ds->sd[0], ds->mean[1], ds->mean[2], ds->mean[3], ds->projection[2][0], ds->projection[2][1],
+           ds->reference2d[0], ds->reference2d[1], ds->reference2d[2], ds->reference2d[3]);
+    CHECK(ds->present && fabs(ds->mean[0] - me) < 1e-12);
+    CHECK(fabs(ds->reference2d[0] - (1 - D[2]) / (1 + D[2])) < 0.05);
     const gp_fv3d_grain *g0 = gp_fv3d_grain_at(s, 0);
     CHECK(g0->desc.sphericity > 0.5 && g0->desc.sphericity <= 1.0 && g0->desc.convexity > 0.5 &&
           g0->desc.convexity <= 1.0 + 1e-12);
