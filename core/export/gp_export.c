@@ -1,5 +1,6 @@
 /* gp_export.c -- format registry, packs, the cached pack reader and the pull-stream driver.
- * The formats themselves are in gp_export_{lammps,lammps_relax,yade,vtk,csv}.c. */
+ * The formats themselves are in gp_export_{lammps,lammps_relax,yade,vtk,csv}.c, and those of a
+ * fv3d pack in gp_export_fv3d_{dem,mesh}.c (its records: gp_export_fv3d.c). */
 #include "gp_export_internal.h"
 
 #include <math.h>
@@ -12,17 +13,34 @@
 
 /* ------------------------------------------------------------------ registry */
 
+#define DIMS_2 (1u << 2)
+#define DIMS_3 (1u << 3)
+#define DIMS_FV3D (1u << GP_EXPORT_FV3D)
+
 static const struct {
     const char *name, *ext, *mime;
-    unsigned dims; /* bit 2: 2D, bit 3: 3D */
+    unsigned dims; /* bit 2: 2D, bit 3: 3D, bit GP_EXPORT_FV3D: fv3d */
 } formats[GP_EXPORT_NFORMATS] = {
-    [GP_EXPORT_LAMMPS] = {"lammps", "data", "text/plain; charset=utf-8", 1u << 2 | 1u << 3},
-    [GP_EXPORT_LIGGGHTS] = {"liggghts", "data", "text/plain; charset=utf-8", 1u << 3},
-    [GP_EXPORT_YADE] = {"yade", "txt", "text/plain; charset=utf-8", 1u << 2 | 1u << 3},
-    [GP_EXPORT_VTK] = {"vtk", "vtk", "application/octet-stream", 1u << 2 | 1u << 3},
-    [GP_EXPORT_CSV] = {"csv", "csv", "text/csv; charset=utf-8", 1u << 2 | 1u << 3},
-    [GP_EXPORT_LAMMPS_RELAX] = {"lammps-relax", "tar", "application/x-tar", 1u << 3},
+    [GP_EXPORT_LAMMPS] = {"lammps", "data", "text/plain; charset=utf-8", DIMS_2 | DIMS_3 | DIMS_FV3D},
+    [GP_EXPORT_LIGGGHTS] = {"liggghts", "data", "text/plain; charset=utf-8", DIMS_3 | DIMS_FV3D},
+    [GP_EXPORT_YADE] = {"yade", "txt", "text/plain; charset=utf-8", DIMS_2 | DIMS_3 | DIMS_FV3D},
+    [GP_EXPORT_VTK] = {"vtk", "vtk", "application/octet-stream", DIMS_2 | DIMS_3 | DIMS_FV3D},
+    [GP_EXPORT_CSV] = {"csv", "csv", "text/csv; charset=utf-8", DIMS_2 | DIMS_3},
+    [GP_EXPORT_LAMMPS_RELAX] = {"lammps-relax", "tar", "application/x-tar", DIMS_3},
+    [GP_EXPORT_STL] = {"stl", "stl", "model/stl", DIMS_FV3D},
 };
+
+/* a pack's dimension that the registry knows */
+static int known_dim(int dim)
+{
+    return dim == 2 || dim == 3 || dim == GP_EXPORT_FV3D;
+}
+
+/* its name in messages */
+static const char *dim_name(int dim)
+{
+    return dim == 2 ? "2D" : dim == 3 ? "3D" : dim == GP_EXPORT_FV3D ? "fv3d" : "unknown";
+}
 
 int gp_export_format_parse(const char *name)
 {
@@ -39,13 +57,17 @@ const char *gp_export_format_name(gp_export_format f)
 
 int gp_export_format_supports(gp_export_format f, int dim)
 {
-    return (unsigned)f < GP_EXPORT_NFORMATS && (dim == 2 || dim == 3) &&
-           (formats[f].dims >> dim & 1u);
+    return (unsigned)f < GP_EXPORT_NFORMATS && known_dim(dim) && (formats[f].dims >> dim & 1u);
 }
 
 const char *gp_export_format_list(int dim)
 {
-    return dim == 2 ? "lammps, yade, vtk, csv" : "lammps, liggghts, yade, vtk, csv, lammps-relax";
+    switch (dim) {
+    case 2: return "lammps, yade, vtk, csv";
+    case 3: return "lammps, liggghts, yade, vtk, csv, lammps-relax";
+    case GP_EXPORT_FV3D: return "lammps, liggghts, yade, vtk, stl";
+    default: return "";
+    }
 }
 
 const char *gp_export_format_extension(gp_export_format f)
@@ -56,6 +78,26 @@ const char *gp_export_format_extension(gp_export_format f)
 const char *gp_export_format_mime(gp_export_format f)
 {
     return (unsigned)f < GP_EXPORT_NFORMATS ? formats[f].mime : "application/octet-stream";
+}
+
+const char *gp_export_format_extension_in(gp_export_format f, int dim)
+{
+    if (dim == GP_EXPORT_FV3D && f == GP_EXPORT_LAMMPS) return "tar";
+    if (dim == GP_EXPORT_FV3D && f == GP_EXPORT_LIGGGHTS) return "in";
+    return gp_export_format_extension(f);
+}
+
+int gp_export_format_needs_clumps(gp_export_format f, int dim)
+{
+    return dim == GP_EXPORT_FV3D &&
+           (f == GP_EXPORT_LAMMPS || f == GP_EXPORT_LIGGGHTS || f == GP_EXPORT_YADE);
+}
+
+const char *gp_export_format_mime_in(gp_export_format f, int dim)
+{
+    if (dim == GP_EXPORT_FV3D && f == GP_EXPORT_LAMMPS) return "application/x-tar";
+    if (dim == GP_EXPORT_FV3D && f == GP_EXPORT_LIGGGHTS) return "text/plain; charset=utf-8";
+    return gp_export_format_mime(f);
 }
 
 /* ------------------------------------------------------------------ packs */
@@ -308,6 +350,187 @@ gp_status gp_export_pack_2d_view(const gp_specimen2d *s, const gp_spec2d *spec, 
     return pack_2d(s, spec, GP_EXPORT_DEFAULT_DENSITY, 1, pack, len, err);
 }
 
+/* ------------------------------------------------------------------ the fv3d pack */
+
+/* lammps' member sizes counted into the fv3d block of pack (len bytes, with clumps): made here
+ * once on the worker rather than by every download (as put_relax_size). Left 0 (counted at the
+ * download) when the pack cannot be read back. */
+static void put_fv3d_sizes(unsigned char *pack, size_t len)
+{
+    gp_export_source src = gp_export_memory_source(pack, len);
+    gp_export *e = NULL;
+    gp_error err;
+    uint64_t data = 0, rigid = 0;
+    if (gp_export_open(GP_EXPORT_LAMMPS, &src, &e, &err) != GP_OK) return;
+    if (gp_export_fv3d_count(e, &data, &rigid) == 0) {
+        uint32_t layout = GP_EXPORT_FV3D_LAYOUT;
+        memcpy(pack + GP_PACK_HEADER + 16, &data, 8);
+        memcpy(pack + GP_PACK_HEADER + 24, &rigid, 8);
+        memcpy(pack + GP_PACK_HEADER + 32, &layout, 4);
+    }
+    gp_export_destroy(e);
+}
+
+/* The box of a fv3d specimen: its cells' vertices' extent (the container's bounding box), with
+ * the grains' vertices and clump spheres, which lie inside (a guard); max_extent the largest
+ * grain's bounding-box diagonal. xyz holds 3 x ndirs doubles. */
+static gp_status fv3d_box(const gp_fv3d *s, size_t ndirs, double *xyz, pack_header *h,
+                          gp_error *err)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    const gp_voronoi3d *v = gp_fv3d_cells(s);
+    size_t n = gp_fv3d_count(s), cap = 0;
+    double *cv = NULL;
+    for (size_t i = 0; v && i < gp_voronoi3d_count(v); i++) {
+        size_t nv = gp_voronoi3d_cell_vertices(v, i, NULL, 0);
+        if (nv > cap) {
+            double *nb = realloc(cv, 3 * nv * sizeof *nb);
+            if (!nb) {
+                free(cv);
+                return gp_error_set(err, GP_ERR_NOMEM, "out of memory packing the cells");
+            }
+            cv = nb;
+            cap = nv;
+        }
+        nv = gp_voronoi3d_cell_vertices(v, i, cv, cap);
+        for (size_t k = 0; k < nv; k++)
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fmin(lo[a], cv[3 * k + a]);
+                hi[a] = fmax(hi[a], cv[3 * k + a]);
+            }
+    }
+    free(cv);
+    double ext = 0;
+    for (size_t g = 0; g < n; g++) {
+        const gp_fv3d_grain *gr = gp_fv3d_grain_at(s, g);
+        double a[3] = {INFINITY, INFINITY, INFINITY}, b[3] = {-INFINITY, -INFINITY, -INFINITY};
+        gp_fv3d_grain_vertices(s, g, xyz);
+        for (size_t k = 0; k < ndirs; k++)
+            for (int c = 0; c < 3; c++) {
+                a[c] = fmin(a[c], xyz[3 * k + c]);
+                b[c] = fmax(b[c], xyz[3 * k + c]);
+            }
+        for (size_t k = 0; k < gr->nspheres; k++)
+            for (int c = 0; c < 3; c++) {
+                a[c] = fmin(a[c], gr->spheres[4 * k + c] - gr->spheres[4 * k + 3]);
+                b[c] = fmax(b[c], gr->spheres[4 * k + c] + gr->spheres[4 * k + 3]);
+            }
+        if (ndirs) ext = fmax(ext, sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                                        (b[2] - a[2]) * (b[2] - a[2])));
+        for (int c = 0; c < 3; c++) {
+            lo[c] = fmin(lo[c], a[c]);
+            hi[c] = fmax(hi[c], b[c]);
+        }
+    }
+    for (int c = 0; c < 3; c++)
+        if (!(lo[c] <= hi[c]) || !isfinite(lo[c]) || !isfinite(hi[c]))
+            return gp_error_set(err, GP_ERR_INVALID, "the specimen has no finite extent");
+    memcpy(h->lo, lo, sizeof lo);
+    memcpy(h->hi, hi, sizeof hi);
+    h->max_extent = ext;
+    return GP_OK;
+}
+
+gp_status gp_export_pack_fv3d(const gp_fv3d *s, double density, void **pack, size_t *len,
+                              gp_error *err)
+{
+    *pack = NULL;
+    *len = 0;
+    if (!s) return gp_error_set(err, GP_ERR_INVALID, "no specimen");
+    gp_status st = check_density(density, err);
+    if (st) return st;
+    const double *dirs;
+    const uint32_t *tris;
+    size_t n = gp_fv3d_count(s), nd = gp_fv3d_directions(s, &dirs), nt = gp_fv3d_triangles(s, &tris);
+    if ((nd && !dirs) || (nt && !tris))
+        return gp_error_set(err, GP_ERR_INVALID, "the specimen has no icosphere");
+    uint64_t nsph = 0;
+    size_t with = 0;
+    double rmin = 0, rmax = 0, volume = 0;
+    for (size_t g = 0; g < n; g++) {
+        const gp_fv3d_grain *gr = gp_fv3d_grain_at(s, g);
+        if (!gr->radii && nd) return gp_error_set(err, GP_ERR_INVALID, "grain %zu has no radii", g);
+        if (gr->nspheres && !gr->spheres)
+            return gp_error_set(err, GP_ERR_INVALID, "grain %zu has no sphere list", g);
+        with += gr->nspheres > 0;
+        for (size_t k = 0; k < gr->nspheres; k++) {
+            double r = gr->spheres[4 * k + 3];
+            rmin = nsph + k == 0 ? r : fmin(rmin, r);
+            rmax = nsph + k == 0 ? r : fmax(rmax, r);
+        }
+        nsph += gr->nspheres;
+        volume += gr->volume;
+    }
+    if (with && with < n)
+        return gp_error_set(err, GP_ERR_INVALID,
+                            "%zu of %zu grains have a clump of spheres: all or none must", with, n);
+    double need = GP_PACK_HEADER + (double)GP_PACK_FV3D + (double)GP_PACK_GRAIN3 * (double)n +
+                  32.0 * (double)nsph + 8.0 * (double)n * (double)nd + 24.0 * (double)nd +
+                  12.0 * (double)nt;
+    if (need > (double)(SIZE_MAX / 2)) return gp_error_set(err, GP_ERR_NOMEM, "specimen too large to pack");
+    size_t bytes = (size_t)need;
+    double *xyz = malloc((nd ? 3 * nd : 1) * sizeof *xyz);
+    unsigned char *p = calloc(1, bytes);
+    if (!p || !xyz) {
+        free(p);
+        free(xyz);
+        return gp_error_set(err, GP_ERR_NOMEM, "out of memory packing %zu grains", n);
+    }
+    pack_header h;
+    header_init(&h, GP_EXPORT_FV3D, density);
+    h.flags = with ? GP_EXPORT_HAS_CLUMPS : 0;
+    h.nitems = n;
+    h.npoints = nd;
+    h.ndiscs = nsph;
+    st = fv3d_box(s, nd, xyz, &h, err);
+    free(xyz);
+    if (st) {
+        free(p);
+        return st;
+    }
+    memcpy(p, &h, sizeof h);
+    /* the fv3d block */
+    unsigned char *w = p + GP_PACK_HEADER;
+    memcpy(w, GP_PACK_FV3D_MAGIC, 8);
+    w += 8;
+    put_u64(&w, nt);
+    w += 8 + 8 + 8; /* the counted sizes (below) and the layout */
+    put_f64(&w, volume);
+    put_f64(&w, rmin);
+    put_f64(&w, rmax);
+    /* the grains, their spheres, their radii, the icosphere */
+    w = p + GP_PACK_HEADER + GP_PACK_FV3D;
+    unsigned char *ws = w + (size_t)GP_PACK_GRAIN3 * n;
+    unsigned char *wr = ws + 32 * nsph;
+    uint64_t first = 0;
+    for (size_t g = 0; g < n; g++) {
+        const gp_fv3d_grain *gr = gp_fv3d_grain_at(s, g);
+        put_u64(&w, gr->cell);
+        put_u64(&w, first);
+        put_u64(&w, gr->nspheres);
+        for (int k = 0; k < 3; k++) put_f64(&w, gr->centre[k]);
+        for (int k = 0; k < 4; k++) put_f64(&w, gr->rotation[k]);
+        put_f64(&w, gr->scale);
+        put_f64(&w, gr->volume);
+        put_f64(&w, density * gr->volume);
+        for (int k = 0; k < 3; k++) put_f64(&w, gr->centroid[k]);
+        static const int upper[6] = {0, 4, 8, 1, 2, 5}; /* xx yy zz xy xz yz */
+        for (int k = 0; k < 6; k++) put_f64(&w, density * gr->inertia[upper[k]]);
+        if (gr->nspheres) memcpy(ws, gr->spheres, 32 * gr->nspheres);
+        ws += 32 * gr->nspheres;
+        first += gr->nspheres;
+        if (nd) memcpy(wr, gr->radii, 8 * nd);
+        wr += 8 * nd;
+    }
+    if (nd) memcpy(wr, dirs, 24 * nd);
+    wr += 24 * nd;
+    if (nt) memcpy(wr, tris, 12 * nt);
+    if (with) put_fv3d_sizes(p, bytes);
+    *pack = p;
+    *len = bytes;
+    return GP_OK;
+}
+
 /* ------------------------------------------------------------------ sources */
 
 /* The pack in memory. Bounds are checked by cache_get() against the source's size before any
@@ -345,6 +568,38 @@ static const unsigned char *cache_get(gp_export *e, uint64_t off, size_t n)
     e->cache_off = off;
     e->cache_len = len;
     return e->cache;
+}
+
+const unsigned char *gp_xr_window(gp_export *e, uint64_t off, size_t n)
+{
+    return cache_get(e, off, n);
+}
+
+const unsigned char *gp_xr_window2(gp_export *e, uint64_t off, size_t n)
+{
+    gp_x3 *x = &e->x3;
+    if (x->cache && off >= x->cache_off && off + n <= x->cache_off + x->cache_len)
+        return x->cache + (off - x->cache_off);
+    if (off > e->src.size || n > e->src.size - off || n > CACHE_BYTES) {
+        gp_error_set(&e->err, GP_ERR_INVALID, "pack truncated: %zu bytes at offset %llu of %llu",
+                     n, (unsigned long long)off, (unsigned long long)e->src.size);
+        return NULL;
+    }
+    if (!x->cache && !(x->cache = malloc(CACHE_BYTES))) {
+        gp_error_set(&e->err, GP_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    uint64_t want = e->src.size - off;
+    size_t len = want < CACHE_BYTES ? (size_t)want : CACHE_BYTES;
+    if (e->src.read(e->src.user, off, x->cache, len)) {
+        x->cache_len = 0;
+        gp_error_set(&e->err, GP_ERR_INVALID, "reading the pack failed at offset %llu",
+                     (unsigned long long)off);
+        return NULL;
+    }
+    x->cache_off = off;
+    x->cache_len = len;
+    return x->cache;
 }
 
 static int read_f64s(gp_export *e, uint64_t off, double *out, int n)
@@ -533,7 +788,7 @@ static gp_status pack_open(const gp_export_source *src, gp_export **out, gp_erro
     if (memcmp(h.magic, GP_PACK_MAGIC, 8)) why = "bad magic";
     else if (h.bom != GP_PACK_BOM) why = "written with another byte order";
     else if (h.version != GP_PACK_VERSION) why = "unknown version";
-    else if (h.dim != 2 && h.dim != 3) why = "bad dimension";
+    else if (!known_dim((int)h.dim)) why = "bad dimension";
     if (!why) {
         e->info.dim = (int)h.dim;
         e->info.flags = h.flags;
@@ -548,7 +803,10 @@ static gp_status pack_open(const gp_export_source *src, gp_export **out, gp_erro
         e->off_items = GP_PACK_HEADER;
         /* sizes are checked in floating point first so that a corrupt count cannot wrap */
         double need;
-        if (e->info.dim == 3) {
+        if (e->info.dim == GP_EXPORT_FV3D) {
+            need = gp_x3_read_block(e) ? -1.0 : gp_x3_pack_size(&e->info);
+            if (need < 0) why = "bad fv3d block";
+        } else if (e->info.dim == 3) {
             need = GP_PACK_HEADER + 32.0 * (double)e->info.nitems;
             if (e->info.flags & GP_EXPORT_HAS_DEM) need += GP_PACK_DEM;
         } else {
@@ -557,7 +815,7 @@ static gp_status pack_open(const gp_export_source *src, gp_export **out, gp_erro
             e->off_points = GP_PACK_HEADER + (uint64_t)GP_PACK_GRAIN * e->info.nitems;
             e->off_discs = e->off_points + 16 * e->info.npoints;
         }
-        if (need != (double)src->size) why = "its size does not match its counts";
+        if (!why && need != (double)src->size) why = "its size does not match its counts";
     }
     if (!why && e->info.dim == 3 && (e->info.flags & GP_EXPORT_HAS_DEM) && read_dem(e))
         why = "bad DEM block";
@@ -593,8 +851,27 @@ gp_status gp_export_open(gp_export_format f, const gp_export_source *src, gp_exp
     if (!gp_export_format_supports(f, e->info.dim)) {
         int dim = e->info.dim;
         gp_export_destroy(e);
-        return gp_error_set(err, GP_ERR_INVALID, "format %s does not exist in %dD (valid: %s)",
-                            gp_export_format_name(f), dim, gp_export_format_list(dim));
+        return gp_error_set(err, GP_ERR_INVALID, "format %s does not exist in %s (valid: %s)",
+                            gp_export_format_name(f), dim_name(dim), gp_export_format_list(dim));
+    }
+    if (e->info.dim == GP_EXPORT_FV3D) {
+        switch (f) {
+        case GP_EXPORT_LAMMPS: e->step = gp_export_step_fv3d_lammps; break;
+        case GP_EXPORT_LIGGGHTS: e->step = gp_export_step_fv3d_liggghts; break;
+        case GP_EXPORT_YADE: e->step = gp_export_step_fv3d_yade; break;
+        case GP_EXPORT_VTK: e->step = gp_export_step_fv3d_vtk; break;
+        default: e->step = gp_export_step_fv3d_stl; break;
+        }
+        if (gp_export_format_needs_clumps(f, e->info.dim) &&
+            !(e->info.flags & GP_EXPORT_HAS_CLUMPS) && e->info.nitems > 0) {
+            gp_export_destroy(e);
+            return gp_error_set(err, GP_ERR_INVALID,
+                                "%s needs the clumps output (outputs must include \"clumps\"): "
+                                "its rigid bodies are the grains' clumps of spheres",
+                                gp_export_format_name(f));
+        }
+        *out = e;
+        return GP_OK;
     }
     switch (f) {
     case GP_EXPORT_LAMMPS:
@@ -654,6 +931,10 @@ void gp_export_destroy(gp_export *e)
     if (!e) return;
     free(e->cache);
     free(e->buf);
+    free(e->x3.cache);
+    free(e->x3.verts);
+    free(e->x3.dirs);
+    free(e->x3.tris);
     free(e);
 }
 
@@ -695,8 +976,8 @@ static gp_status reader_check(const gp_export_reader *r, int dim, const char *wh
                               uint64_t count, gp_error *err)
 {
     if (r->e->info.dim != dim)
-        return gp_error_set(err, GP_ERR_INVALID, "a %dD pack has no %s records", r->e->info.dim,
-                            what);
+        return gp_error_set(err, GP_ERR_INVALID, "a %s pack has no %s records",
+                            dim_name(r->e->info.dim), what);
     if (k >= count)
         return gp_error_set(err, GP_ERR_INVALID, "%s %llu of %llu", what, (unsigned long long)k,
                             (unsigned long long)count);
@@ -732,6 +1013,41 @@ gp_status gp_export_reader_disc(gp_export_reader *r, uint64_t k, double d[3], gp
 {
     gp_status st = reader_check(r, 2, "disc", k, r->e->info.ndiscs, err);
     return st ? st : reader_result(r, gp_xr_disc(r->e, k, d), err);
+}
+
+gp_status gp_export_reader_grain3(gp_export_reader *r, uint64_t g, gp_export_grain3 *out,
+                                  gp_error *err)
+{
+    gp_status st = reader_check(r, GP_EXPORT_FV3D, "grain", g, r->e->info.nitems, err);
+    return st ? st : reader_result(r, gp_xr_grain3(r->e, g, out), err);
+}
+
+gp_status gp_export_reader_clump_sphere(gp_export_reader *r, uint64_t k, double q[4],
+                                        gp_error *err)
+{
+    gp_status st = reader_check(r, GP_EXPORT_FV3D, "clump sphere", k, r->e->info.ndiscs, err);
+    return st ? st : reader_result(r, gp_xr_clump(r->e, k, q), err);
+}
+
+gp_status gp_export_reader_direction(gp_export_reader *r, uint64_t k, double d[3], gp_error *err)
+{
+    gp_status st = reader_check(r, GP_EXPORT_FV3D, "direction", k, r->e->info.npoints, err);
+    return st ? st : reader_result(r, gp_xr_direction(r->e, k, d), err);
+}
+
+gp_status gp_export_reader_triangle(gp_export_reader *r, uint64_t t, uint32_t tri[3],
+                                    gp_error *err)
+{
+    gp_status st = reader_check(r, GP_EXPORT_FV3D, "triangle", t, r->e->info.ntriangles, err);
+    return st ? st : reader_result(r, gp_xr_triangle(r->e, t, tri), err);
+}
+
+gp_status gp_export_reader_vertices(gp_export_reader *r, uint64_t g, double *xyz, gp_error *err)
+{
+    gp_status st = reader_check(r, GP_EXPORT_FV3D, "grain", g, r->e->info.nitems, err);
+    if (st) return st;
+    gp_export_grain3 gr;
+    return reader_result(r, gp_xr_grain3(r->e, g, &gr) || gp_x3_vertices(r->e, g, &gr, xyz), err);
 }
 
 void gp_export_reader_destroy(gp_export_reader *r)

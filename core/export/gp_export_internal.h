@@ -18,6 +18,9 @@
 #define GP_PACK_GRAIN 80u /* bytes per 2D grain record */
 #define GP_PACK_DEM 128u  /* bytes of the 3D DEM block (GP_EXPORT_HAS_DEM) */
 #define GP_PACK_DEM_MAGIC "GPEXDEM3"
+#define GP_PACK_FV3D 128u   /* bytes of the fv3d block */
+#define GP_PACK_GRAIN3 176u /* bytes per fv3d grain record */
+#define GP_PACK_FV3D_MAGIC "GPEXFV3D"
 
 /* The 3D DEM block of a pack (gp_export.h has its layout); present = 0 without one. */
 typedef struct gp_xdem {
@@ -27,11 +30,29 @@ typedef struct gp_xdem {
     int32_t tiling[3];
 } gp_xdem;
 
+/* A fv3d pack's block (gp_export.h) and the state of its formats. */
+typedef struct gp_x3 {
+    uint64_t data_bytes, rigid_bytes; /* lammps: the tar members' sizes (0: not counted) */
+    double rmin, rmax;                /* clump spheres */
+    uint64_t off_radii, off_dirs, off_tris; /* byte offsets of the arrays */
+    gp_export_grain3 grain;           /* the grain at e->index, loaded by the family */
+    double rho;                       /* lammps: the density of its atoms */
+    double *verts;                    /* vtk, stl: grain e->index's vertices (3 x npoints) */
+    double *dirs;                     /* the icosphere's directions, loaded once */
+    uint32_t *tris;                   /* the icosphere's triangles, loaded once */
+    uint64_t member, member_written;  /* lammps: the tar member being written, its bytes */
+    /* the second read window: grain records, beside the array a format walks */
+    unsigned char *cache;
+    uint64_t cache_off;
+    size_t cache_len;
+} gp_x3;
+
 struct gp_export {
     gp_export_format format;
     gp_export_source src;
     gp_export_info info;  /* the header */
     gp_xdem dem;          /* 3D: the DEM block, if the pack has one */
+    gp_x3 x3;             /* fv3d */
     uint64_t off_items, off_points, off_discs; /* byte offsets of the arrays */
     /* read cache */
     unsigned char *cache;
@@ -66,6 +87,27 @@ int gp_xr_sphere(gp_export *e, uint64_t i, double q[4]);
 int gp_xr_grain(gp_export *e, uint64_t g, gp_export_grain *out);
 int gp_xr_point(gp_export *e, uint64_t k, double p[2]);
 int gp_xr_disc(gp_export *e, uint64_t k, double d[3]);
+/* A window of the pack (the read cache): [off, off + n) with n <= 64 KiB; NULL with e->err set.
+ * gp_xr_window2 reads through the second window (allocated at its first use). */
+const unsigned char *gp_xr_window(gp_export *e, uint64_t off, size_t n);
+const unsigned char *gp_xr_window2(gp_export *e, uint64_t off, size_t n);
+
+/* fv3d records (gp_export_fv3d.c; 0, or -1 with e->err set): grain g's record (through the
+ * second window; a sphere range outside the array refused), clump sphere k, direction k,
+ * triangle t (an index past the directions refused), and grain g's placed vertices into xyz
+ * (3 x npoints doubles; g's record in gr) with the directions loaded once into e->x3.dirs. */
+int gp_xr_grain3(gp_export *e, uint64_t g, gp_export_grain3 *out);
+int gp_xr_clump(gp_export *e, uint64_t k, double q[4]);
+int gp_xr_direction(gp_export *e, uint64_t k, double d[3]);
+int gp_xr_triangle(gp_export *e, uint64_t t, uint32_t tri[3]);
+int gp_x3_vertices(gp_export *e, uint64_t g, const gp_export_grain3 *gr, double *xyz);
+/* The icosphere into e->x3.dirs and e->x3.tris (triangles checked), once. */
+int gp_x3_mesh(gp_export *e);
+/* The fv3d block after the header into e->x3 and e->info; -1 when it is not one. */
+int gp_x3_read_block(gp_export *e);
+/* The byte size a fv3d pack of these counts must have (as a double: a corrupt count cannot
+ * wrap). */
+double gp_x3_pack_size(const gp_export_info *in);
 
 /* A format that is a header, then one line per sphere (3D) or per ODEC disc (2D, grain by
  * grain, disc e->sub of grain e->index): lammps / liggghts, yade and csv. gp_xw_lines() is the
@@ -92,6 +134,18 @@ int gp_export_step_vtk3d(gp_export *e);
 int gp_export_step_vtk2d(gp_export *e);
 int gp_export_step_csv(gp_export *e);
 int gp_export_step_lammps_relax(gp_export *e);
+int gp_export_step_fv3d_lammps(gp_export *e);   /* gp_export_fv3d_dem.c */
+int gp_export_step_fv3d_liggghts(gp_export *e);
+int gp_export_step_fv3d_yade(gp_export *e);
+int gp_export_step_fv3d_vtk(gp_export *e);      /* gp_export_fv3d_mesh.c */
+int gp_export_step_fv3d_stl(gp_export *e);
+
+/* lammps' tar of a fv3d pack: its members' layout (the counted sizes in a fv3d block hold for
+ * this layout only, as GP_EXPORT_RELAX_LAYOUT), and the sizes of grains.data and grains.rigid
+ * for the pack of e (an export opened in format lammps, not yet read): every line formatted
+ * once. 0, or -1 with e->err set. */
+#define GP_EXPORT_FV3D_LAYOUT 1u
+int gp_export_fv3d_count(gp_export *e, uint64_t *data_bytes, uint64_t *rigid_bytes);
 
 /* lammps-relax's data file layout: a pack's counted size (gp_export.h, "relax_bytes") holds for
  * this layout only; change it with the data file's format, and older packs are counted again
