@@ -883,6 +883,11 @@ static enum MHD_Result h_export(struct MHD_Connection *c, req *r, const char *id
     if (!own && (f < 0 || !gp_export_format_supports(f, k->export_dim))) {
         char formats[256];
         gpd_kind_export_list(k, formats, sizeof formats);
+        if (!formats[0]) /* a kind without export formats (kind.h: no exports, export_dim 0) */
+            return send_error(c, r, 400, "invalid_parameter", NULL,
+                              "format: a job of kind %s has no export formats in this version%s"
+                              "%.64s%s", k->name, format ? "; got \"" : "", format ? format : "",
+                              format ? "\"" : "");
         return send_error(c, r, 400, "invalid_parameter", NULL,
                           "format: expected one of %s%s%.64s%s", formats,
                           format ? "; got \"" : "", format ? format : "", format ? "\"" : "");

@@ -13,7 +13,8 @@
     X(gpd_kind_fv2d)          \
     X(gpd_kind_spheres3d)     \
     X(gpd_kind_triax)         \
-    X(gpd_kind_geostatic)
+    X(gpd_kind_geostatic)     \
+    X(gpd_kind_fv3d)
 
 #define DECLARE(k) extern const gpd_kind k;
 GPD_KINDS(DECLARE)

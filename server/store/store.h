@@ -368,9 +368,10 @@ void store_stream_close(store_stream *s);
 
 /* ---- the summary of a result: what pictures and a result panel read ---- */
 
-/* The members a summary leaves out: a result's per-item arrays, its bulk. */
-#define STORE_SUMMARY_SKIP {"grains", "cells", "spheres", "contacts", NULL}
-#define STORE_SUMMARY_NSKIP 4
+/* The members a summary leaves out: a result's per-item arrays, its bulk (and a 3D
+ * Fourier-Voronoi result's shared icosphere, a few hundred KB its views make again). */
+#define STORE_SUMMARY_SKIP {"grains", "cells", "spheres", "contacts", "clumps", "icosphere", NULL}
+#define STORE_SUMMARY_NSKIP 6
 
 /* The summary of job id's result: the result object without STORE_SUMMARY_SKIP's members --
  * kind, seed, outputs, container or box, stats, warnings, timings..., a few KB -- as JSON text

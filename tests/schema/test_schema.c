@@ -207,7 +207,7 @@ typedef struct good_case {
 
 static const bad_case k_refused[] = {
     /* 2D: the schema, field by field */
-    {EX2D, "/kind", "\"voronoi\"", "/kind", "unknown kind \"voronoi\"; expected one of \"fourier-voronoi-2d\", \"geostatic-3d\", \"spheres-3d\", \"triaxial-3d\""},
+    {EX2D, "/kind", "\"voronoi\"", "/kind", "unknown kind \"voronoi\"; expected one of \"fourier-voronoi-2d\", \"fourier-voronoi-3d\", \"geostatic-3d\", \"spheres-3d\", \"triaxial-3d\""},
     {EX2D, "/kind", "3", "/kind", "unknown kind 3"},
     {EX2D, "/colour", "1", "/colour", "unknown field \"colour\""},
     {EX2D, "/seed", "-1", "/seed", "expected an integer in [0, 9007199254740991], got -1"},
@@ -838,12 +838,13 @@ static void test_documents(void)
     json_error_t e;
     json_t *j = json_loads(doc, 0, &e);
     CHECK(j != NULL);
-    CHECK(json_array_size(json_object_get(j, "oneOf")) == 4);
+    CHECK(json_array_size(json_object_get(j, "oneOf")) == 5);
     json_t *defs = json_object_get(j, "$defs");
     CHECK(json_is_object(json_object_get(defs, "fourier-voronoi-2d")));
     CHECK(json_is_object(json_object_get(defs, "spheres-3d")));
     CHECK(json_is_object(json_object_get(defs, "triaxial-3d")));
     CHECK(json_is_object(json_object_get(defs, "geostatic-3d")));
+    CHECK(json_is_object(json_object_get(defs, "fourier-voronoi-3d")));
     CHECK(!strcmp(json_string_value(json_object_get(j, "$schema")),
                   "https://json-schema.org/draft/2020-12/schema"));
     json_decref(j);
