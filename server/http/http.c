@@ -832,6 +832,15 @@ static int export_open(struct MHD_Connection *c, req *r, const char *id, const g
                           "the spec again with \"%s\" in outputs",
                           id, k->pack_what, k->pack_output);
     if (rc != STORE_OK || none) return -1;
+    gp_export_info info;
+    if (gp_export_format_needs_clumps(f, k->export_dim) && gp_export_pack_info(&src, &info, NULL) == GP_OK &&
+        !(info.flags & GP_EXPORT_HAS_CLUMPS)) {
+        *ret = send_error(c, r, 409, "missing_output", "/outputs",
+                          "job %s has no clumps to export to %s (its spec did not ask for them): "
+                          "submit the spec again with \"clumps\" in outputs",
+                          id, gp_export_format_name(f));
+        return -1;
+    }
     gp_error err;
     if (gp_export_open(f, &src, &d->e, &err) == GP_OK) return 0;
     if (!store_reachable()) /* the pack's stream broke with the server */
@@ -902,9 +911,9 @@ static enum MHD_Result h_export(struct MHD_Connection *c, req *r, const char *id
     }
     char disp[160];
     snprintf(disp, sizeof disp, "attachment; filename=\"%s-%s.%s\"", id,
-             gp_export_format_name(f), gp_export_format_extension(f));
-    return send_stream(c, r, gp_export_format_mime(f), MHD_SIZE_UNKNOWN, read_export, d,
-                       free_export, disp);
+             gp_export_format_name(f), gp_export_format_extension_in(f, k->export_dim));
+    return send_stream(c, r, gp_export_format_mime_in(f, k->export_dim), MHD_SIZE_UNKNOWN,
+                       read_export, d, free_export, disp);
 }
 
 /* GET /v1/jobs/{id}/svg and /export: by the job's kind */

@@ -77,7 +77,7 @@ void gpd_kind_export_list(const gpd_kind *k, char *buf, size_t n)
     int first = 1;
     for (const gpd_kind_export *e = k->exports; e && e->format; e++, first = 0)
         join(buf, n, first, ", ", "", e->format);
-    if (k->export_dim != 2 && k->export_dim != 3) return;
+    if (k->export_dim <= 0) return;
     /* core/export's formats, but those the kind writes itself */
     const char *p = gp_export_format_list(k->export_dim);
     while (*p) {

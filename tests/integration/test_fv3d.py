@@ -7,13 +7,16 @@ cells' vertices (counter-clockwise from outside); the cells' volumes and their s
 container; neighbours mutual, walls on the container; the solid fraction, the descriptor means
 and the clump counts against the stats. A cylinder, a polyhedron and a sieve law; the same
 specimen bit for bit on 1 and 2 threads; the refusals at submit (422 at the field's JSON
-pointer, too_large for the work, the memory and the result); the views; the export's 400;
-cancel while running."""
+pointer, too_large for the work, the memory and the result); the views; the exports (the VTK
+surfaces enclose the grains' volumes, the LAMMPS bodies weigh rho V, 409 without clumps or
+grains); cancel while running."""
 import hashlib
+import io
 import json
 import math
 import os
 import sys
+import tarfile
 import time
 import xml.etree.ElementTree as ET
 
@@ -275,10 +278,62 @@ def check_views(d, jid):
     assert st == 400 and "valid z from 0 to 1" in j["error"]["message"], j
     st, _, j = d.json("GET", "/v1/jobs/%s/svg?view=psd" % jid)
     assert st == 400 and all(v in j["error"]["message"] for v in VIEWS), j
-    # no export formats yet: a clear 400
-    st, _, j = d.json("GET", "/v1/jobs/%s/export?format=lammps" % jid)
+    st, _, j = d.json("GET", "/v1/jobs/%s/export?format=csv" % jid)
     gpd.check_error_body(st, j, "invalid_parameter")
-    assert st == 400 and "no export formats" in j["error"]["message"], j
+    assert st == 400 and all(f in j["error"]["message"] for f in EXPORTS), j
+
+
+# the exports of this kind (core/export's fv3d pack; tests/integration/test_export_fv3d.py
+# loads the same files into LAMMPS, LIGGGHTS and YADE)
+EXPORTS = ("lammps", "liggghts", "yade", "vtk", "stl")
+DENSITY = 2650.0
+
+
+def check_exports(d, jid, r):
+    """the downloads against the result: the VTK and STL surfaces enclose each grain's volume,
+    the LAMMPS bodies weigh rho V each"""
+    vols = [g["volume"] for g in r["grains"]]
+    ntri = len(r["icosphere"]["triangles"])
+    st, h, body = d.request("GET", "/v1/jobs/%s/export?format=vtk" % jid)
+    assert st == 200, (st, body[:300])
+    pts, polys = vtk_surfaces(body.decode())
+    assert len(polys) == len(vols) * ntri, (len(polys), len(vols), ntri)
+    enclosed = mesh_volume(pts, polys, pts[0])
+    assert close(enclosed, math.fsum(vols), 1e-9), (enclosed, math.fsum(vols))
+    st, h, body = d.request("GET", "/v1/jobs/%s/export?format=stl" % jid)
+    assert st == 200 and body.decode().count("facet normal") == len(vols) * ntri, st
+    st, h, body = d.request("GET", "/v1/jobs/%s/export?format=lammps" % jid)
+    assert st == 200 and h["Content-Type"].startswith("application/x-tar"), (st, h)
+    with tarfile.open(fileobj=io.BytesIO(body)) as tar:
+        names = tar.getnames()
+        rigid = tar.extractfile("lammps-grains/grains.rigid").read().decode()
+    assert {"lammps-grains/grains.data", "lammps-grains/grains.in",
+            "lammps-grains/grains.rigid"} <= set(names), names
+    bodies = [ln.split() for ln in rigid.splitlines() if ln.strip() and ln.split()[0].isdigit()
+              and len(ln.split()) >= 11]
+    masses = sorted(float(b[1]) for b in bodies)
+    assert len(masses) == len(vols), (len(masses), len(vols))
+    assert all(close(m, DENSITY * v, 1e-12) for m, v in zip(masses, sorted(vols)))
+    for fmt in ("liggghts", "yade"):
+        st, _, body = d.request("GET", "/v1/jobs/%s/export?format=%s" % (jid, fmt))
+        assert st == 200 and len(body) > 1000, (fmt, st)
+
+
+def vtk_surfaces(text):
+    """the points and the triangles of a legacy ASCII polydata"""
+    tok = text.split()
+    i = tok.index("POINTS")
+    n = int(tok[i + 1])
+    vals = [float(t) for t in tok[i + 3:i + 3 + 3 * n]]
+    pts = [vals[3 * k:3 * k + 3] for k in range(n)]
+    j = tok.index("POLYGONS")
+    m = int(tok[j + 1])
+    polys, k = [], j + 3
+    for _ in range(m):
+        c = int(tok[k])
+        polys.append([int(t) for t in tok[k + 1:k + 1 + c]])
+        k += 1 + c
+    return pts, polys
 
 
 def test_example(env):
@@ -300,6 +355,7 @@ def test_example(env):
     assert st == 200 and s == {k: v for k, v in r.items()
                                if k not in ("grains", "cells", "clumps", "icosphere")}, sorted(s)
     check_views(d, jid)
+    check_exports(d, jid, r)
     assert d.stop() == 0, "daemon did not exit cleanly:\n" + d.read_log()
 
 
@@ -362,6 +418,13 @@ def test_containers_and_sieve(env):
                        ("descriptors", 409)):
         st, _, body = d.request("GET", "/v1/jobs/%s/svg?view=%s" % (ids[3], view))
         assert st == want, (view, st, body[:200])
+    # no clumps asked: the surfaces export, the rigid bodies 409; no grains asked: no pack
+    st, _, body = d.request("GET", "/v1/jobs/%s/export?format=vtk" % ids[0])
+    assert st == 200, (st, body[:200])
+    for jid, fmt in ((ids[0], "lammps"), (ids[0], "yade"), (ids[3], "vtk")):
+        st, _, j = d.json("GET", "/v1/jobs/%s/export?format=%s" % (jid, fmt))
+        gpd.check_error_body(st, j, "missing_output")
+        assert st == 409, (fmt, st, j)
     for jid in ids[:3]:  # the views of each container (the outline of a cylinder, a polyhedron)
         for view in ("section", "projection"):
             st, _, body = d.request("GET", "/v1/jobs/%s/svg?view=%s" % (jid, view))

@@ -1,6 +1,6 @@
 /* kind_fv3d.c -- the kind "fourier-voronoi-3d": 3D Fourier-Voronoi specimens (core/3d/gp_fv3d.h)
- * with their result (result_fv3d.c), progress and SVG views (svg_fv3d.c). No export pack yet:
- * the kind has no export formats (GET .../export answers 400 saying so).
+ * with their result (result_fv3d.c), progress, SVG views (svg_fv3d.c) and export pack
+ * (core/export: lammps, liggghts and yade of the clumps, vtk and stl of the grain surfaces).
  *
  * Progress: the core reports "imc" (detail {"steps", "error"}) and "grains" (detail
  * {"grains": done}); the plan adds "result". The brief's headline is the solid fraction. */
@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gp_export.h"
 #include "gp_fv3d.h"
 #include "gp_grain3d.h"
 #include "gp_imc.h"
@@ -134,13 +135,17 @@ static json_t *result(const void *specimen, const void *spec, const json_t *spec
     return result_fv3d_write(((const fv3d_job *)specimen)->s, spec, spec_json, w);
 }
 
-/* no export pack in this version */
+/* The export pack (core/export, GP_EXPORT_FV3D): the grains' poses, exact masses and
+ * inertia, radii and clumps, made when the spec asked for the grains (1: no pack otherwise) */
 static int pack(const void *specimen, const void *spec, void **pack, size_t *len,
                 gp_error *err)
 {
+    (void)spec;
+    const fv3d_job *j = specimen;
     *pack = NULL;
     *len = 0;
-    return 1;
+    if (!(j->outputs & GP_OUT3_GRAINS)) return 1;
+    return gp_export_pack_fv3d(j->s, GP_EXPORT_DEFAULT_DENSITY, pack, len, err) ? -1 : 0;
 }
 
 /* How the IMC ended, the warnings and the fit summary (stats.fit without its CDF curves), so
@@ -186,5 +191,5 @@ const gpd_kind gpd_kind_fv3d = {
     .name = KIND_NAME, .example = example, .bounds = gp_spec_check_result, .brief = brief,
     GPD_KIND_CORE_OPS(gp_spec_fv3d), .progress_detail = progress_detail, .plan = plan,
     .result_cost = result_cost, .result = result, .pack = pack, .done_detail = done_detail,
-    .views = views, .export_dim = 0, .pack_what = "export pack", .pack_output = "grains",
+    .views = views, .export_dim = GP_EXPORT_FV3D, .pack_what = "grains", .pack_output = "grains",
     .phases = phases};
