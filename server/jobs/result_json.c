@@ -12,6 +12,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "gp_fit.h"
+#include "gp_law.h"
 #include "jobs/file_errors.h"
 
 json_t *gpd_jreal(double x)
@@ -25,6 +27,42 @@ json_t *gpd_jreals(const double *v, size_t n)
     json_t *a = json_array();
     for (size_t i = 0; i < n; i++) json_array_append_new(a, gpd_jreal(v[i]));
     return a;
+}
+
+static json_t *mean_cov(double mean, double cov)
+{
+    return json_pack("{s:o, s:o}", "mean", gpd_jreal(mean), "cov", gpd_jreal(cov));
+}
+
+static json_t *pair(double a, double b)
+{
+    return json_pack("[o, o]", gpd_jreal(a), gpd_jreal(b));
+}
+
+json_t *gpd_fit_size(const gp_fit_area *a, int with_curves)
+{
+    const char *law = gp_law_name(a->law);
+    json_t *o = json_pack("{s:s, s:o, s:o, s:o, s:o, s:o, s:I}", "law", law ? law : "",
+                          "target", mean_cov(a->target_mean, a->target_cov), "achieved",
+                          mean_cov(a->mean, a->cov), "ks", gpd_jreal(a->ks), "ks_critical",
+                          gpd_jreal(a->ks_critical), "w1", gpd_jreal(a->w1), "n",
+                          (json_int_t)a->n);
+    if (!o) return NULL;
+    json_object_set_new(o, "range", json_pack("{s:o, s:o}", "achieved", pair(a->min, a->max),
+                                              "target_p001_p999", pair(a->q001, a->q999)));
+    if (with_curves && a->ncurve > 0 && a->curve_x && a->curve_target && a->curve_achieved)
+        json_object_set_new(o, "cdf",
+                            json_pack("{s:o, s:o, s:o}", "x", gpd_jreals(a->curve_x, a->ncurve),
+                                      "target", gpd_jreals(a->curve_target, a->ncurve), "achieved",
+                                      gpd_jreals(a->curve_achieved, a->ncurve)));
+    return o;
+}
+
+json_t *gpd_fit_passing(const gp_fit_passing *p)
+{
+    return json_pack("{s:o, s:o, s:o, s:o}", "diameters", gpd_jreals(p->diameters, p->n), "target",
+                     gpd_jreals(p->target, p->n), "achieved", gpd_jreals(p->achieved, p->n),
+                     "max_error_pp", gpd_jreal(p->max_error_pp));
 }
 
 json_t *gpd_result_new(const char *kind, uint64_t seed, const json_t *spec_json)

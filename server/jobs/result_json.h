@@ -48,6 +48,14 @@ json_t *gpd_jreal(double x);
 /* n doubles as an array of gpd_jreal, or null when v is NULL. */
 json_t *gpd_jreals(const double *v, size_t n);
 
+/* stats.fit's members that every specimen kind writes alike (api.md): the fit of a size law
+ * (areas in 2D, volumes in 3D: {"law", "target", "achieved", "ks", "ks_critical", "w1", "n",
+ * "range"} and, with_curves, "cdf") and a sieve's passing by mass. */
+struct gp_fit_area;
+struct gp_fit_passing;
+json_t *gpd_fit_size(const struct gp_fit_area *a, int with_curves);
+json_t *gpd_fit_passing(const struct gp_fit_passing *p);
+
 /* 1 when the worker's cancel flag (raised by another thread with an atomic store; may be
  * NULL) is up. */
 int gpd_cancel_raised(const volatile int *cancel);

@@ -97,35 +97,6 @@ static const char *imc_measure(const gp_specimen2d *s, gp_imc_error_kind k)
     }
 }
 
-static json_t *mean_cov(double mean, double cov)
-{
-    return json_pack("{s:o, s:o}", "mean", gpd_jreal(mean), "cov", gpd_jreal(cov));
-}
-
-static json_t *pair(double a, double b)
-{
-    return json_pack("[o, o]", gpd_jreal(a), gpd_jreal(b));
-}
-
-static json_t *fit_area(const gp_fit_area *a, int with_curves)
-{
-    const char *law = gp_law_name(a->law);
-    json_t *o = json_pack("{s:s, s:o, s:o, s:o, s:o, s:o, s:I}", "law", law ? law : "",
-                          "target", mean_cov(a->target_mean, a->target_cov), "achieved",
-                          mean_cov(a->mean, a->cov), "ks", gpd_jreal(a->ks), "ks_critical",
-                          gpd_jreal(a->ks_critical), "w1", gpd_jreal(a->w1), "n",
-                          (json_int_t)a->n);
-    if (!o) return NULL;
-    json_object_set_new(o, "range", json_pack("{s:o, s:o}", "achieved", pair(a->min, a->max),
-                                              "target_p001_p999", pair(a->q001, a->q999)));
-    if (with_curves && a->ncurve > 0 && a->curve_x && a->curve_target && a->curve_achieved)
-        json_object_set_new(o, "cdf",
-                            json_pack("{s:o, s:o, s:o}", "x", gpd_jreals(a->curve_x, a->ncurve),
-                                      "target", gpd_jreals(a->curve_target, a->ncurve), "achieved",
-                                      gpd_jreals(a->curve_achieved, a->ncurve)));
-    return o;
-}
-
 static json_t *fit_orient(const gp_fit_orient *o)
 {
     return json_pack("{s:{s:o, s:o}, s:o, s:o, s:I}", "target", "mean_deg",
@@ -134,26 +105,19 @@ static json_t *fit_orient(const gp_fit_orient *o)
                      gpd_jreal(o->ks_critical), "n", (json_int_t)o->n);
 }
 
-static json_t *fit_passing(const gp_fit_passing *p)
-{
-    return json_pack("{s:o, s:o, s:o, s:o}", "diameters", gpd_jreals(p->diameters, p->n), "target",
-                     gpd_jreals(p->target, p->n), "achieved", gpd_jreals(p->achieved, p->n),
-                     "max_error_pp", gpd_jreal(p->max_error_pp));
-}
-
 json_t *gpd_fit_2d(const gp_fit2d *f, int with_curves)
 {
     json_t *o = json_object();
     if (!o || !f) return o;
     if (f->cell_area.present)
-        json_object_set_new(o, "cell_area", fit_area(&f->cell_area, with_curves));
+        json_object_set_new(o, "cell_area", gpd_fit_size(&f->cell_area, with_curves));
     if (f->grain_area.present)
-        json_object_set_new(o, "grain_area", fit_area(&f->grain_area, with_curves));
+        json_object_set_new(o, "grain_area", gpd_fit_size(&f->grain_area, with_curves));
     if (f->cell_orientation.present)
         json_object_set_new(o, "cell_orientation", fit_orient(&f->cell_orientation));
     if (f->grain_orientation.present)
         json_object_set_new(o, "grain_orientation", fit_orient(&f->grain_orientation));
-    if (f->passing.n > 0) json_object_set_new(o, "passing", fit_passing(&f->passing));
+    if (f->passing.n > 0) json_object_set_new(o, "passing", gpd_fit_passing(&f->passing));
     return o;
 }
 

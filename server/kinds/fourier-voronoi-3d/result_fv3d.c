@@ -63,42 +63,11 @@ static const char *const AXES[3] = {"long", "intermediate", "short"};
 
 /* ------------------------------------------------------------------ stats */
 
-static json_t *mean_cov(double mean, double cov)
-{
-    return json_pack("{s:o, s:o}", "mean", gpd_jreal(mean), "cov", gpd_jreal(cov));
-}
-
-static json_t *pair(double a, double b)
-{
-    return json_pack("[o, o]", gpd_jreal(a), gpd_jreal(b));
-}
-
 static json_t *vec3(const double *v)
 {
     return json_pack("[o, o, o]", gpd_jreal(v[0]), gpd_jreal(v[1]), gpd_jreal(v[2]));
 }
 
-/* a fit of volumes, as the 2D kind writes its areas' */
-static json_t *fit_volume(const gp_fit_area *a, int with_curves)
-{
-    const char *law = gp_law_name(a->law);
-    json_t *o = json_pack("{s:s, s:o, s:o, s:o, s:o, s:o, s:I}", "law", law ? law : "",
-                          "target", mean_cov(a->target_mean, a->target_cov), "achieved",
-                          mean_cov(a->mean, a->cov), "ks", gpd_jreal(a->ks), "ks_critical",
-                          gpd_jreal(a->ks_critical), "w1", gpd_jreal(a->w1), "n",
-                          (json_int_t)a->n);
-    if (!o) return NULL;
-    json_object_set_new(o, "range", json_pack("{s:o, s:o}", "achieved", pair(a->min, a->max),
-                                              "target_p001_p999", pair(a->q001, a->q999)));
-    if (with_curves && a->ncurve > 0 && a->curve_x && a->curve_target && a->curve_achieved)
-        json_object_set_new(o, "cdf",
-                            json_pack("{s:o, s:o, s:o}", "x", gpd_jreals(a->curve_x, a->ncurve),
-                                      "target", gpd_jreals(a->curve_target, a->ncurve),
-                                      "achieved", gpd_jreals(a->curve_achieved, a->ncurve)));
-    return o;
-}
-
-/* an orientation fit: its target is an axis (unit) and an anisotropy */
 static json_t *fit_orient(const gp_fit_orient *o, const double axis[3])
 {
     double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
@@ -114,9 +83,9 @@ json_t *result_fv3d_fit(const gp_fv3d *s, const gp_spec_fv3d *spec, int with_cur
     json_t *o = json_object();
     if (!o) return NULL;
     if (t->cell_volume.present)
-        json_object_set_new(o, "cell_volume", fit_volume(&t->cell_volume, with_curves));
+        json_object_set_new(o, "cell_volume", gpd_fit_size(&t->cell_volume, with_curves));
     if (t->grain_volume.present)
-        json_object_set_new(o, "grain_volume", fit_volume(&t->grain_volume, with_curves));
+        json_object_set_new(o, "grain_volume", gpd_fit_size(&t->grain_volume, with_curves));
     if (t->cell_orientation.present)
         json_object_set_new(o, "cell_orientation",
                             fit_orient(&t->cell_orientation, spec->core.axis));
@@ -125,12 +94,7 @@ json_t *result_fv3d_fit(const gp_fv3d *s, const gp_spec_fv3d *spec, int with_cur
                             fit_orient(&t->grain_orientation, spec->core.axis));
     const gp_fit_passing *p = &t->passing;
     if (p->n > 0)
-        json_object_set_new(o, "passing",
-                            json_pack("{s:o, s:o, s:o, s:o}", "diameters",
-                                      gpd_jreals(p->diameters, p->n), "target",
-                                      gpd_jreals(p->target, p->n), "achieved",
-                                      gpd_jreals(p->achieved, p->n), "max_error_pp",
-                                      gpd_jreal(p->max_error_pp)));
+        json_object_set_new(o, "passing", gpd_fit_passing(p));
     return o;
 }
 
