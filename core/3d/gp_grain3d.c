@@ -24,9 +24,10 @@ struct gp_grain3d_basis {
     unsigned level, degree;
     size_t nv, nt, ne, ncoef;
     double elongation, flatness; /* the stretch S = diag(1, e, e f) the table is for */
-    gp_mesh3d *mesh;
-    double *u;       /* 3 per vertex: u_i = S^-1 d_i / |S^-1 d_i| (d_i without a stretch) */
-    double *k;       /* per vertex: 1 / |S^-1 d_i| */
+    double kappa;    /* the level's volume factor: (4 pi / 3 / V_icosphere)^(1/3) */
+    gp_mesh3d *mesh; /* the directions d_i = S u_i / |S u_i| and the icosphere's triangles */
+    double *u;       /* 3 per vertex: the icosphere's directions u_i, where the field is summed */
+    double *k;       /* per vertex: kappa |S u_i|, the radius along d_i over the field's */
     double *Y;       /* ncoef rows of nv: Y[k nv + i] = Y_k(u_i) */
     double *rho2;    /* per triangle of the u_i: its squared spherical circumradius */
     uint32_t *edges; /* ne pairs (i, j), i < j */
@@ -113,27 +114,49 @@ void gp_grain3d_basis_destroy(gp_grain3d_basis *b)
     free(b);
 }
 
-/* The directions u_i and factors k_i of the stretch: S^-1 is linear, so it maps great circles
- * to great circles and the u_i triangulate the sphere with the icosphere's triangles. */
-static void basis_stretch(gp_grain3d_basis *b)
+/* The level's volume factor: the unit icosphere's vertices lie on the sphere and its flat
+ * triangles inside it; kappa^3 times its volume is the sphere's. */
+static gp_status basis_kappa(gp_grain3d_basis *b, gp_error *err)
 {
-    const double *d = gp_mesh3d_vertices(b->mesh);
-    double sy = 1.0 / b->elongation, sz = 1.0 / (b->elongation * b->flatness);
-    if (b->elongation == 1.0 && b->flatness == 1.0) { /* the directions themselves, bit for bit */
-        memcpy(b->u, d, 3 * b->nv * sizeof(double));
-        for (size_t i = 0; i < b->nv; i++) b->k[i] = 1.0;
-        return;
-    }
-    for (size_t i = 0; i < b->nv; i++) {
-        double q[3] = {d[3 * i], d[3 * i + 1] * sy, d[3 * i + 2] * sz}, l = norm3(q);
-        b->k[i] = 1.0 / l;
-        for (int j = 0; j < 3; j++) b->u[3 * i + j] = q[j] / l;
-    }
+    gp_mesh3d_mass ms;
+    gp_status st = gp_mesh3d_mass_properties(gp_mesh3d_vertices(b->mesh), b->nv, gp_mesh3d_triangles(b->mesh),
+                                             b->nt, &ms, err);
+    if (st) return st;
+    b->kappa = cbrt(4.0 * G3_PI / 3.0 / ms.volume);
+    return GP_OK;
 }
 
-static void basis_fill(gp_grain3d_basis *b)
+/* The field's directions u_i (the icosphere), the stretched body's d_i = S u_i / |S u_i| and the
+ * factors k_i = kappa |S u_i|: the stretch maps the icosphere's mesh affinely, so a stretched
+ * sphere's mesh is the ellipsoid's with the sphere's own (volume-exact) accuracy. */
+static gp_status basis_stretch(gp_grain3d_basis *b, gp_error *err)
 {
-    basis_stretch(b);
+    const double *u = gp_mesh3d_vertices(b->mesh);
+    memcpy(b->u, u, 3 * b->nv * sizeof(double));
+    if (b->elongation == 1.0 && b->flatness == 1.0) { /* the directions themselves, bit for bit */
+        for (size_t i = 0; i < b->nv; i++) b->k[i] = b->kappa;
+        return GP_OK;
+    }
+    double sy = b->elongation, sz = b->elongation * b->flatness;
+    double *d = malloc(3 * b->nv * sizeof *d);
+    if (!d) return gp_error_set(err, GP_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < b->nv; i++) {
+        double q[3] = {u[3 * i], u[3 * i + 1] * sy, u[3 * i + 2] * sz}, l = norm3(q);
+        b->k[i] = b->kappa * l;
+        for (int j = 0; j < 3; j++) d[3 * i + j] = q[j] / l;
+    }
+    gp_mesh3d *m = gp_mesh3d_create(d, b->nv, gp_mesh3d_triangles(b->mesh), b->nt, err);
+    free(d);
+    if (!m) return err ? err->code : GP_ERR_NOMEM;
+    gp_mesh3d_destroy(b->mesh);
+    b->mesh = m;
+    return GP_OK;
+}
+
+static gp_status basis_fill(gp_grain3d_basis *b, gp_error *err)
+{
+    gp_status st = basis_kappa(b, err);
+    if (st || (st = basis_stretch(b, err))) return st;
     const double *d = b->u;
     const uint32_t *t = gp_mesh3d_triangles(b->mesh);
     double row[GP_GRAIN3D_NCOEF(GP_GRAIN3D_DEGREE_MAX)];
@@ -151,6 +174,7 @@ static void basis_fill(gp_grain3d_basis *b)
                 b->edges[2 * b->ne++ + 1] = v[(k + 1) % 3];
             }
     }
+    return GP_OK;
 }
 
 gp_grain3d_basis *gp_grain3d_basis_create(unsigned level, unsigned degree, gp_error *err)
@@ -180,7 +204,7 @@ gp_grain3d_basis *gp_grain3d_basis_create_ex(unsigned level, unsigned degree, do
     }
     gp_grain3d_basis *b = calloc(1, sizeof *b);
     if (b) {
-        *b = (gp_grain3d_basis){level, degree, nv, nt, 0, nc, elongation, flatness, m, NULL, NULL, NULL, NULL, NULL};
+        *b = (gp_grain3d_basis){level, degree, nv, nt, 0, nc, elongation, flatness, 1.0, m, NULL, NULL, NULL, NULL, NULL};
         b->u = malloc(3 * nv * sizeof(double));
         b->k = malloc(nv * sizeof(double));
         b->Y = malloc(nc * nv * sizeof(double));
@@ -193,11 +217,15 @@ gp_grain3d_basis *gp_grain3d_basis_create_ex(unsigned level, unsigned degree, do
         gp_error_set(err, GP_ERR_NOMEM, "out of memory");
         return NULL;
     }
-    basis_fill(b);
+    if (basis_fill(b, err) != GP_OK) {
+        gp_grain3d_basis_destroy(b);
+        return NULL;
+    }
     return b;
 }
 
 unsigned gp_grain3d_basis_level(const gp_grain3d_basis *b) { return b ? b->level : 0; }
+double gp_grain3d_basis_kappa(const gp_grain3d_basis *b) { return b ? b->kappa : 0; }
 unsigned gp_grain3d_basis_degree(const gp_grain3d_basis *b) { return b ? b->degree : 0; }
 double gp_grain3d_basis_elongation(const gp_grain3d_basis *b) { return b ? b->elongation : 0; }
 double gp_grain3d_basis_flatness(const gp_grain3d_basis *b) { return b ? b->flatness : 0; }
@@ -465,11 +493,10 @@ gp_status gp_grain3d_radii(const gp_grain3d_basis *b, const gp_grain3d_shape *s,
     table_product(b, s, radii);
     if ((st = gp_grain3d_star_check(b, s, radii, err))) return st;
     if (s->elongation == b->elongation && s->flatness == b->flatness) {
-        if (b->elongation != 1.0 || b->flatness != 1.0)
-            for (size_t i = 0; i < b->nv; i++) radii[i] *= b->k[i];
+        for (size_t i = 0; i < b->nv; i++) radii[i] *= b->k[i];
     } else { /* another stretch than the table's: summed direction by direction */
         const double *d = gp_mesh3d_vertices(b->mesh);
-        for (size_t i = 0; i < b->nv; i++) radii[i] = gp_grain3d_radius(s, d + 3 * i);
+        for (size_t i = 0; i < b->nv; i++) radii[i] = b->kappa * gp_grain3d_radius(s, d + 3 * i);
     }
     return GP_OK;
 }

@@ -15,9 +15,9 @@
  * The statistics views read the summary only. The geometry views read the grains and cells one
  * at a time from the result (their items' element texts, parsed one by one) and draw them
  * whole when they open: what they hold is the picture, whose outlines are decimated to half a
- * pixel, not the result. The grains' directions are the icosphere of stats.mesh.level, made
- * again (gp_mesh3d_icosphere: the same vertices, in the same order, as the result's
- * "icosphere"). */
+ * pixel, not the result. The grains' directions are made again from stats.mesh.level and
+ * stats.shape's stretch (gp_grain3d_basis_create_ex: the same vertices, in the same order, as the
+ * result's "icosphere"). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -530,7 +530,7 @@ static double ring_area(const double *xy, size_t n)
 /* the shared icosphere (stats.mesh.level) and its edges: edge e joins ev[2 e], ev[2 e + 1];
  * triangle t has the edges te[3 t .. 3 t + 2] (its sides ab, bc, ca) */
 typedef struct mesh {
-    gp_mesh3d *m;
+    gp_grain3d_basis *b; /* degree 0: the directions and triangles only */
     const double *dir;
     const uint32_t *tri;
     size_t nv, nt, ne;
@@ -539,7 +539,7 @@ typedef struct mesh {
 
 static void mesh_free(mesh *m)
 {
-    gp_mesh3d_destroy(m->m);
+    gp_grain3d_basis_destroy(m->b);
     free(m->ev);
     free(m->te);
     memset(m, 0, sizeof *m);
@@ -560,15 +560,18 @@ static int cmp_dedge(const void *x, const void *y)
 static int mesh_init(mesh *m, const json_t *res)
 {
     memset(m, 0, sizeof *m);
-    double level = svg_plot_jnum(
-        json_object_get(json_object_get(json_object_get(res, "stats"), "mesh"), "level"), NAN);
+    const json_t *st = json_object_get(res, "stats"), *shape = json_object_get(st, "shape");
+    double level = svg_plot_jnum(json_object_get(json_object_get(st, "mesh"), "level"), NAN);
+    double el = svg_plot_jnum(json_object_get(shape, "elongation"), 1);
+    double fl = svg_plot_jnum(json_object_get(shape, "flatness"), 1);
     if (!(level >= 0 && level <= GP_MESH3D_ICOSPHERE_LEVEL_MAX)) return -1;
     gp_error e;
-    if (!(m->m = gp_mesh3d_icosphere((unsigned)level, &e))) return -1;
-    m->nv = gp_mesh3d_vertex_count(m->m);
-    m->nt = gp_mesh3d_triangle_count(m->m);
-    m->dir = gp_mesh3d_vertices(m->m);
-    m->tri = gp_mesh3d_triangles(m->m);
+    if (!(m->b = gp_grain3d_basis_create_ex((unsigned)level, 0, el, fl, &e))) return -1;
+    const gp_mesh3d *g = gp_grain3d_basis_mesh(m->b);
+    m->nv = gp_mesh3d_vertex_count(g);
+    m->nt = gp_mesh3d_triangle_count(g);
+    m->dir = gp_mesh3d_vertices(g);
+    m->tri = gp_mesh3d_triangles(g);
     dedge *d = malloc(3 * m->nt * sizeof *d);
     m->ev = malloc(3 * m->nt * sizeof *m->ev);
     m->te = malloc(3 * m->nt * sizeof *m->te);
@@ -1030,10 +1033,7 @@ int svg_fv3d_projection(gp_svg *g, const gp_svg_input *in, const gp_svg_options 
         return -1;
     }
     gp_error e;
-    gp_grain3d_basis *basis = gp_grain3d_basis_create(
-        (unsigned)svg_plot_jnum(json_object_get(json_object_get(json_object_get(res, "stats"),
-                                                                "mesh"), "level"), 0),
-        0, &e);
+    const gp_grain3d_basis *basis = m.b;
     grain3 gr = {0};
     gr.r = malloc(m.nv * sizeof *gr.r);
     gp_vec2 *ct = malloc(PROJ_ANGLES * sizeof *ct);
@@ -1100,7 +1100,6 @@ int svg_fv3d_projection(gp_svg *g, const gp_svg_input *in, const gp_svg_options 
     free(gr.r);
     free(ct);
     free(xy);
-    gp_grain3d_basis_destroy(basis);
     mesh_free(&m);
     gp_svg_items_close(it);
     return rc ? -1 : 0;
