@@ -235,7 +235,13 @@ done:
 }
 
 /* Volume, first and second moments of the solid bounded by the triangles, relative to o
- * (tetrahedra from o; s2 = xx yy zz xy xz yz). */
+ * (tetrahedra from o; s2 = xx yy zz xy xz yz).
+ * Why not gp_mesh3d_mass_properties, the same integral: it refuses clockwise meshes, which
+ * gp_clump3d_mesh_body measures with their signs and gp_clump3d_build refuses by name, and it
+ * sums about the vertices' mean, so its last bits differ (to 1e-14 on the test grains). The
+ * principal frame comes from these moments, and a last-bit change turns the frame of a grain
+ * with two equal moments (a needle, a torus: a different clump) and moves the spheres of the
+ * others by rounding (the lammps, liggghts and yade exports of a fv3d pack change). */
 static void mesh_moments(const double *v, const uint32_t *tri, size_t nt, const double o[3],
                          double *vol, double s1[3], double s2[6])
 {

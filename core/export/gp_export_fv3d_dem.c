@@ -18,8 +18,8 @@
  *   Why a tar and an infile: LAMMPS reads atoms from a data file only, and a rigid body's mass
  *   and inertia from an infile only. Both members are sized before their tar headers by
  *   formatting every line once: when the pack is made (its fv3d block), else at the first read
- *   (as lammps-relax, whose tar writing this repeats); a member that differs from its header
- *   fails the download.
+ *   (as lammps-relax, whose ustar writer, gp_export_tar.c, this shares); a member that differs
+ *   from its header fails the download.
  * liggghts: LIGGGHTS 3.8 input lines: per grain k (type k + 1) a fix particletemplate/multisphere
  *   gpt<k+1> with its spheres relative to its centroid in the specimen's axes (inserted with
  *   "orientation template" a grain keeps its orientation), "mass" = rho V, "inertia_tensor" =
@@ -38,12 +38,8 @@
 #include "gp_export_internal.h"
 
 #include <math.h>
-#include <stdio.h>
-#include <string.h>
 
 #define DIR "lammps-grains/"
-#define TAR_BLOCK 512
-#define TAR_MAX_SIZE 077777777777ull /* 11 octal digits */
 #define TEMPLATE_SEED 15485863       /* LIGGGHTS asks primes above 10,000 */
 #define DIST_SEED 15485867
 #define TEMPLATE_NTRY 1000           /* the least fix particletemplate/multisphere takes */
@@ -67,35 +63,6 @@ static int next_grain_with_spheres(gp_export *e, int first)
         if (e->x3.grain.sphere_count) return 0;
     }
     return 1;
-}
-
-/* ------------------------------------------------------------------ lammps: tar */
-
-/* A ustar header block for a file (type '0') or a folder ('5') of size bytes; owner, group and
- * time 0, so that a job gives the same bytes at every download. */
-static void tar_header(unsigned char h[TAR_BLOCK], const char *name, char type, uint64_t size)
-{
-    memset(h, 0, TAR_BLOCK);
-    snprintf((char *)h, 100, "%s", name);
-    memcpy(h + 100, type == '5' ? "0000755" : "0000644", 8);
-    memcpy(h + 108, "0000000", 8);
-    memcpy(h + 116, "0000000", 8);
-    snprintf((char *)h + 124, 12, "%011llo", (unsigned long long)size);
-    memcpy(h + 136, "00000000000", 12);
-    memset(h + 148, ' ', 8); /* the checksum counts its own field as spaces */
-    h[156] = (unsigned char)type;
-    memcpy(h + 257, "ustar", 6);
-    memcpy(h + 263, "00", 2);
-    unsigned sum = 0;
-    for (int k = 0; k < TAR_BLOCK; k++) sum += h[k];
-    snprintf((char *)h + 148, 7, "%06o", sum & 0777777u);
-    h[155] = ' ';
-}
-
-static int tar_pad(gp_export *e, uint64_t size)
-{
-    size_t r = (size_t)(size % TAR_BLOCK);
-    return r ? gp_xw_bytes(e, NULL, TAR_BLOCK - r) : 0;
 }
 
 /* ------------------------------------------------------------------ lammps: the files */
@@ -268,27 +235,17 @@ static int write_script(gp_export *e)
     gp_x3 *x = &e->x3;
     if ((!x->data_bytes || !x->rigid_bytes) && gp_export_fv3d_count(e, &x->data_bytes, &x->rigid_bytes))
         return -1;
-    if (x->data_bytes > TAR_MAX_SIZE || x->rigid_bytes > TAR_MAX_SIZE)
+    if (x->data_bytes > GP_XW_TAR_MAX_SIZE || x->rigid_bytes > GP_XW_TAR_MAX_SIZE)
         return gp_error_set(&e->err, GP_ERR_INVALID,
                             "lammps: a data file of %llu bytes is over the 8 GiB of a tar member",
                             (unsigned long long)x->data_bytes), -1;
-    unsigned char h[TAR_BLOCK];
-    tar_header(h, DIR, '5', 0);
-    if (gp_xw_bytes(e, h, TAR_BLOCK) || gp_xw_bytes(e, NULL, TAR_BLOCK)) return -1;
-    size_t start = e->len;
-    if (script(e)) return -1;
-    uint64_t n = e->len - start;
-    tar_header(h, DIR "grains.in", '0', n);
-    memcpy(e->buf + start - TAR_BLOCK, h, TAR_BLOCK);
-    return tar_pad(e, n);
+    return gp_xw_tar_header(e, DIR, '5', 0) || gp_xw_tar_file(e, DIR "grains.in", script) ? -1 : 0;
 }
 
 /* a member's tar header and its first record (its header lines) */
 static int member_head(gp_export *e, const char *name, uint64_t bytes, int (*head)(gp_export *))
 {
-    unsigned char h[TAR_BLOCK];
-    tar_header(h, name, '0', bytes);
-    if (gp_xw_bytes(e, h, TAR_BLOCK)) return -1;
+    if (gp_xw_tar_header(e, name, '0', bytes)) return -1;
     size_t at = e->len;
     if (head(e)) return -1;
     e->x3.member = bytes;
@@ -314,7 +271,7 @@ int gp_export_step_fv3d_lammps(gp_export *e)
         if (++e->index >= e->info.nitems) e->section = L_DATA_HEAD;
         return 0;
     case L_DATA_HEAD:
-        if (member_complete(e, "grains.rigid") || tar_pad(e, x->member)) return -1;
+        if (member_complete(e, "grains.rigid") || gp_xw_tar_pad(e, x->member)) return -1;
         if (member_head(e, DIR "grains.data", x->data_bytes, data_head)) return -1;
         e->index = 0;
         rc = next_grain_with_spheres(e, 1);
@@ -332,8 +289,7 @@ int gp_export_step_fv3d_lammps(gp_export *e)
         return 0;
     }
     default: /* the data file's padding, then the end of the archive: two zero blocks */
-        return member_complete(e, "grains.data") || tar_pad(e, x->member) ||
-                       gp_xw_bytes(e, NULL, 2 * TAR_BLOCK)
+        return member_complete(e, "grains.data") || gp_xw_tar_pad(e, x->member) || gp_xw_tar_end(e)
                    ? -1
                    : 1;
     }

@@ -82,6 +82,21 @@ int gp_xw_printf(gp_export *e, const char *fmt, ...) __attribute__((format(print
 /* Appends n raw bytes (p == NULL: n zero bytes); -1 on out of memory. */
 int gp_xw_bytes(gp_export *e, const void *p, size_t n);
 
+/* POSIX ustar members for the formats that are a tar (gp_export_tar.c); each returns 0, or -1
+ * on out of memory:
+ *   header  the header block of a file (type '0') or a folder ('5', size 0) of size bytes, with
+ *           owner, group and time 0 (a job gives the same bytes at every download);
+ *   file    a file whose size is known once it is written: a header block, the file as write
+ *           appends it (its -1 passed on), the header filled in with its size, then the padding;
+ *   pad     the zero bytes that fill a member of size bytes up to whole blocks;
+ *   end     the two zero blocks that end an archive. */
+#define GP_XW_TAR_BLOCK 512
+#define GP_XW_TAR_MAX_SIZE 077777777777ull /* a member's size: 11 octal digits */
+int gp_xw_tar_header(gp_export *e, const char *name, char type, uint64_t size);
+int gp_xw_tar_file(gp_export *e, const char *name, int (*write)(gp_export *e));
+int gp_xw_tar_pad(gp_export *e, uint64_t size);
+int gp_xw_tar_end(gp_export *e);
+
 /* Record readers (0 on success, -1 with e->err set). */
 int gp_xr_sphere(gp_export *e, uint64_t i, double q[4]);
 int gp_xr_grain(gp_export *e, uint64_t g, gp_export_grain *out);

@@ -30,7 +30,6 @@
 
 #include <math.h>
 #include <stdio.h>
-#include <string.h>
 
 #define DIR "lammps-relax/"
 #define MAX_TYPES 32     /* size classes: pair_coeff lines grow as types^2 / 2 */
@@ -38,39 +37,8 @@
 #define SKIN 0.2         /* neighbour skin, times the smallest radius */
 #define MAX_STEPS 1000000
 #define EVERY 100        /* S_c is looked at every this many steps (gp_specimen3d's CHUNK) */
-#define TAR_BLOCK 512
-#define TAR_MAX_SIZE 077777777777ull /* 11 octal digits */
 
 enum { SEC_SCRIPT = 0, SEC_DATA_HEAD, SEC_ATOMS, SEC_END };
-
-/* ------------------------------------------------------------------ tar */
-
-/* A ustar header block for a file (type '0') or a folder ('5') of size bytes. Owner, group
- * and time are 0: the same job gives the same bytes at every download. */
-static void tar_header(unsigned char h[TAR_BLOCK], const char *name, char type, uint64_t size)
-{
-    memset(h, 0, TAR_BLOCK);
-    snprintf((char *)h, 100, "%s", name);
-    memcpy(h + 100, type == '5' ? "0000755" : "0000644", 8);
-    memcpy(h + 108, "0000000", 8);
-    memcpy(h + 116, "0000000", 8);
-    snprintf((char *)h + 124, 12, "%011llo", (unsigned long long)size);
-    memcpy(h + 136, "00000000000", 12);
-    memset(h + 148, ' ', 8); /* the checksum counts its own field as spaces */
-    h[156] = (unsigned char)type;
-    memcpy(h + 257, "ustar", 6);
-    memcpy(h + 263, "00", 2);
-    unsigned sum = 0;
-    for (int k = 0; k < TAR_BLOCK; k++) sum += h[k];
-    snprintf((char *)h + 148, 7, "%06o", sum & 0777777u);
-    h[155] = ' ';
-}
-
-static int tar_pad(gp_export *e, uint64_t size)
-{
-    size_t r = (size_t)(size % TAR_BLOCK);
-    return r ? gp_xw_bytes(e, NULL, TAR_BLOCK - r) : 0;
-}
 
 /* ------------------------------------------------------------------ size classes */
 
@@ -390,6 +358,15 @@ static int script_run(gp_export *e)
 
 /* ------------------------------------------------------------------ the stream */
 
+/* relax.in, all of it */
+static int script(gp_export *e)
+{
+    return script_head(e) || script_model(e) || script_forces(e) || script_measures(e) ||
+                   script_run(e)
+               ? -1
+               : 0;
+}
+
 /* section SEC_SCRIPT: the folder, and relax.in with its header (written in front of it once
  * its size is known); the data file is sized first, while the staging buffer is empty */
 static int write_script(gp_export *e)
@@ -397,29 +374,17 @@ static int write_script(gp_export *e)
     size_classes(e);
     uint64_t bytes = e->relax_bytes;
     if (!bytes && data_size(e, &bytes)) return -1;
-    if (bytes > TAR_MAX_SIZE)
+    if (bytes > GP_XW_TAR_MAX_SIZE)
         return gp_error_set(&e->err, GP_ERR_INVALID,
                             "lammps-relax: a data file of %llu bytes is over the 8 GiB of a tar "
                             "member", (unsigned long long)bytes), -1;
     e->file_bytes = bytes;
-    unsigned char h[TAR_BLOCK];
-    tar_header(h, DIR, '5', 0);
-    if (gp_xw_bytes(e, h, TAR_BLOCK) || gp_xw_bytes(e, NULL, TAR_BLOCK)) return -1;
-    size_t start = e->len;
-    if (script_head(e) || script_model(e) || script_forces(e) || script_measures(e) ||
-        script_run(e))
-        return -1;
-    uint64_t n = e->len - start;
-    tar_header(h, DIR "relax.in", '0', n);
-    memcpy(e->buf + start - TAR_BLOCK, h, TAR_BLOCK);
-    return tar_pad(e, n);
+    return gp_xw_tar_header(e, DIR, '5', 0) || gp_xw_tar_file(e, DIR "relax.in", script) ? -1 : 0;
 }
 
 static int write_data_head(gp_export *e)
 {
-    unsigned char h[TAR_BLOCK];
-    tar_header(h, DIR "spheres.data", '0', e->file_bytes);
-    if (gp_xw_bytes(e, h, TAR_BLOCK)) return -1;
+    if (gp_xw_tar_header(e, DIR "spheres.data", '0', e->file_bytes)) return -1;
     size_t at = e->len;
     if (data_head(e)) return -1;
     e->written = e->len - at;
@@ -454,8 +419,6 @@ int gp_export_step_lammps_relax(gp_export *e)
         return 0;
     }
     default: /* the data file's padding, then the end of the archive: two zero blocks */
-        return data_complete(e) || tar_pad(e, e->file_bytes) || gp_xw_bytes(e, NULL, 2 * TAR_BLOCK)
-                   ? -1
-                   : 1;
+        return data_complete(e) || gp_xw_tar_pad(e, e->file_bytes) || gp_xw_tar_end(e) ? -1 : 1;
     }
 }

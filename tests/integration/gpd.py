@@ -24,6 +24,7 @@ import glob
 import json
 import os
 import pwd
+import re
 import select
 import shutil
 import signal
@@ -72,6 +73,9 @@ SMALL_3D = {
 # Latency limits are multiplied by this (tests/run.sh sets GPD_TEST_TIME_SCALE=2 for its ASan
 # pass; set 5 for a TSan build, which runs the core several times slower).
 TIME_SCALE = float(os.environ.get("GPD_TEST_TIME_SCALE", "1"))
+
+# How long one run of a program the exports are loaded into (LAMMPS, YADE, ...) may take.
+PROGRAM_TIMEOUT = 300 * TIME_SCALE
 
 DB_MODE = os.environ.get("GP_TEST_DB", "sqlite")
 PG = DB_MODE == "postgresql"
@@ -450,6 +454,24 @@ def need(binary, package):
             "`%s` is not on PATH: install the Debian package `%s` (bash deploy/install-deps.sh "
             "--test installs it; CI does). This test never skips." % (binary, package))
     return path
+
+
+def run_program(cmd, cwd, what):
+    """Runs cmd in cwd (one OpenMP thread) and returns its stdout and stderr; a failure, named
+    by what, when it exits non-zero, prints a line starting with ERROR or takes longer than
+    PROGRAM_TIMEOUT."""
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    t0 = time.time()
+    try:
+        p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=env,
+                           timeout=PROGRAM_TIMEOUT)
+    except subprocess.TimeoutExpired as e:
+        raise AssertionError("%s did not finish in %ds: %s" % (what, PROGRAM_TIMEOUT, cmd)) from e
+    out = p.stdout + p.stderr
+    if p.returncode != 0 or re.search(r"^ERROR", out, re.M):
+        raise AssertionError("%s failed (exit %d): %s\n%s" % (what, p.returncode, cmd, out[-4000:]))
+    print("    %s: %.2fs" % (what, time.time() - t0), flush=True)
+    return out
 
 
 def check_error_body(status, body, code, pointer=None):

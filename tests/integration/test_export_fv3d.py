@@ -19,11 +19,9 @@ import json
 import math
 import os
 import re
-import subprocess
 import sys
 import tarfile
 import tempfile
-import time
 import atexit
 import shutil
 
@@ -32,7 +30,6 @@ import gpd  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 VTK_PYTHON = os.environ.get("GPD_VTK_PYTHON", "/usr/bin/python3")
-PROGRAM_TIMEOUT = 300 * gpd.TIME_SCALE
 NGRAINS = 30
 
 # tolerances: masses and centres pass through %.17g text and the programs' own sums; inertia
@@ -53,21 +50,6 @@ def writer_path():
     return os.path.join(build, "tests", "test_export_fv3d")
 
 
-def run_program(cmd, cwd, what):
-    env = dict(os.environ, OMP_NUM_THREADS="1")
-    t0 = time.time()
-    try:
-        p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=env,
-                           timeout=PROGRAM_TIMEOUT)
-    except subprocess.TimeoutExpired as e:
-        raise AssertionError("%s did not finish in %ds: %s" % (what, PROGRAM_TIMEOUT, cmd)) from e
-    out = p.stdout + p.stderr
-    if p.returncode != 0 or re.search(r"^ERROR", out, re.M):
-        raise AssertionError("%s failed (exit %d): %s\n%s" % (what, p.returncode, cmd, out[-4000:]))
-    print("    %s: %.2fs" % (what, time.time() - t0), flush=True)
-    return out
-
-
 class Fixture:
     """The specimen's files and values, written once."""
 
@@ -77,7 +59,8 @@ class Fixture:
         w = writer_path()
         if not os.access(w, os.X_OK):
             raise AssertionError("the writer %s is missing: build the tests (test_export_fv3d)" % w)
-        run_program([w, "--write", self.dir, str(NGRAINS)], self.dir, "test_export_fv3d --write")
+        gpd.run_program([w, "--write", self.dir, str(NGRAINS)], self.dir,
+                        "test_export_fv3d --write")
         with open(os.path.join(self.dir, "fv3d.json")) as f:
             self.spec = json.load(f)
         self.grains = self.spec["grains"]
@@ -192,7 +175,7 @@ def test_lammps(fx):
                          "lammps-grains/grains.data"], names
         t.extractall(fx.dir)
     d = fx.path("lammps-grains")
-    out = run_program(["lmp", "-in", "grains.in", "-log", "none"], d, "LAMMPS grains.in")
+    out = gpd.run_program(["lmp", "-in", "grains.in", "-log", "none"], d, "LAMMPS grains.in")
     rb = re.search(r"^\s*(\d+) rigid bodies with (\d+) atoms", out, re.M)
     assert rb, out[-3000:]
     assert (int(rb.group(1)), int(rb.group(2))) == (NGRAINS, fx.spec["spheres"]), rb.group(0)
@@ -206,7 +189,7 @@ def test_lammps(fx):
                 "dump bodies all local 1 bodies.dump %s\n"
                 "dump_modify bodies format float %%.17g\n"
                 "run 0\n" % cols)
-    run_program(["lmp", "-in", "bodies.in", "-log", "none"], d, "LAMMPS bodies")
+    gpd.run_program(["lmp", "-in", "bodies.in", "-log", "none"], d, "LAMMPS bodies")
     _, rows = dump_local(os.path.join(d, "bodies.dump"))
     bodies = {}
     for r in rows:
@@ -272,7 +255,7 @@ def test_liggghts(fx):
     os.makedirs(d, exist_ok=True)
     with open(os.path.join(d, "in.bodies"), "w") as f:
         f.write("\n".join(lines) + "\n")
-    out = run_program(["liggghts", "-in", "in.bodies", "-log", "none"], d, "LIGGGHTS")
+    out = gpd.run_program(["liggghts", "-in", "in.bodies", "-log", "none"], d, "LIGGGHTS")
     inserted = re.findall(r"inserted (\d+) particle templates", out)
     assert sum(int(n) for n in inserted) == NGRAINS, inserted
     _, rows = dump_local(os.path.join(d, "bodies.dump"))
@@ -338,7 +321,8 @@ def test_yade(fx):
     with open(script, "w") as f:
         f.write(YADE_SCRIPT % {"rho": fx.rho})
     out_json = fx.path("yade.json")
-    run_program(["yade", "-n", "-x", script, fx.path("fv3d-yade.txt"), out_json], fx.dir, "YADE")
+    gpd.run_program(["yade", "-n", "-x", script, fx.path("fv3d-yade.txt"), out_json], fx.dir,
+                    "YADE")
     with open(out_json) as f:
         rep = json.load(f)
     assert rep["clumps"] == NGRAINS and rep["spheres"] == fx.spec["spheres"], rep["clumps"]
@@ -398,8 +382,8 @@ def test_vtk(fx):
     STL points in 32-bit floats: to 1e-5)."""
     need_vtk()
     out_json = fx.path("vtk.json")
-    run_program([VTK_PYTHON, os.path.join(HERE, "export_check_vtk.py"), out_json, fx.path("fv3d.vtk")],
-                fx.dir, "VTK reader")
+    gpd.run_program([VTK_PYTHON, os.path.join(HERE, "export_check_vtk.py"), out_json,
+                     fx.path("fv3d.vtk")], fx.dir, "VTK reader")
     with open(out_json) as f:
         r = json.load(f)[0]
     assert r["errors"] == [], r["errors"]
@@ -427,8 +411,8 @@ def test_vtk(fx):
     script = fx.path("stl_check.py")
     with open(script, "w") as f:
         f.write(STL_SCRIPT)
-    run_program([VTK_PYTHON, script, fx.path("fv3d.stl"), fx.path("stl.json")], fx.dir,
-                "VTK STL reader")
+    gpd.run_program([VTK_PYTHON, script, fx.path("fv3d.stl"), fx.path("stl.json")], fx.dir,
+                    "VTK STL reader")
     with open(fx.path("stl.json")) as f:
         s = json.load(f)
     print("    STL: %d solids, %d facets, enclosed volume %.9g (grains %.9g)"

@@ -25,7 +25,6 @@ import gpd  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 VTK_PYTHON = os.environ.get("GPD_VTK_PYTHON", "/usr/bin/python3")
-PROGRAM_TIMEOUT = 300 * gpd.TIME_SCALE
 
 FORMATS_3D = ["lammps", "liggghts", "yade", "vtk", "csv"]
 FORMATS_2D = ["lammps", "yade", "vtk", "csv"]
@@ -178,21 +177,6 @@ def need_vtk():
                              % (VTK_PYTHON, p.stderr[-2000:]))
 
 
-def run_program(cmd, cwd, what):
-    env = dict(os.environ, OMP_NUM_THREADS="1")
-    t0 = time.time()
-    try:
-        p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=env,
-                           timeout=PROGRAM_TIMEOUT)
-    except subprocess.TimeoutExpired as e:
-        raise AssertionError("%s did not finish in %ds: %s" % (what, PROGRAM_TIMEOUT, cmd)) from e
-    out = p.stdout + p.stderr
-    if p.returncode != 0 or re.search(r"^ERROR", out, re.M):
-        raise AssertionError("%s failed (exit %d): %s\n%s" % (what, p.returncode, cmd, out[-4000:]))
-    print("    %s: %.2fs" % (what, time.time() - t0), flush=True)
-    return out
-
-
 def thermo(out, what):
     """The first thermo line after a 'Step ...' header, as {column: float}."""
     lines = out.splitlines()
@@ -222,7 +206,7 @@ def run_lammps_3d(fx, binary, jid, fmt, what):
     inp = data + ".in"
     with open(inp, "w") as f:
         f.write(script)
-    out = run_program([binary, "-in", os.path.basename(inp), "-log", "none"], fx.dir, what)
+    out = gpd.run_program([binary, "-in", os.path.basename(inp), "-log", "none"], fx.dir, what)
     t = thermo(out, what)
     n = len(fx.spheres(jid))
     assert int(t["Atoms"]) == n, "%s: %s atoms after read_data/run 0, the result has %d" % (
@@ -333,8 +317,8 @@ def test_lammps_2d(fx):
         with open(data + ".in", "w") as f:
             f.write(script)
         what = "LAMMPS 2D %s" % jid[:8]
-        out = run_program(["lmp", "-in", os.path.basename(data) + ".in", "-log", "none"],
-                          fx.dir, what)
+        out = gpd.run_program(["lmp", "-in", os.path.basename(data) + ".in", "-log", "none"],
+                              fx.dir, what)
         grains = fx.grains(jid)
         ndiscs = sum(len(g["discs"]) for g in grains)
         rb = re.search(r"^\s*(\d+) rigid bodies with (\d+) atoms", out, re.M)
@@ -358,7 +342,7 @@ def test_yade(fx):
     out_json = os.path.join(fx.dir, "yade.json")
     args = ["3d:" + fx.files[fx.j3, "yade"], "3d:" + fx.files[fx.jt, "yade"],
             "2d:" + fx.files[fx.j2, "yade"], "2d:" + fx.files[fx.jc, "yade"]]
-    out = run_program(["yade", "-n", "-x", script, out_json] + args, fx.dir, "YADE")
+    out = gpd.run_program(["yade", "-n", "-x", script, out_json] + args, fx.dir, "YADE")
     assert os.path.exists(out_json), "YADE wrote no report:\n" + out[-4000:]
     with open(out_json) as f:
         rep = json.load(f)
@@ -382,8 +366,8 @@ def test_yade(fx):
 def run_vtk(fx, paths):
     need_vtk()
     out_json = os.path.join(fx.dir, "vtk.json")
-    run_program([VTK_PYTHON, os.path.join(HERE, "export_check_vtk.py"), out_json] + paths,
-                fx.dir, "VTK reader")
+    gpd.run_program([VTK_PYTHON, os.path.join(HERE, "export_check_vtk.py"), out_json] + paths,
+                    fx.dir, "VTK reader")
     with open(out_json) as f:
         return json.load(f)
 
