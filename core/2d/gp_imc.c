@@ -51,6 +51,16 @@
  * tessellations at N = 500 and 2,000, and the orientation KS about 0.2 (bench_fit2d; the
  * figures in docs/design/imc.md). */
 #define GP_IMC_AD_THRESHOLD 0.05
+/* the KS goals a run at the default threshold stops on (gp_imc.h "Stopping"): fractions of the
+ * 5 % critical value 1.36 / sqrt(N); the threshold tightened by 0.7 while they are missed, down
+ * to 0.25 of the params' (at 0.05: 0.035, 0.0245, 0.01715), within twice the steps the params'
+ * took (ks_budget_spent) */
+#define GP_IMC_KS_CRIT 1.36
+#define GP_IMC_KS_GOAL_SIZE 0.15
+#define GP_IMC_KS_GOAL_ORIENT 0.3
+#define GP_IMC_KS_TIGHTEN 0.7
+#define GP_IMC_KS_TIGHTEST 0.25
+#define GP_IMC_KS_EXTRA 2
 /* the orientations' excess counts half in the error and the descent (gp_imc.h "Objective") */
 #define GP_IMC_ORIENT_WEIGHT 0.5
 
@@ -63,6 +73,7 @@ void gp_imc_params_defaults(gp_imc_params *p)
     p->anisotropy = 1.0;
     p->error_kind = GP_IMC_ERROR_AD;
     p->threshold = GP_IMC_AD_THRESHOLD;
+    p->ks_goals = 1;
     p->max_steps = 1000000;
     p->init = 0;
     p->seed = 1;
@@ -1025,6 +1036,8 @@ typedef struct run_ctx {
     run_out ro;
     double best;
     long best_step;
+    double thr;                /* the threshold in force: p->threshold, tightened by ks_short */
+    long first_at;             /* the step the params' threshold was first reached at (or -1) */
 } run_ctx;
 
 static void round_fn(void *ctx, int tid)
@@ -1063,14 +1076,65 @@ static void run_round(run_ctx *C)
         gp_team_run(C->team, round_fn, C);
 }
 
-/* The checks each step starts with, in step order; 1 when the run stops here (ro.why). */
+/* The KS distance of the n values u (sorted here) to the uniform law. */
+static double ks_uniform(double *u, size_t n)
+{
+    qsort(u, n, sizeof *u, cmp_double);
+    double d = 0.0;
+    for (size_t i = 0; i < n; i++) d = fmax(d, fmax((i + 1.0) / n - u[i], u[i] - (double)i / n));
+    return d;
+}
+
+/* 1 when the run is at its threshold but the cells' KS distances miss the goals that threshold
+ * stands for (gp_imc.h "Stopping"); 0 when they meet them, when the params ask for no check, or
+ * when it cannot be made (out of memory: the run stops as it would without it). */
+static int ks_short(const imc_state *S, const gp_imc_params *p)
+{
+    if (!p->ks_goals || S->kind != GP_IMC_ERROR_AD || S->n < 2) return 0;
+    double *u = malloc(S->n * sizeof *u), crit = GP_IMC_KS_CRIT / sqrt((double)S->n);
+    if (!u) return 0;
+    for (size_t i = 0; i < S->n; i++) u[i] = exp(S->adv[i].sg);
+    int short_ = ks_uniform(u, S->n) > GP_IMC_KS_GOAL_SIZE * crit;
+    for (size_t i = 0; !short_ && i < S->n; i++) u[i] = S->adv[i].tk;
+    short_ = short_ || ks_uniform(u, S->n) > GP_IMC_KS_GOAL_ORIENT * crit;
+    free(u);
+    return short_;
+}
+
+/* At the threshold in force: 1 to stop; 0 to go on to a tighter one, while the KS goals are
+ * missed and the threshold has room (down to GP_IMC_KS_TIGHTEST of the params'). */
+static int at_threshold(run_ctx *C)
+{
+    if (C->first_at < 0) C->first_at = C->ro.steps;
+    if (C->thr * GP_IMC_KS_TIGHTEN < C->p->threshold * GP_IMC_KS_TIGHTEST || !ks_short(C->S, C->p)) return 1;
+    C->thr *= GP_IMC_KS_TIGHTEN;
+    return 0;
+}
+
+/* Past the params' threshold the KS goals get GP_IMC_KS_EXTRA times the steps it took to get
+ * there, at least one sweep: a tightened threshold can be out of reach, and the stall window
+ * alone would let such a run go on for long. */
+static int ks_budget_spent(const run_ctx *C)
+{
+    if (C->first_at < 0) return 0;
+    long extra = GP_IMC_KS_EXTRA * C->first_at, sweep = (long)C->S->n;
+    return C->ro.steps - C->first_at > (extra > sweep ? extra : sweep);
+}
+
+/* The checks each step starts with, in step order; 1 when the run stops here (ro.why). Past
+ * the params' threshold (a tightened one in force) the run stops for "threshold" whatever
+ * ends it. */
 static int stop_before_step(run_ctx *C)
 {
     run_out *ro = &C->ro;
     ro->why = GP_IMC_STOP_THRESHOLD;
-    if (C->cur.error <= C->p->threshold) return 1;
+    if (C->cur.error <= C->thr && at_threshold(C)) return 1;
+    if (ks_budget_spent(C) && C->cur.error <= C->p->threshold) return 1;
     ro->why = stop_check(C->S, C->p, &C->cur, ro, &C->best, &C->best_step);
-    if (ro->why != GP_IMC_STOP_THRESHOLD) return 1;
+    if (ro->why != GP_IMC_STOP_THRESHOLD) {
+        if (C->cur.error <= C->p->threshold && ro->why != GP_IMC_STOP_SINGLE_CELL) ro->why = GP_IMC_STOP_THRESHOLD;
+        return 1;
+    }
     if ((ro->steps % GP_IMC_CANCEL_EVERY) == 0 && cancel_raised(C->cancel)) {
         ro->why = GP_IMC_STOP_CANCELLED;
         return 1;
@@ -1352,7 +1416,7 @@ static gp_status run_steps(imc_state *S, const gp_imc_params *p, gp_voronoi *v, 
                            objective *cur, run_out *ro, gp_error *err)
 {
     run_ctx C = {.S = S, .p = p, .progress = progress, .user = user, .cancel = cancel, .cur = *cur,
-                 .ro = *ro};
+                 .ro = *ro, .thr = p->threshold, .first_at = -1};
     gp_status st = lanes_init(&C, v, J, err);
     if (st == GP_ERR_CANCELLED) {
         C.ro.why = GP_IMC_STOP_CANCELLED;

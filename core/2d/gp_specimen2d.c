@@ -878,6 +878,7 @@ static gp_status run_imc(build_ctx *b, const gp_vec2 *seeds, gp_error *err)
     ip.anisotropy = spec->anisotropy;
     ip.error_kind = (int)spec->imc_error;
     ip.threshold = spec->imc_threshold;
+    ip.ks_goals = spec->imc_threshold == gp_imc_default_threshold(GP_IMC_ERROR_AD); /* the default's goals only */
     ip.max_steps = spec->imc_max_steps - out->imc_steps; /* one budget for both runs */
     ip.init = spec->imc_init == GP_INIT_HALTON ? 1 : 0;
     ip.classes_size = spec->imc_classes;

@@ -244,6 +244,39 @@ static void walls_untie(size_t n, uint64_t seed)
     gp_imc_report_free(&r);
 }
 
+/* The default stopping rule asks the KS goals the threshold stands for (gp_imc.h "Stopping"):
+ * over seeds 1 .. nseeds, runs without the check leave some cells' area or orientation KS
+ * (recomputed here from the cells) beyond 0.15 / 0.3 of the critical value; with it none is. */
+static void ks_goals(size_t n, double cov, double aniso, int nseeds)
+{
+    double crit = 1.36 / sqrt((double)n), worst[2][2] = {{0, 0}, {0, 0}};
+    long steps[2] = {0, 0};
+    for (int g = 0; g < 2; g++)
+        for (int seed = 1; seed <= nseeds; seed++) {
+            gp_imc_params p;
+            gp_imc_params_defaults(&p);
+            p.cov = cov;
+            p.anisotropy = aniso;
+            p.seed = (uint64_t)seed;
+            p.ks_goals = g;
+            gp_voronoi *v = NULL;
+            gp_imc_report r;
+            CHECK(run(SQ, 4, NULL, NULL, 0, n, &p, &v, &r, g ? "  with the KS check" : "  without") == GP_OK);
+            CHECK(r.stop_reason == GP_IMC_STOP_THRESHOLD && r.error <= p.threshold);
+            cell_stats c = cell_stats_of(v, &p);
+            worst[g][0] = fmax(worst[g][0], c.ks / crit);
+            worst[g][1] = fmax(worst[g][1], c.ks_orient / crit);
+            steps[g] += r.steps;
+            gp_voronoi_destroy(v);
+            gp_imc_report_free(&r);
+        }
+    printf("KS goals, N %zu, COV %.1f, a %.1f, seeds 1-%d: worst area / orientation KS of critical %.3f / %.3f "
+           "without the check (%ld steps), %.3f / %.3f with it (%ld steps)\n", n, cov, aniso, nseeds, worst[0][0],
+           worst[0][1], steps[0], worst[1][0], worst[1][1], steps[1]);
+    CHECK(worst[0][0] > 0.2 || worst[0][1] > 0.3); /* the case is real: beyond even 0.2 */
+    CHECK(worst[1][0] <= 0.15 && worst[1][1] <= 0.3);
+}
+
 /* a hard case: converges, or stops at max_steps with the error not above the start */
 static void hard(const char *name, const gp_vec2 *outer, size_t no, const gp_vec2 *const *holes, const size_t *nh,
                  size_t nholes, size_t n, gp_imc_params *p)
@@ -581,6 +614,8 @@ int main(void)
 
     walls_untie(500, 1);
     walls_untie(2000, 2);
+    ks_goals(500, 1.2, 0.3, 8);
+    ks_goals(200, 0.8, 1.0, 8);
 
     gp_imc_params p;
     /* --- a wrong specimen that a histogram error passes: 4 equal-probability classes at
