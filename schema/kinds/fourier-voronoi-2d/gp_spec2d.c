@@ -5,6 +5,7 @@
  * threshold, the work budget) and its work and result bounds. See gp_spec.h. */
 #include "gp_spec_internal.h"
 
+#include "gp_spec_fv.h"
 #include "gp_imc.h"
 #include "gp_outline.h"
 #include "gp_rings.h"
@@ -20,10 +21,8 @@ extern const gp_spec_kind gp_spec_kind_fourier_voronoi_2d; /* this kind, defined
 extern const unsigned char gp_schema_text_fourier_voronoi_2d[];
 
 /* the names of the enums, at the index of their value */
-static const char *const g_laws[] = {"lognormal", "normal", "uniform", "sieve"}; /* gp_law_kind */
 static const char *const g_errors[] = {"E1", "E2", "E3", "AD"}; /* gp_imc_error_kind - 1 */
 static const char *const g_inits[] = {"uniform", "halton"};     /* gp_init_kind */
-static const char *const g_of[] = {"cells", "grains"};          /* size_of_grains */
 static const char *const g_outputs[] = {"grains", "odec", "descriptors", "cells"}; /* GP_OUT2_ */
 /* shape.descriptors' names, in the order of gp_descriptors and GP_SHAPEMAP_BIT */
 static const char *const g_descriptors[] = {"elongation", "roundness", "circularity",
@@ -36,47 +35,8 @@ static const char *const g_descriptors[] = {"elongation", "roundness", "circular
  * or 1,000 traced at 1,000 -- is more than a mean spectrum and its spread need. */
 #define OUTLINE_VERTICES_MAX 2000000
 
-/* o[key] is the string value */
-static int str_is(const json_t *o, const char *key, const char *value)
-{
-    const char *s = json_string_value(json_object_get(o, key));
-    return s && !strcmp(s, value);
-}
-
 /* ------------------------------------------------------------------------------------------ */
 /* the spec as posted, and the defaults that depend on other fields */
-
-/* size.law decides which size fields belong; checked on the spec as posted, since particles
- * and size.cov have schema defaults */
-static int check_size_posted(const json_t *spec, gp_spec_problem *p)
-{
-    const json_t *size = json_object_get(spec, "size");
-    const char *law = json_string_value(json_object_get(size, "law"));
-    if (!law || strcmp(law, "sieve") != 0) {
-        const char *f = json_object_get(size, "sieve")         ? "sieve"
-                        : json_object_get(size, "sieve_units") ? "sieve_units" : NULL;
-        if (!f) return 0;
-        char ptr[32];
-        snprintf(ptr, sizeof ptr, "/size/%s", f);
-        return gp_problem(p, "invalid_spec", ptr, "only allowed with law \"sieve\" (the law here "
-                          "is \"%s\"); add \"law\": \"sieve\" or leave %s out",
-                          law ? law : "lognormal", f);
-    }
-    if (json_object_get(spec, "particles"))
-        return gp_problem(p, "invalid_spec", "/particles", "leave particles out with size.law "
-                          "\"sieve\": the number of grains follows from the container area and "
-                          "solid_fraction");
-    if (json_object_get(size, "cov"))
-        return gp_problem(p, "invalid_spec", "/size/cov", "not allowed with law \"sieve\": the "
-                          "sieve curve sets the spread of sizes; leave cov out");
-    if (!json_object_get(size, "sieve"))
-        return gp_problem(p, "invalid_spec", "/size/sieve", "required with law \"sieve\": "
-                          "expected rows [diameter, percent passing by mass]");
-    if (str_is(size, "of", "cells"))
-        return gp_problem(p, "invalid_spec", "/size/of", "expected \"grains\" (or nothing) with "
-                          "law \"sieve\", got \"cells\": a sieve curve is a law of the grains");
-    return 0;
-}
 
 /* shape.descriptors names at least one (the schema's minProperties, which its engine leaves
  * to this check for a clearer message) */
@@ -90,7 +50,8 @@ static int check_shape_posted(const json_t *spec, gp_spec_problem *p)
 
 static int check_posted_2d(const json_t *spec, gp_spec_problem *p)
 {
-    return check_size_posted(spec, p) || check_shape_posted(spec, p) ? -1 : 0;
+    if (gp_spec_fv_check_size_posted(spec, "the container area", p)) return -1;
+    return check_shape_posted(spec, p) ? -1 : 0;
 }
 
 /* The shape's forms, by the fields that make them; spread goes with any. */
@@ -135,22 +96,9 @@ static int explain_2d(const json_t *spec, gp_spec_problem *p)
  * belongs to a sieve; the threshold follows imc.error. 0, or -1 out of memory */
 static int settle_defaults_2d(json_t *full)
 {
-    json_t *size = json_object_get(full, "size");
-    int rc = 0;
-    if (str_is(size, "law", "sieve")) {
-        json_object_del(full, "particles");
-        json_object_del(size, "cov");
-        rc |= json_object_set_new(size, "of", json_string("grains"));
-    } else {
-        json_object_del(size, "sieve_units");
-    }
-    json_t *imc = json_object_get(full, "imc");
-    if (!json_object_get(imc, "threshold")) {
-        gp_spec_reader r = {0};
-        int error = gp_rd_enum(&r, imc, "/imc/error", g_errors, 4) + 1;
-        rc |= json_object_set_new(imc, "threshold", json_real(gp_imc_default_threshold(error)));
-    }
-    return rc ? -1 : 0;
+    gp_spec_reader r = {0};
+    const json_t *imc = json_object_get(full, "imc");
+    return gp_spec_fv_settle(full, gp_rd_enum(&r, imc, "/imc/error", g_errors, 4) + 1);
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -223,22 +171,15 @@ static int read_container_2d(gp_spec_reader *r, const json_t *cont, gp_spec2d *o
 /* the law, and its cov or its sieve (in metres); -1 out of memory */
 static int read_size_2d(gp_spec_reader *r, const json_t *size, gp_spec2d *out)
 {
-    out->size_law = (gp_law_kind)gp_rd_enum(r, size, "/size/law", g_laws, 4);
-    out->size_of_grains = gp_rd_enum(r, size, "/size/of", g_of, 2);
-    if (out->size_law != GP_LAW_SIEVE) {
-        out->cov = gp_rd_num(r, size, "/size/cov", -GP_RD_ANY, GP_RD_ANY);
-        return 0;
-    }
-    const json_t *sieve = gp_rd_array(r, size, "/size/sieve", 2, SIZE_MAX, 0);
-    double scale = gp_rd_sieve_scale(r, size, "/size/sieve_units");
-    size_t n = json_array_size(sieve);
-    double *d = malloc((n ? n : 1) * sizeof *d), *pw = malloc((n ? n : 1) * sizeof *pw);
-    out->sieve_d = d;
-    out->sieve_pass = pw;
-    if (!d || !pw) return -1;
-    for (size_t i = 0; i < n; i++) gp_rd_row(r, sieve, i, "/size/sieve", scale, &d[i], &pw[i]);
-    out->nsieve = n;
-    return 0;
+    gp_spec_fv_size z;
+    int rc = gp_spec_fv_read_size(r, size, &z);
+    out->size_law = (gp_law_kind)z.law;
+    out->size_of_grains = z.of_grains;
+    out->cov = z.cov;
+    out->sieve_d = z.sieve_d;
+    out->sieve_pass = z.sieve_pass;
+    out->nsieve = z.nsieve;
+    return rc;
 }
 
 /* shape.descriptors: the given ones and their values */
@@ -299,20 +240,11 @@ static int read_shape_2d(gp_spec_reader *r, const json_t *shape, gp_spec2d *out)
         return 0;
     }
     if (outl) return read_outlines_2d(r, outl, out);
-    const json_t *spec = gp_rd_array(r, shape, "/shape/spectrum", 1, SIZE_MAX, 1);
-    if (!spec) {
-        out->D2 = gp_rd_num(r, shape, "/shape/D2", -GP_RD_ANY, GP_RD_ANY);
-        out->D3 = gp_rd_num(r, shape, "/shape/D3", -GP_RD_ANY, GP_RD_ANY);
-        out->D8 = gp_rd_num(r, shape, "/shape/D8", -GP_RD_ANY, GP_RD_ANY);
-        out->alpha = gp_rd_num(r, shape, "/shape/alpha", -GP_RD_ANY, GP_RD_ANY);
-        out->beta = gp_rd_num(r, shape, "/shape/beta", -GP_RD_ANY, GP_RD_ANY);
-        return 0;
-    }
-    size_t n = json_array_size(spec);
-    double *d = malloc(n * sizeof *d);
-    if (!d) return -1;
-    for (size_t i = 0; i < n; i++)
-        d[i] = gp_rd_value(r, json_array_get(spec, i), "/shape/spectrum", -GP_RD_ANY, GP_RD_ANY);
+    double *const num[5] = {&out->D2, &out->D3, &out->D8, &out->alpha, &out->beta};
+    double *d = NULL;
+    size_t n = 0;
+    int form = gp_spec_fv_read_shape(r, shape, num, &d, &n);
+    if (form <= 0) return form;
     out->has_spectrum = 1;
     out->shape_form = GP_SHAPE_FORM_SPECTRUM;
     out->spectrum = d;
@@ -439,34 +371,6 @@ static int check_container_2d(const gp_spec2d *s, int rings, gp_spec_problem *p)
 
 /* ------------------------------------------------------------------------------------------ */
 /* the size law, the shape, the cell count */
-
-/* size.cov of a parametric law: GP_LAW_COV_MIN and each law's own maximum (gp_law.h) */
-static int check_cov(gp_law_kind law, double cov, gp_spec_problem *p)
-{
-    if (cov < GP_LAW_COV_MIN)
-        return gp_problem(p, "invalid_spec", "/size/cov", "expected at least %g, got %.15g: equal "
-                          "sizes cannot be tessellated exactly; use %g for nearly equal sizes",
-                          GP_LAW_COV_MIN, cov, GP_LAW_COV_MIN);
-    if (law == GP_LAW_NORMAL && cov > GP_LAW_NORMAL_COV_MAX)
-        return gp_problem(p, "invalid_spec", "/size/cov", "expected at most %g for law "
-                          "\"normal\", got %.15g (a wider normal law is mostly cut off at area "
-                          "0); use law \"lognormal\" for a wider spread", GP_LAW_NORMAL_COV_MAX,
-                          cov);
-    if (law == GP_LAW_UNIFORM && cov > GP_LAW_UNIFORM_COV_MAX)
-        return gp_problem(p, "invalid_spec", "/size/cov", "expected at most 0.5773 (1/√3) for "
-                          "law \"uniform\", got %.15g (its least area, mean (1 - √3 cov), would "
-                          "be negative)", cov);
-    return 0;
-}
-
-/* a sieve's rows, or a parametric law's cov */
-static int check_size_2d(const json_t *full, const gp_spec2d *s, gp_spec_problem *p)
-{
-    if (s->size_law == GP_LAW_SIEVE)
-        return gp_spec_check_sieve_rows(json_object_get(json_object_get(full, "size"), "sieve"),
-                                        "/size/sieve", p);
-    return check_cov(s->size_law, s->cov, p);
-}
 
 static int check_spectrum_2d(const gp_spec2d *s, gp_spec_problem *p)
 {
@@ -626,7 +530,8 @@ static int read_counted_2d(const json_t *full, gp_spec2d *s, int rings, size_t *
                            gp_spec_problem *p)
 {
     if (gp_spec2d_read(full, s, p) || check_container_2d(s, rings, p) ||
-        check_size_2d(full, s, p) || check_spectrum_2d(s, p))
+        gp_spec_fv_check_size(full, s->size_law, s->cov, "area", p) ||
+        check_spectrum_2d(s, p))
         return -1;
     return cell_count_2d(s, n, p);
 }

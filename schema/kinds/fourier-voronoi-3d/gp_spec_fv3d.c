@@ -5,6 +5,7 @@
  * memory and the work budget) and its work and result bounds. See gp_spec_fv3d.h. */
 #include "gp_spec_internal.h"
 
+#include "gp_spec_fv.h"
 #include "gp_spec_fv3d.h"
 
 #include "gp_fourier.h"
@@ -23,8 +24,6 @@ extern const gp_spec_kind gp_spec_kind_fourier_voronoi_3d; /* this kind, defined
 extern const unsigned char gp_schema_text_fourier_voronoi_3d[];
 
 const char *const gp_spec_fv3d_outputs[4] = {"grains", "clumps", "descriptors", "cells"};
-static const char *const g_laws[] = {"lognormal", "normal", "uniform", "sieve"}; /* gp_law_kind */
-static const char *const g_of[] = {"cells", "grains"};
 
 /* the star-shape sampling at submit draws from this stream of seed 0, whatever the spec's
  * seed: whether a spec is accepted does not depend on its seed */
@@ -33,45 +32,13 @@ static const char *const g_of[] = {"cells", "grains"};
 
 static double u01(void *rng) { return gp_rng_uniform(rng); }
 
-/* o[key] is the string value */
-static int str_is(const json_t *o, const char *key, const char *value)
-{
-    const char *s = json_string_value(json_object_get(o, key));
-    return s && !strcmp(s, value);
-}
-
 /* ------------------------------------------------------------------------------------------ */
 /* the spec as posted, and the defaults that depend on other fields */
 
 /* size.law decides which size fields belong (particles and size.cov have schema defaults) */
 static int check_posted_fv3d(const json_t *spec, gp_spec_problem *p)
 {
-    const json_t *size = json_object_get(spec, "size");
-    const char *law = json_string_value(json_object_get(size, "law"));
-    if (!law || strcmp(law, "sieve") != 0) {
-        const char *f = json_object_get(size, "sieve")         ? "sieve"
-                        : json_object_get(size, "sieve_units") ? "sieve_units" : NULL;
-        if (!f) return 0;
-        char ptr[32];
-        snprintf(ptr, sizeof ptr, "/size/%s", f);
-        return gp_problem(p, "invalid_spec", ptr, "only allowed with law \"sieve\" (the law here "
-                          "is \"%s\"); add \"law\": \"sieve\" or leave %s out",
-                          law ? law : "lognormal", f);
-    }
-    if (json_object_get(spec, "particles"))
-        return gp_problem(p, "invalid_spec", "/particles", "leave particles out with size.law "
-                          "\"sieve\": the number of grains follows from the container's volume "
-                          "and solid_fraction");
-    if (json_object_get(size, "cov"))
-        return gp_problem(p, "invalid_spec", "/size/cov", "not allowed with law \"sieve\": the "
-                          "sieve curve sets the spread of sizes; leave cov out");
-    if (!json_object_get(size, "sieve"))
-        return gp_problem(p, "invalid_spec", "/size/sieve", "required with law \"sieve\": "
-                          "expected rows [diameter, percent passing by mass]");
-    if (str_is(size, "of", "cells"))
-        return gp_problem(p, "invalid_spec", "/size/of", "expected \"grains\" (or nothing) with "
-                          "law \"sieve\", got \"cells\": a sieve curve is a law of the grains");
-    return 0;
+    return gp_spec_fv_check_size_posted(spec, "the container's volume", p);
 }
 
 /* the forms of an object of oneOf branches by the fields that start them (index), -1 for a
@@ -139,20 +106,7 @@ static int explain_fv3d(const json_t *spec, gp_spec_problem *p)
  * belongs to a sieve; the IMC's threshold is the AD default. 0, or -1 out of memory */
 static int settle_defaults_fv3d(json_t *full)
 {
-    json_t *size = json_object_get(full, "size");
-    int rc = 0;
-    if (str_is(size, "law", "sieve")) {
-        json_object_del(full, "particles");
-        json_object_del(size, "cov");
-        rc |= json_object_set_new(size, "of", json_string("grains"));
-    } else {
-        json_object_del(size, "sieve_units");
-    }
-    json_t *imc = json_object_get(full, "imc");
-    if (!json_object_get(imc, "threshold"))
-        rc |= json_object_set_new(imc, "threshold",
-                                  json_real(gp_imc_default_threshold(GP_IMC_ERROR_AD)));
-    return rc ? -1 : 0;
+    return gp_spec_fv_settle(full, GP_IMC_ERROR_AD);
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -208,23 +162,15 @@ static int read_container(gp_spec_reader *r, const json_t *c, gp_spec_fv3d *out)
 /* the law, its cov or its sieve (in metres); -1 out of memory */
 static int read_size(gp_spec_reader *r, const json_t *size, gp_spec_fv3d *out)
 {
-    out->law_kind = gp_rd_enum(r, size, "/size/law", g_laws, 4);
-    out->of_grains = gp_rd_enum(r, size, "/size/of", g_of, 2);
-    if (out->law_kind != GP_LAW_SIEVE) {
-        out->cov = gp_rd_num(r, size, "/size/cov", -GP_RD_ANY, GP_RD_ANY);
-        return 0;
-    }
-    out->of_grains = 1;
-    const json_t *sieve = gp_rd_array(r, size, "/size/sieve", 2, SIZE_MAX, 0);
-    double scale = gp_rd_sieve_scale(r, size, "/size/sieve_units");
-    size_t n = json_array_size(sieve);
-    out->sieve_d = malloc((n ? n : 1) * sizeof *out->sieve_d);
-    out->sieve_pass = malloc((n ? n : 1) * sizeof *out->sieve_pass);
-    if (!out->sieve_d || !out->sieve_pass) return -1;
-    for (size_t i = 0; i < n; i++)
-        gp_rd_row(r, sieve, i, "/size/sieve", scale, &out->sieve_d[i], &out->sieve_pass[i]);
-    out->nsieve = n;
-    return 0;
+    gp_spec_fv_size z;
+    int rc = gp_spec_fv_read_size(r, size, &z);
+    out->law_kind = z.law;
+    out->of_grains = z.law == GP_LAW_SIEVE ? 1 : z.of_grains; /* a sieve is a law of the grains */
+    out->cov = z.cov;
+    out->sieve_d = z.sieve_d;
+    out->sieve_pass = z.sieve_pass;
+    out->nsieve = z.nsieve;
+    return rc;
 }
 
 /* the D form's numbers or the spectrum (as given: D0 first), the stretch and the spread; -1
@@ -234,24 +180,10 @@ static int read_shape(gp_spec_reader *r, const json_t *shape, gp_spec_fv3d *out)
     out->core.elongation = gp_rd_num(r, shape, "/shape/elongation", -GP_RD_ANY, GP_RD_ANY);
     out->core.flatness = gp_rd_num(r, shape, "/shape/flatness", -GP_RD_ANY, GP_RD_ANY);
     out->core.spread = gp_rd_num(r, shape, "/shape/spread", -GP_RD_ANY, GP_RD_ANY);
-    const json_t *spec = gp_rd_array(r, shape, "/shape/spectrum", 1, SIZE_MAX, 1);
-    if (!spec) {
-        out->shape_form = 0;
-        out->D2 = gp_rd_num(r, shape, "/shape/D2", -GP_RD_ANY, GP_RD_ANY);
-        out->D3 = gp_rd_num(r, shape, "/shape/D3", -GP_RD_ANY, GP_RD_ANY);
-        out->D8 = gp_rd_num(r, shape, "/shape/D8", -GP_RD_ANY, GP_RD_ANY);
-        out->alpha = gp_rd_num(r, shape, "/shape/alpha", -GP_RD_ANY, GP_RD_ANY);
-        out->beta = gp_rd_num(r, shape, "/shape/beta", -GP_RD_ANY, GP_RD_ANY);
-        return 0;
-    }
-    out->shape_form = 1;
-    size_t n = json_array_size(spec);
-    out->spectrum = malloc(n * sizeof *out->spectrum);
-    if (!out->spectrum) return -1;
-    for (size_t i = 0; i < n; i++)
-        out->spectrum[i] = gp_rd_value(r, json_array_get(spec, i), "/shape/spectrum",
-                                       -GP_RD_ANY, GP_RD_ANY);
-    out->nspectrum = n;
+    double *const num[5] = {&out->D2, &out->D3, &out->D8, &out->alpha, &out->beta};
+    int form = gp_spec_fv_read_shape(r, shape, num, &out->spectrum, &out->nspectrum);
+    if (form < 0) return -1;
+    out->shape_form = form;
     return 0;
 }
 
@@ -436,33 +368,6 @@ static int check_container(gp_spec_fv3d *s, gp_spec_problem *p)
     return gp_problem(p, "invalid_spec", hs, "the polyhedron fills %.3g of its bounding box, "
                       "less than %g: its seeds are placed by rejection in that box, and a sliver "
                       "this thin cannot hold a specimen", fill, GP_SPEC_FV3D_FILL_MIN);
-}
-
-/* size.cov of a parametric law: GP_LAW_COV_MIN and each law's own maximum (gp_law.h) */
-static int check_cov(int law, double cov, gp_spec_problem *p)
-{
-    if (cov < GP_LAW_COV_MIN)
-        return gp_problem(p, "invalid_spec", "/size/cov", "expected at least %g, got %.15g: equal "
-                          "sizes cannot be tessellated exactly; use %g for nearly equal sizes",
-                          GP_LAW_COV_MIN, cov, GP_LAW_COV_MIN);
-    if (law == GP_LAW_NORMAL && cov > GP_LAW_NORMAL_COV_MAX)
-        return gp_problem(p, "invalid_spec", "/size/cov", "expected at most %g for law "
-                          "\"normal\", got %.15g (a wider normal law is mostly cut off at volume "
-                          "0); use law \"lognormal\" for a wider spread", GP_LAW_NORMAL_COV_MAX,
-                          cov);
-    if (law == GP_LAW_UNIFORM && cov > GP_LAW_UNIFORM_COV_MAX)
-        return gp_problem(p, "invalid_spec", "/size/cov", "expected at most 0.5773 (1/√3) for "
-                          "law \"uniform\", got %.15g (its least volume, mean (1 - √3 cov), "
-                          "would be negative)", cov);
-    return 0;
-}
-
-static int check_size(const json_t *full, const gp_spec_fv3d *s, gp_spec_problem *p)
-{
-    if (s->law_kind == GP_LAW_SIEVE)
-        return gp_spec_check_sieve_rows(json_object_get(json_object_get(full, "size"), "sieve"),
-                                        "/size/sieve", p);
-    return check_cov(s->law_kind, s->cov, p);
 }
 
 static int check_axis_spectrum(const gp_spec_fv3d *s, gp_spec_problem *p)
@@ -702,7 +607,8 @@ static int check_fv3d(const json_t *full, gp_spec_problem *p)
     gp_spec_fv3d s;
     gp_error err;
     memset(&err, 0, sizeof err);
-    int rc = read_raw(full, &s, p) || check_container(&s, p) || check_size(full, &s, p) ||
+    int rc = read_raw(full, &s, p) || check_container(&s, p) ||
+             gp_spec_fv_check_size(full, s.law_kind, s.cov, "volume", p) ||
              check_axis_spectrum(&s, p);
     if (!rc && (spectrum_of(&s, &err) != GP_OK || law_of(&s, &err) != GP_OK))
         rc = err.code == GP_ERR_NOMEM ? gp_spec_no_memory(p)
