@@ -8,10 +8,12 @@
  *                half transparent;
  *   size         the CDFs of stats.fit (cells and grains: the target law dashed, achieved
  *                solid) on a log-volume axis, KS against its 5 % critical value; for a sieve law
- *                the grains' passing by mass; the fit lines and the warnings;
+ *                the grains' passing by mass; the fit lines and the warnings (svg/svg_stats.c,
+ *                as the 2D kind's);
  *   descriptors  one histogram each of the grains' elongation, flatness, sphericity and
  *                convexity (stats.descriptors), the mean dashed and the target (the stretch
- *                asked) in red, and the mean 2D descriptors of the three projections.
+ *                asked) in red (the panels: svg/svg_stats.c), and the mean 2D descriptors of
+ *                the three projections.
  * The statistics views read the summary only. The geometry views read the grains and cells one
  * at a time from the result (their items' element texts, parsed one by one) and draw them
  * whole when they open: what they hold is the picture, whose outlines are decimated to half a
@@ -28,42 +30,12 @@
 #include "gp_voronoi3d.h"
 #include "kinds/fourier-voronoi-3d/svg_fv3d.h"
 #include "svg/svg_internal.h"
-
-#define BLUE "#1f77b4"
-#define ORANGE "#ff7f0e"
-#define RED "#d62728"
-#define GREEN "#2ca02c"
+#include "svg/svg_stats.h"
 
 #define PROJ_ANGLES 128 /* points of a projected outline */
 #define MIN_PX 0.5      /* outlines decimated to this */
 
 /* ================================================================== size */
-
-/* stats.fit.<key> with its "cdf" curves; 0 ok */
-static int cdf_read(const json_t *fit, const char *key, const char *name, const char *color,
-                    cdf_series *c)
-{
-    memset(c, 0, sizeof *c);
-    const json_t *b = json_object_get(fit, key), *cdf = json_object_get(b, "cdf");
-    size_t nt, na;
-    c->x = svg_plot_jarray(json_object_get(cdf, "x"), &c->n);
-    c->target = svg_plot_jarray(json_object_get(cdf, "target"), &nt);
-    c->achieved = svg_plot_jarray(json_object_get(cdf, "achieved"), &na);
-    if (!c->x || !c->target || !c->achieved || c->n < 2 || nt != c->n || na != c->n) {
-        svg_plot_cdf_free(c);
-        return -1;
-    }
-    c->name = name;
-    c->color = color;
-    c->law = json_string_value(json_object_get(b, "law"));
-    c->ks = svg_plot_jnum(json_object_get(b, "ks"), NAN);
-    c->ks_critical = svg_plot_jnum(json_object_get(b, "ks_critical"), NAN);
-    c->w1 = svg_plot_jnum(json_object_get(b, "w1"), NAN);
-    c->cov = svg_plot_jnum(json_object_get(json_object_get(b, "achieved"), "cov"), NAN);
-    c->target_cov = svg_plot_jnum(json_object_get(json_object_get(b, "target"), "cov"), NAN);
-    c->count = svg_plot_jnum(json_object_get(b, "n"), NAN);
-    return 0;
-}
 
 /* the unit of a volume axis whose largest value is hi m³: labels from about 10 up */
 static const char *volume_unit(double hi, double *factor)
@@ -78,202 +50,18 @@ static const char *volume_unit(double hi, double *factor)
     return u[k].name;
 }
 
-/* Draws (s != NULL) or counts the lines of the warnings, wrapped at maxch bytes on spaces
- * (never inside a UTF-8 character), from baseline y, 16 px apart. */
-static int warning_lines(sb *s, const json_t *warnings, double x, double y, size_t maxch)
-{
-    int lines = 0;
-    size_t i;
-    const json_t *w;
-    json_array_foreach(warnings, i, w) {
-        const char *t = json_string_value(w);
-        for (int first = 1; t && *t; first = 0) {
-            size_t len = strlen(t), cut = len;
-            if (len > maxch) {
-                cut = maxch;
-                while (cut > maxch / 2 && t[cut] != ' ') cut--;
-                if (t[cut] != ' ')
-                    for (cut = maxch; cut > 1 && ((unsigned char)t[cut] & 0xC0) == 0x80;) cut--;
-            }
-            if (s) {
-                char line[512];
-                snprintf(line, sizeof line, "%s%.*s", first ? "\xe2\x9a\xa0 warning: " : "",
-                         (int)(cut < 400 ? cut : 400), t);
-                svg_plot_text_at(s, first ? x : x + 18, y + 16 * lines, "start",
-                                 "class=\"warning\" fill=\"#b35c00\" font-weight=\"bold\"", line);
-            }
-            lines++;
-            t += cut;
-            while (*t == ' ') t++;
-        }
-    }
-    return lines;
-}
-
-/* "cells: N 500, W1 0.012, COV 0.49 (target 0.5)" and the KS when it is over; 1 then */
-static int fit_line(char *buf, size_t n, const cdf_series *c)
-{
-    int over = isfinite(c->ks) && isfinite(c->ks_critical) && c->ks > c->ks_critical;
-    int k = snprintf(buf, n, "%s:", c->name);
-    if (isfinite(c->count) && k > 0 && (size_t)k < n)
-        k += snprintf(buf + k, n - (size_t)k, " N %.0f,", c->count);
-    if (k > 0 && (size_t)k < n && isfinite(c->w1))
-        k += snprintf(buf + k, n - (size_t)k, " W1 %.3g,", c->w1);
-    if (k > 0 && (size_t)k < n && isfinite(c->cov) && isfinite(c->target_cov))
-        k += snprintf(buf + k, n - (size_t)k, " COV %.3g (target %.3g)", c->cov, c->target_cov);
-    if (k > 0 && (size_t)k < n && buf[k - 1] == ',') buf[--k] = 0;
-    if (k > 0 && (size_t)k < n && over)
-        snprintf(buf + k, n - (size_t)k, " -- KS %.3g is above its 5 %% critical value %.3g",
-                 c->ks, c->ks_critical);
-    return over;
-}
-
-/* stats.fit.passing of a sieve law */
-typedef struct passing {
-    double *d, *target, *achieved, max_pp;
-    size_t n;
-} passing;
-
-static void passing_free(passing *p)
-{
-    free(p->d);
-    free(p->target);
-    free(p->achieved);
-    memset(p, 0, sizeof *p);
-}
-
-static int passing_read(const json_t *fit, passing *p)
-{
-    memset(p, 0, sizeof *p);
-    const json_t *o = json_object_get(fit, "passing");
-    size_t nt, na;
-    p->d = svg_plot_jarray(json_object_get(o, "diameters"), &p->n);
-    p->target = svg_plot_jarray(json_object_get(o, "target"), &nt);
-    p->achieved = svg_plot_jarray(json_object_get(o, "achieved"), &na);
-    p->max_pp = svg_plot_jnum(json_object_get(o, "max_error_pp"), NAN);
-    if (!p->d || !p->target || !p->achieved || p->n < 2 || nt != p->n || na != p->n) {
-        passing_free(p);
-        return -1;
-    }
-    return 0;
-}
-
-static void passing_curve(sb *s, const frame *f, const passing *p, int achieved)
-{
-    const double *y = achieved ? p->achieved : p->target;
-    const char *color = achieved ? ORANGE : RED;
-    svg_plot_sb_printf(s, "<path class=\"passing-%s\" fill=\"none\" stroke=\"%s\" "
-                          "stroke-width=\"2\"%s d=\"",
-                       achieved ? "achieved" : "target", color,
-                       achieved ? "" : " stroke-dasharray=\"6 4\"");
-    int first = 1;
-    for (size_t i = 0; i < p->n; i++) {
-        if (!(p->d[i] > 0) || !isfinite(y[i])) continue;
-        svg_plot_sb_printf(s, "%s%.1f %.1f", first ? "M" : "L", svg_plot_fx(f, p->d[i] * 1e3),
-                           svg_plot_fy(f, fmax(0, fmin(100, y[i]))));
-        first = 0;
-    }
-    svg_plot_sb_puts(s, "\"/>\n");
-    for (size_t i = 0; i < p->n; i++)
-        if (p->d[i] > 0 && isfinite(y[i]))
-            svg_plot_marker(s, svg_plot_fx(f, p->d[i] * 1e3),
-                            svg_plot_fy(f, fmax(0, fmin(100, y[i]))), color);
-}
-
-static void passing_panel(sb *s, const frame *f0, const passing *p)
-{
-    double lo = INFINITY, hi = -INFINITY;
-    for (size_t i = 0; i < p->n; i++)
-        if (p->d[i] > 0) lo = fmin(lo, p->d[i] * 1e3), hi = fmax(hi, p->d[i] * 1e3);
-    if (!(hi > lo)) lo = isfinite(lo) ? lo / 2 : 1, hi = lo * 4;
-    frame f = *f0;
-    f.xmin = lo;
-    f.xmax = hi;
-    f.ymin = 0;
-    f.ymax = 100;
-    f.xlog = 1;
-    svg_plot_text_at(s, f.x0 + f.w / 2, f.y0 - 10, "middle", "font-weight=\"bold\"",
-                     "Grains passing by mass (sieve law)");
-    svg_plot_axes(s, &f, "equivalent diameter (6V/\xcf\x80)^(1/3) (mm, log scale)",
-                  "percent passing by mass (%)", 1);
-    passing_curve(s, &f, p, 0);
-    passing_curve(s, &f, p, 1);
-    char lab[96];
-    if (isfinite(p->max_pp)) snprintf(lab, sizeof lab, "achieved, max error %.2g pp", p->max_pp);
-    else snprintf(lab, sizeof lab, "achieved");
-    legend_item it[2] = {{"target (sieve curve)", "dash", RED}, {lab, "marker", ORANGE}};
-    svg_plot_legend(s, f.x0, f.y0 + f.h + 50, it, 2);
-}
+/* the size view of the 3D kind: the CDFs of the cells' and grains' volumes */
+static const svg_stats_size_kind SIZE_3D = {
+    "cell_volume", "grain_volume", "Volume distribution: target law vs achieved (CDF)", "volume",
+    volume_unit, "equivalent diameter (6V/\xcf\x80)^(1/3) (mm, log scale)", ""};
 
 int svg_fv3d_size(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, int width,
                   gpd_err *err)
 {
-    const json_t *res = in->summary;
-    const json_t *fit = json_object_get(json_object_get(res, "stats"), "fit");
-    cdf_series c[2];
-    int nc = 0;
-    if (cdf_read(fit, "cell_volume", "cells", BLUE, &c[nc]) == 0) nc++;
-    if (cdf_read(fit, "grain_volume", "grains", ORANGE, &c[nc]) == 0) nc++;
-    if (!nc) {
-        gpd_err_set(err, 409, "view \"size\" needs stats.fit.cell_volume or grain_volume with "
-                              "their CDFs in the result");
-        return -1;
-    }
-    passing p;
-    int have_p = passing_read(fit, &p) == 0;
-    double lo, hi, k;
-    svg_plot_cdf_range(c, nc, 1, &lo, &hi);
-    int xlog = lo > 0 && hi > lo;
-    if (!xlog) svg_plot_cdf_range(c, nc, 0, &lo, &hi);
-    if (!(hi > lo)) lo = isfinite(lo) ? lo - 0.5 : 0, hi = lo + 1;
-    const char *unit = volume_unit(hi, &k);
-    for (int j = 0; j < nc; j++)
-        for (size_t i = 0; i < c[j].n; i++) c[j].x[i] *= k;
-    const json_t *warnings = json_object_get(res, "warnings");
-    size_t maxch = (size_t)((width - 60) / 8 - 12);
-    int nwarn = warning_lines(NULL, warnings, 0, 0, maxch);
-    double cdf_h = lround(width * 0.62) - 110.0, pass_h = lround(width * 0.5) - 110.0;
-    double y_pass = 40 + cdf_h + 50 + 8 + 36 * nc + 50;
-    double y_lines = have_p ? y_pass + pass_h + 50 + 44 + 24 : y_pass - 26;
-    int height = (int)ceil(y_lines + 16 * (nc + nwarn));
-    frame f = {80, 40, width - 110.0, cdf_h, lo * k, hi * k, 0, 1, xlog};
-    sb *s = &g->out;
-    svg_plot_doc_begin(s, width, height, "Volume distribution: target law vs achieved (CDF)");
-    char xl[64];
-    snprintf(xl, sizeof xl, "volume (%s%s)", unit, xlog ? ", log scale" : "");
-    svg_plot_axes(s, &f, xl, "cumulative fraction (by number)", 1);
-    legend_item it[4];
-    char names[4][96];
-    for (int j = 0; j < nc; j++) {
-        svg_plot_cdf_path(s, &f, &c[j], 0);
-        svg_plot_cdf_path(s, &f, &c[j], 1);
-        snprintf(names[2 * j], sizeof names[0], "%s: target (%s)", c[j].name,
-                 c[j].law ? c[j].law : "law");
-        if (isfinite(c[j].ks) && isfinite(c[j].ks_critical))
-            snprintf(names[2 * j + 1], sizeof names[0], "%s: achieved, KS %.3g (5 %% critical "
-                     "%.3g)", c[j].name, c[j].ks, c[j].ks_critical);
-        else
-            snprintf(names[2 * j + 1], sizeof names[0], "%s: achieved", c[j].name);
-        it[2 * j] = (legend_item){names[2 * j], "dash", c[j].color};
-        it[2 * j + 1] = (legend_item){names[2 * j + 1], "line", c[j].color};
-    }
-    svg_plot_legend(s, f.x0, f.y0 + f.h + 50, it, 2 * nc);
-    if (have_p) {
-        frame fp = {80, y_pass, width - 110.0, pass_h, 0, 1, 0, 100, 1};
-        passing_panel(s, &fp, &p);
-    }
-    double y = y_lines;
-    for (int j = 0; j < nc; j++, y += 16) {
-        char line[320];
-        int over = fit_line(line, sizeof line, &c[j]);
-        svg_plot_text_at(s, 20, y, "start",
-                         over ? "class=\"fit ks-over\" fill=\"#d62728\"" : "class=\"fit\"", line);
-    }
-    warning_lines(s, warnings, 20, y, maxch);
-    svg_plot_doc_end(s);
-    for (int j = 0; j < nc; j++) svg_plot_cdf_free(&c[j]);
-    passing_free(&p);
-    return 0;
+    if (svg_stats_size(&g->out, in->summary, width, &SIZE_3D) == 0) return 0;
+    gpd_err_set(err, 409, "view \"size\" needs stats.fit.cell_volume or grain_volume with "
+                          "their CDFs in the result");
+    return -1;
 }
 
 /* ================================================================== descriptors */
@@ -281,39 +69,6 @@ int svg_fv3d_size(gp_svg *g, const gp_svg_input *in, const gp_svg_options *opt, 
 static const char *const DESC3[4] = {"elongation", "flatness", "sphericity", "convexity"};
 static const char *const DESC2[4] = {"elongation", "roundness", "circularity", "regularity"};
 static const char *const AXES[3] = {"long", "intermediate", "short"};
-
-static void vline(sb *s, const frame *f, double v, const char *cls, const char *style)
-{
-    double x = svg_plot_fx(f, v);
-    svg_plot_sb_printf(s, "<line class=\"%s\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" %s/>\n",
-                       cls, x, f->y0, x, f->y0 + f->h, style);
-}
-
-/* one panel: the histogram, the mean (dashed) and the target (red), mean and sd in its title;
- * the x range widened to show a target outside the data */
-static void desc_panel(sb *s, double ox, double oy, double pw, double ph, const char *name,
-                       const hist *h, double sd, double target)
-{
-    frame f = svg_plot_hist_frame(ox + 62, oy + 26, pw - 82, ph - 76, h);
-    if (isfinite(target)) {
-        double st = (f.xmax - f.xmin) / (double)h->k;
-        if (target < f.xmin) f.xmin = floor(target / st) * st;
-        if (target > f.xmax) f.xmax = ceil(target / st) * st;
-    }
-    char t[160];
-    int k = snprintf(t, sizeof t, "%s", name);
-    if (h->has_mean) k += snprintf(t + k, sizeof t - (size_t)k, ": mean %.3g", h->mean);
-    if (isfinite(sd)) k += snprintf(t + k, sizeof t - (size_t)k, ", sd %.2g", sd);
-    if (isfinite(target)) snprintf(t + k, sizeof t - (size_t)k, " (asked %.3g)", target);
-    svg_plot_text_at(s, f.x0 + f.w / 2, oy + 14, "middle",
-                     "class=\"panel-title\" font-weight=\"bold\"", t);
-    svg_plot_axes(s, &f, name, "fraction of grains", 0);
-    svg_plot_draw_hist(s, &f, h, GREEN);
-    if (h->has_mean && h->mean >= f.xmin && h->mean <= f.xmax)
-        vline(s, &f, h->mean, "mean",
-              "stroke=\"#000000\" stroke-width=\"1.5\" stroke-dasharray=\"5 3\"");
-    if (isfinite(target)) vline(s, &f, target, "target", "stroke=\"#d62728\" stroke-width=\"2\"");
-}
 
 /* the mean 2D descriptors of the projections (stats.descriptors.projections) as a table: a row
  * an axis the grains are seen along, a column a descriptor ("mean ± sd") */
@@ -364,21 +119,11 @@ int svg_fv3d_descriptors(gp_svg *g, const gp_svg_input *in, const gp_svg_options
     int height = (int)lround(width * 0.75) + 20 + 4 * 18 + 24;
     sb *s = &g->out;
     svg_plot_doc_begin(s, width, height, "Shape descriptors of the grains (3D)");
-    legend_item it[3] = {{"achieved (fraction of grains per bin)", "bar", GREEN},
-                         {"mean", "dash", "#000000"},
-                         {"asked (the stretch: elongation I/L, flatness S/I)", "line", RED}};
-    svg_plot_legend_row(s, 40, 44, it, 3);
-    double pw = (width - 40) / 2.0, ph = (lround(width * 0.75) + 20 - 60) / 2.0;
-    for (int k = 0; k < 4; k++) {
-        double ox = 20 + (k % 2) * pw, oy = 56 + (k / 2) * ph;
-        if (!h[k].k) {
-            svg_plot_text_at(s, ox + pw / 2, oy + ph / 2, "middle", NULL, "(not in the result)");
-            continue;
-        }
-        desc_panel(s, ox, oy, pw, ph, DESC3[k], &h[k], sd[k], target[k]);
-    }
+    svg_stats_desc panels = {DESC3, h, sd, target,
+                             "asked (the stretch: elongation I/L, flatness S/I)", 1};
+    double y = svg_stats_desc_panels(s, width, &panels);
     const json_t *pr = json_object_get(d, "projections");
-    if (pr) projection_table(s, pr, 40, 56 + 2 * ph + 24, width - 60);
+    if (pr) projection_table(s, pr, 40, y + 24, width - 60);
     svg_plot_doc_end(s);
     for (int k = 0; k < 4; k++) svg_plot_hist_free(&h[k]);
     return 0;
