@@ -51,8 +51,8 @@
  * Stopping. A run stops at its threshold, at max_steps, when it stalls (the descent not 1 %
  * lower over gp_imc_stall_window(N) steps) or when cancelled. The AD threshold stands for KS
  * goals, the cell areas' KS distance within 0.15 and the orientations' within 0.3 of the 5 %
- * critical value 1.36 / sqrt(N) (0.15: Neper's fits sit at 0.16-0.2 of it at COV 0.8, issue
- * #33); A^2 and KS weigh a CDF's misfit differently (a narrow step costs A^2 little), so with
+ * critical value 1.36 / sqrt(N) (0.15: Neper's fits sit at 0.16-0.2 of it at COV 0.8, the
+ * tool to be no worse than); A^2 and KS weigh a CDF's misfit differently (a narrow step costs A^2 little), so with
  * ks_goals (the default) a run at its threshold measures both distances (O(N log N), from the
  * values the statistics hold) and, while either misses its goal, goes on to 0.7 of the
  * threshold in force, down to a quarter of the params', for at most twice the steps (and at
