@@ -1050,6 +1050,26 @@ gp_status gp_export_reader_vertices(gp_export_reader *r, uint64_t g, double *xyz
     return reader_result(r, gp_xr_grain3(r->e, g, &gr) || gp_x3_vertices(r->e, g, &gr, xyz), err);
 }
 
+/* grain g's radii (g below nitems) in pieces of the read cache's size, as gp_x3_vertices reads
+ * them */
+static int read_radii(gp_export *e, uint64_t g, double *radii)
+{
+    const uint64_t nd = e->info.npoints, piece = 4096;
+    for (uint64_t k0 = 0; k0 < nd; k0 += piece) {
+        uint64_t m = nd - k0 < piece ? nd - k0 : piece;
+        const unsigned char *p = gp_xr_window(e, e->x3.off_radii + 8 * (g * nd + k0), 8 * (size_t)m);
+        if (!p) return -1;
+        memcpy(radii + k0, p, 8 * (size_t)m);
+    }
+    return 0;
+}
+
+gp_status gp_export_reader_radii(gp_export_reader *r, uint64_t g, double *radii, gp_error *err)
+{
+    gp_status st = reader_check(r, GP_EXPORT_FV3D, "grain", g, r->e->info.nitems, err);
+    return st ? st : reader_result(r, read_radii(r->e, g, radii), err);
+}
+
 void gp_export_reader_destroy(gp_export_reader *r)
 {
     if (!r) return;

@@ -314,6 +314,9 @@ gp_status gp_export_reader_direction(gp_export_reader *r, uint64_t k, double d[3
 gp_status gp_export_reader_triangle(gp_export_reader *r, uint64_t t, uint32_t tri[3],
                                     gp_error *err);
 gp_status gp_export_reader_vertices(gp_export_reader *r, uint64_t g, double *xyz, gp_error *err);
+/* fv3d: the npoints radii of grain g into radii (the result's "radii", the same doubles), for a
+ * caller that places the vertices itself. */
+gp_status gp_export_reader_radii(gp_export_reader *r, uint64_t g, double *radii, gp_error *err);
 void gp_export_reader_destroy(gp_export_reader *r);
 
 #endif /* GP_EXPORT_H */

@@ -72,9 +72,9 @@
  * Compact reading (what grainpackd does): a view reads the result's small members -- the
  * "summary": stats, warnings, container, box, kind (the result without grains, cells, spheres
  * and contacts, see store_get_summary) -- and its geometry one item at a time from an item
- * source: the export pack (gp_svg_items_pack: 2D grains, 3D spheres), or an array of the
- * result text walked element by element (gp_svg_items_scan, server/util/json_scan.h), or an array in
- * memory (gp_svg_items_json). The size and psd views need only the summary; orientation and
+ * source: the export pack (gp_svg_items_pack: 2D grains, 3D spheres, fv3d grains), or an
+ * array of the result text walked element by element (gp_svg_items_scan,
+ * server/util/json_scan.h), or an array in memory (gp_svg_items_json). The size and psd views need only the summary; orientation and
  * descriptors read the grains' numbers in one and three light passes (no contours: O(1)
  * memory); the geometry views (packing, cells, section) read their items in two to four
  * passes (bounds and colour range, then drawing, the cells' seeds, the inset). The SVG is handed out as a pull stream (gp_svg_open /
@@ -119,9 +119,10 @@ gp_svg_items *gp_svg_items_json(const json_t *array, gp_svg_part part);
  * stay valid until the source is closed. NULL on out of memory. */
 gp_svg_items *gp_svg_items_scan(const js_source *text, uint64_t off, gp_svg_part part);
 
-/* The grains (2D) or spheres (3D) of an export pack (core/export/gp_export.h), which must stay
- * readable until the source is closed. NULL when pack is not a pack, or not of that part
- * (cells are not in packs). */
+/* The grains (2D, fv3d) or spheres (3D) of an export pack (core/export/gp_export.h), which must
+ * stay readable until the source is closed. NULL when pack is not a pack, or not of that part
+ * (cells are not in packs). A fv3d pack's grains come with their 2D numbers NaN: their views
+ * read the records (pose, volume, radii) through the source's reader. */
 gp_svg_items *gp_svg_items_pack(const gp_export_source *pack, gp_svg_part part);
 
 void gp_svg_items_close(gp_svg_items *it);

@@ -39,7 +39,9 @@ struct gp_svg_items {
     js_scan *js; /* scan */
     uint64_t off;
     gp_export_reader *e, *ep; /* pack: its grain or sphere records, its contour points (a reader of
-                        * its own, so that both are read in order, each through its cache) */
+                        * its own, so that both are read in order, each through its cache; none
+                        * for a fv3d pack, whose radii e reads beside the records in a window
+                        * of their own) */
     uint64_t k;
 };
 

@@ -1,6 +1,8 @@
 /* svg_items.c -- the item sources of the SVG views (svg.h): a result's grains, cells or spheres,
  * one at a time, from a JSON array in memory, from an array of a JSON text walked element by
- * element (json_scan.h), or from a pack (core/export: an export pack, or a 2D view pack). */
+ * element (json_scan.h), or from a pack (core/export: an export pack, or a 2D view pack). A
+ * fv3d pack's grains have no 2D numbers: their views read its records through the items'
+ * reader (svg_fv3d.c). */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -512,6 +514,12 @@ static int pack_next(gp_svg_items *it)
         if (gp_export_reader_sphere(e, k, c->q, NULL)) return -1;
         return 1;
     }
+    if (gp_export_reader_info(e)->dim == GP_EXPORT_FV3D) {
+        /* a 3D grain has none of the item's 2D numbers (all NaN): its views read the pack's
+         * records through it->e themselves (svg_fv3d.c) */
+        gp_export_grain3 g3;
+        return gp_export_reader_grain3(e, k, &g3, NULL) ? -1 : 1;
+    }
     gp_export_grain g;
     if (gp_export_reader_grain(e, k, &g, NULL)) return -1;
     if (!it->light) {
@@ -536,6 +544,14 @@ static int pack_next(gp_svg_items *it)
     return 1;
 }
 
+/* whether a pack of dimension dim holds the items of part: spheres a 3D pack's, grains a 2D or
+ * a fv3d pack's */
+static int pack_has(int dim, gp_svg_part part)
+{
+    if (part == GP_SVG_SPHERES) return dim == 3;
+    return part == GP_SVG_GRAINS && (dim == 2 || dim == GP_EXPORT_FV3D);
+}
+
 gp_svg_items *gp_svg_items_pack(const gp_export_source *pack, gp_svg_part part)
 {
     if (part == GP_SVG_CELLS) return NULL;
@@ -543,8 +559,8 @@ gp_svg_items *gp_svg_items_pack(const gp_export_source *pack, gp_svg_part part)
     if (!it) return NULL;
     gp_error err;
     if (gp_export_reader_open(pack, &it->e, &err) ||
-        gp_export_reader_info(it->e)->dim != (part == GP_SVG_SPHERES ? 3 : 2) ||
-        (part == GP_SVG_GRAINS && gp_export_reader_open(pack, &it->ep, &err))) {
+        !pack_has(gp_export_reader_info(it->e)->dim, part) ||
+        (gp_export_reader_info(it->e)->dim == 2 && gp_export_reader_open(pack, &it->ep, &err))) {
         gp_svg_items_close(it);
         return NULL;
     }

@@ -15,8 +15,9 @@
  *                asked) in red (the panels: svg/svg_stats.c), and the mean 2D descriptors of
  *                the three projections.
  * The statistics views read the summary only. The geometry views read the grains and cells one
- * at a time from the result (their items' element texts, parsed one by one) and draw them
- * whole when they open: what they hold is the picture, whose outlines are decimated to half a
+ * at a time -- the grains from the job's export pack when it has one (their records and radii,
+ * the result's doubles), else, as the cells, from the result (their items' element texts, parsed
+ * one by one) -- and draw them whole when they open: what they hold is the picture, whose outlines are decimated to half a
  * pixel, not the result. The grains' directions are made again from stats.mesh.level and
  * stats.shape's stretch (gp_grain3d_basis_create_ex: the same vertices, in the same order, as the
  * result's "icosphere"). */
@@ -350,6 +351,26 @@ typedef struct grain3 {
     size_t nr;
 } grain3;
 
+/* g's rotation from the unit quaternion w (w, x, y, z); its radii cleared */
+static void grain_rotation(grain3 *g, const double w[4])
+{
+    double a = w[0], x = w[1], y = w[2], z = w[3];
+    double M[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - a * z),     2 * (x * z + a * y),
+                   2 * (x * y + a * z),     1 - 2 * (x * x + z * z), 2 * (y * z - a * x),
+                   2 * (x * z - a * y),     2 * (y * z + a * x),     1 - 2 * (x * x + y * y)};
+    memcpy(g->R, M, sizeof M);
+    g->nr = 0;
+    g->rmax = 0;
+}
+
+/* 0 when g has a pose (finite centre and rotation, positive scale), else -1 */
+static int grain_posed(const grain3 *g)
+{
+    for (int k = 0; k < 9; k++)
+        if (!isfinite(g->R[k])) return -1;
+    return isfinite(g->c[0]) && isfinite(g->c[1]) && isfinite(g->c[2]) && g->s > 0 ? 0 : -1;
+}
+
 /* e's members into g (radii copied into g->r, nv of them, when it has them); 0, or -1 when
  * it has no pose */
 static int grain_parse(const json_t *e, grain3 *g, size_t nv)
@@ -361,22 +382,79 @@ static int grain_parse(const json_t *e, grain3 *g, size_t nv)
     for (int k = 0; k < 4; k++) w[k] = svg_plot_jnum(json_array_get(q, (size_t)k), NAN);
     g->s = svg_plot_jnum(json_object_get(e, "scale"), NAN);
     g->vol = svg_plot_jnum(json_object_get(e, "volume"), NAN);
-    double a = w[0], x = w[1], y = w[2], z = w[3];
-    double M[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - a * z),     2 * (x * z + a * y),
-                   2 * (x * y + a * z),     1 - 2 * (x * x + z * z), 2 * (y * z - a * x),
-                   2 * (x * z - a * y),     2 * (y * z + a * x),     1 - 2 * (x * x + y * y)};
-    memcpy(g->R, M, sizeof M);
-    g->nr = 0;
-    g->rmax = 0;
+    grain_rotation(g, w);
     if (json_array_size(r) == nv && g->r)
         for (size_t i = 0; i < nv; i++) {
             g->r[i] = svg_plot_jnum(json_array_get(r, i), NAN);
             g->rmax = fmax(g->rmax, g->r[i]);
             g->nr++;
         }
-    for (int k = 0; k < 9; k++)
-        if (!isfinite(g->R[k])) return -1;
-    return isfinite(g->c[0]) && isfinite(g->c[1]) && isfinite(g->c[2]) && g->s > 0 ? 0 : -1;
+    return grain_posed(g);
+}
+
+/* a pack's double as the JSON result gives it: that writes a non-finite one as null (NaN) */
+static double finite_or_nan(double v)
+{
+    return isfinite(v) ? v : NAN;
+}
+
+/* Grain k of a fv3d pack into g, the same values as grain_parse gives for the result's element
+ * (radii into g->r when the pack's directions are the nv of the mesh). 1, with *ok when it has
+ * a pose; -1 when the pack cannot be read. */
+static int grain_read(gp_export_reader *pk, uint64_t k, grain3 *g, size_t nv, int *ok)
+{
+    gp_export_grain3 rec;
+    if (gp_export_reader_grain3(pk, k, &rec, NULL)) return -1;
+    double w[4];
+    for (int j = 0; j < 3; j++) g->c[j] = finite_or_nan(rec.centre[j]);
+    for (int j = 0; j < 4; j++) w[j] = finite_or_nan(rec.rotation[j]);
+    g->s = finite_or_nan(rec.scale);
+    g->vol = finite_or_nan(rec.volume);
+    grain_rotation(g, w);
+    if (gp_export_reader_info(pk)->npoints == nv && g->r) {
+        if (gp_export_reader_radii(pk, k, g->r, NULL)) return -1;
+        for (size_t i = 0; i < nv; i++) {
+            g->r[i] = finite_or_nan(g->r[i]);
+            g->rmax = fmax(g->rmax, g->r[i]);
+        }
+        g->nr = nv;
+    }
+    *ok = grain_posed(g) == 0;
+    return 1;
+}
+
+/* The grains of a geometry view one at a time: from the records of the job's fv3d pack when the
+ * items are a pack's (binary doubles: parsing 2,562 radii a grain from the text is most of a
+ * view's time), else the result's elements. */
+typedef struct grains {
+    elems e;
+    gp_export_reader *pack; /* NULL: the elements */
+    uint64_t k;
+} grains;
+
+static int grains_begin(grains *s, gp_svg_items *it)
+{
+    s->e = (elems){it, 0};
+    s->k = 0;
+    s->pack = it->e && gp_export_reader_info(it->e)->dim == GP_EXPORT_FV3D ? it->e : NULL;
+    return s->pack ? 0 : elems_begin(&s->e);
+}
+
+/* the next grain into g (radii, nv of them, when it has them): 1 with *ok when it has a pose,
+ * 0 at the end, -1 on failure */
+static int grains_next(grains *s, grain3 *g, size_t nv, int *ok)
+{
+    *ok = 0;
+    if (s->pack) {
+        if (s->k >= gp_export_reader_info(s->pack)->nitems) return 0;
+        return grain_read(s->pack, s->k++, g, nv, ok);
+    }
+    int r;
+    json_t *el = elems_next(&s->e, &r);
+    if (!el) return r;
+    *ok = grain_parse(el, g, nv) == 0;
+    json_decref(el);
+    return 1;
 }
 
 /* vertex i of g: c + s R r_i d_i */
@@ -624,15 +702,12 @@ static int section_grains(sb *s, const frame *f, gp_svg_items *it, const json_t 
     double dmin, dmax;
     diameter_range(res, &dmin, &dmax);
     int logscale = dmax > 4 * dmin;
-    elems e = {it, 0};
-    if (!rc && elems_begin(&e)) rc = -1;
+    grains src;
+    if (!rc && grains_begin(&src, it)) rc = -1;
     svg_plot_sb_puts(s, "<g class=\"grains\" stroke=\"#222222\" stroke-width=\"0.6\" "
                         "fill-rule=\"evenodd\">\n");
-    json_t *el;
-    int r = 0;
-    while (!rc && (el = elems_next(&e, &r))) {
-        int ok = grain_parse(el, &g, m.nv) == 0;
-        json_decref(el);
+    int r = 0, ok;
+    while (!rc && (r = grains_next(&src, &g, m.nv, &ok)) > 0) {
         if (!ok) continue;
         x->grains++;
         if (g.nr != m.nv || fabs(g.c[2] - x->z) > g.s * g.rmax) continue;
@@ -790,17 +865,14 @@ int svg_fv3d_projection(gp_svg *g, const gp_svg_input *in, const gp_svg_options 
     f.y0 += 36;
     sb body = {0};
     size_t drawn = 0, n = 0;
-    elems el = {it, 0};
-    if (!rc && elems_begin(&el)) rc = -1;
+    grains src;
+    if (!rc && grains_begin(&src, it)) rc = -1;
     svg_plot_sb_puts(&body, "<g class=\"grains\" stroke=\"#222222\" stroke-width=\"0.5\" "
                             "fill-opacity=\"0.45\">\n");
-    json_t *item;
-    int r = 0;
-    while (!rc && (item = elems_next(&el, &r))) {
-        int ok = grain_parse(item, &gr, m.nv) == 0 && gr.nr == m.nv;
-        json_decref(item);
+    int r = 0, ok;
+    while (!rc && (r = grains_next(&src, &gr, m.nv, &ok)) > 0) {
         n++;
-        if (!ok) continue;
+        if (!ok || gr.nr != m.nv) continue;
         /* the world's x and y axes in the grain's frame: R's first two rows */
         double eu[3] = {gr.R[0], gr.R[1], gr.R[2]}, ev[3] = {gr.R[3], gr.R[4], gr.R[5]};
         if (gp_grain3d_projection(basis, gr.r, eu, ev, PROJ_ANGLES, ct, &e) != GP_OK) continue;
