@@ -953,7 +953,7 @@ static void lane_eval(lane *L, const imc_state *S, uint64_t seed, const objectiv
 
 /* A LANE_SERIAL step judged by changing the statistics (kept when accepted, put back when
  * not); only while no lane runs. */
-static int judge_serial(imc_state *S, lane *L, const objective *cur)
+static int judge_serial(imc_state *S, lane *L, const objective *cur, double cap)
 {
     const uint32_t *ch;
     size_t nch = gp_voronoi_changed(L->v, &ch);
@@ -963,7 +963,7 @@ static int judge_serial(imc_state *S, lane *L, const objective *cur)
     }
     for (size_t k = 0; k < nch; k++) cell_put(S, ch[k], &L->b.nv[k]);
     L->nw = evaluate(S);
-    if (not_worse(&L->nw, cur)) return LANE_ACCEPT;
+    if (not_worse(&L->nw, cur) && L->nw.error <= cap) return LANE_ACCEPT;
     for (size_t k = nch; k-- > 0;) cell_put(S, ch[k], &L->b.undo[k]);
     return LANE_REJECT;
 }
@@ -1038,6 +1038,9 @@ typedef struct run_ctx {
     long best_step;
     double thr;                /* the threshold in force: p->threshold, tightened by ks_short */
     long first_at;             /* the step the params' threshold was first reached at (or -1) */
+    double cap;                /* from first_at on, p->threshold: no accepted move takes the
+                                * error back above it (the moves are judged on the descent,
+                                * which can fall while the error, a max, rises) */
 } run_ctx;
 
 static void round_fn(void *ctx, int tid)
@@ -1105,7 +1108,10 @@ static int ks_short(const imc_state *S, const gp_imc_params *p)
  * missed and the threshold has room (down to GP_IMC_KS_TIGHTEST of the params'). */
 static int at_threshold(run_ctx *C)
 {
-    if (C->first_at < 0) C->first_at = C->ro.steps;
+    if (C->first_at < 0) {
+        C->first_at = C->ro.steps;
+        C->cap = C->p->threshold;
+    }
     if (C->thr * GP_IMC_KS_TIGHTEN < C->p->threshold * GP_IMC_KS_TIGHTEST || !ks_short(C->S, C->p)) return 1;
     C->thr *= GP_IMC_KS_TIGHTEN;
     return 0;
@@ -1205,14 +1211,16 @@ static gp_status lane_commit(run_ctx *C, int w, int put, gp_error *err)
  * would have computed, lane_commit saw to that). */
 static int lane_outcome(run_ctx *C, lane *L, int after_win)
 {
-    if (L->out == LANE_SERIAL) return judge_serial(C->S, L, &C->cur);
-    if (after_win && (L->out == LANE_ACCEPT || L->out == LANE_REJECT)) {
+    if (L->out == LANE_SERIAL) return judge_serial(C->S, L, &C->cur, C->cap);
+    int out = L->out;
+    if (after_win && (out == LANE_ACCEPT || out == LANE_REJECT)) {
         const uint32_t *ch;
         size_t nch = gp_voronoi_changed(L->v, &ch);
         L->nw = evaluate_ad_if(C->S, ch, nch, L->b.nv, &L->b);
-        return not_worse(&L->nw, &C->cur) ? LANE_ACCEPT : LANE_REJECT;
+        out = not_worse(&L->nw, &C->cur) ? LANE_ACCEPT : LANE_REJECT;
     }
-    return L->out;
+    /* the lane was judged before the cap it is settled under (at_threshold) */
+    return out == LANE_ACCEPT && L->nw.error > C->cap ? LANE_REJECT : out;
 }
 
 /* A round's steps in order, as one thread would take them: each accepted step is committed
@@ -1416,7 +1424,8 @@ static gp_status run_steps(imc_state *S, const gp_imc_params *p, gp_voronoi *v, 
                            objective *cur, run_out *ro, gp_error *err)
 {
     run_ctx C = {.S = S, .p = p, .progress = progress, .user = user, .cancel = cancel, .cur = *cur,
-                 .ro = *ro, .thr = p->threshold, .first_at = -1};
+                 .ro = *ro, .thr = p->threshold, .first_at = -1,
+                 .cap = INFINITY};
     gp_status st = lanes_init(&C, v, J, err);
     if (st == GP_ERR_CANCELLED) {
         C.ro.why = GP_IMC_STOP_CANCELLED;

@@ -56,7 +56,9 @@
  * ks_goals (the default) a run at its threshold measures both distances (O(N log N), from the
  * values the statistics hold) and, while either misses its goal, goes on to 0.7 of the
  * threshold in force, down to a quarter of the params', for at most twice the steps (and at
- * least N) it took to reach the params'. It then stops for "threshold" whatever ends it. (bench_fit2d, three seeds a row: the worst area KS of a row was 0.23 of critical
+ * least N) it took to reach the params'; in that phase no move that lifts the error above the
+ * params' threshold is accepted (moves are judged on the descent, a sum, which can fall while
+ * the error, a max, rises). It then stops for "threshold" whatever ends it. (bench_fit2d, three seeds a row: the worst area KS of a row was 0.23 of critical
  * without it, 0.15 with it, for up to 3x the steps at N = 500 -- still under a second.)
  *
  * Step (d1-d5): take the next seed of a sweep along the seeds' order (the paper picks one at

@@ -277,6 +277,30 @@ static void ks_goals(size_t n, double cov, double aniso, int nseeds)
     CHECK(worst[1][0] <= 0.15 && worst[1][1] <= 0.3);
 }
 
+/* Past the threshold the KS phase accepts no move that takes the error back above it (moves are
+ * judged on the descent, a sum, which can fall while the error, a max, rises): this run first
+ * reaches 0.05 at step 1883, and a move at step 1888 used to lift the error to 0.0502, so that a
+ * max_steps of 1900 ended it "not converged". Checked on one and two threads. */
+static void ks_phase_keeps_threshold(void)
+{
+    for (int threads = 1; threads <= 2; threads++) {
+        gp_imc_params p;
+        gp_imc_params_defaults(&p);
+        p.cov = 0.8;
+        p.seed = 3;
+        p.max_steps = 1900;
+        p.threads = threads;
+        gp_voronoi *v = NULL;
+        gp_imc_report r;
+        gp_status st = run(SQ, 4, NULL, NULL, 0, 200, &p, &v, &r, "KS phase, max_steps 1900");
+        CHECK(st == GP_OK && r.stop_reason == GP_IMC_STOP_THRESHOLD && r.error <= p.threshold);
+        cell_stats c = cell_stats_of(v, &p);
+        CHECK(fmax(c.ad_size, c.ad_orient / 2) <= p.threshold * (1 + 1e-6));
+        gp_voronoi_destroy(v);
+        gp_imc_report_free(&r);
+    }
+}
+
 /* a hard case: converges, or stops at max_steps with the error not above the start */
 static void hard(const char *name, const gp_vec2 *outer, size_t no, const gp_vec2 *const *holes, const size_t *nh,
                  size_t nholes, size_t n, gp_imc_params *p)
@@ -616,6 +640,7 @@ int main(void)
     walls_untie(2000, 2);
     ks_goals(500, 1.2, 0.3, 8);
     ks_goals(200, 0.8, 1.0, 8);
+    ks_phase_keeps_threshold();
 
     gp_imc_params p;
     /* --- a wrong specimen that a histogram error passes: 4 equal-probability classes at
