@@ -204,6 +204,10 @@ void gpd_kind_names(char *buf, size_t n, const char *quote, const char *sep);
  * member `headline` (a number); particles and achieved are taken (NULL: null). */
 json_t *gpd_brief_new(const json_t *spec, const char *headline, json_t *particles,
                       json_t *achieved);
+/* The brief of a kind of one grain a cell (the Fourier-Voronoi kinds): the grains (the spec's
+ * count, or the one its sieve law derives, as the run will; once succeeded those the run made)
+ * and the solid fraction. */
+json_t *gpd_brief_cells(const json_t *spec, const json_t *stats);
 /* The brief of a stored job as text (malloc'ed; NULL when its kind is unknown here or its texts
  * do not parse): kind, its effective spec and, once it has succeeded, its result summary
  * (store_get_summary; NULL before). The store fills in the briefs of jobs stored by an older

@@ -113,6 +113,23 @@ json_t *gpd_brief_new(const json_t *spec, const char *headline, json_t *particle
                      "achieved", achieved ? achieved : json_null());
 }
 
+json_t *gpd_brief_cells(const json_t *spec, const json_t *stats)
+{
+    json_t *particles = NULL, *achieved = NULL;
+    if (stats) {
+        particles =
+            json_deep_copy(json_object_get(json_object_get(stats, "particles"), "achieved"));
+        achieved =
+            json_deep_copy(json_object_get(json_object_get(stats, "solid_fraction"), "achieved"));
+    } else {
+        gp_spec_bounds_t b;
+        gp_spec_problem p;
+        if (gp_spec_bounds(spec, &b, &p) == 0 && b.cells >= 1)
+            particles = json_integer((json_int_t)b.cells);
+    }
+    return gpd_brief_new(spec, "solid_fraction", particles, achieved);
+}
+
 char *gpd_brief_text(const char *kind, const char *spec, const char *summary)
 {
     const gpd_kind *k = gpd_kind_find(kind);

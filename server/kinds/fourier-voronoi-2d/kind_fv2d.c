@@ -470,25 +470,6 @@ static json_t *progress_detail(const gp_progress *p)
     return json_pack("{s:I, s:o}", "steps", (json_int_t)p->steps, "error", gpd_jreal(p->error));
 }
 
-/* The brief: the grains (the spec's count, or the one its sieve law derives, as the run will;
- * once succeeded the cells the run made, one grain each) and the solid fraction. */
-static json_t *brief(const json_t *spec, const json_t *stats)
-{
-    json_t *particles = NULL, *achieved = NULL;
-    if (stats) {
-        const json_t *n = json_object_get(json_object_get(stats, "particles"), "achieved");
-        particles = json_deep_copy(n);
-        achieved =
-            json_deep_copy(json_object_get(json_object_get(stats, "solid_fraction"), "achieved"));
-    } else {
-        gp_spec_bounds_t b;
-        gp_spec_problem p;
-        if (gp_spec_bounds(spec, &b, &p) == 0 && b.cells >= 1)
-            particles = json_integer((json_int_t)b.cells);
-    }
-    return gpd_brief_new(spec, "solid_fraction", particles, achieved);
-}
-
 /* ---- the progress plan (progress.h): seconds on one core, measured with
  * bench/bench_progress.py (10,000 grains of 128 points; the 3D kind's figures are of the same
  * run: together they give the machine's speed) ---- */
@@ -671,7 +652,7 @@ static const char *const phases[] = {"shape", "tessellation", "imc", "fill", "od
                                      "descriptors", "total", NULL};
 
 const gpd_kind gpd_kind_fv2d = {
-    .name = KIND_NAME, .example = example, .bounds = gp_spec_check_result, .brief = brief,
+    .name = KIND_NAME, .example = example, .bounds = gp_spec_check_result, .brief = gpd_brief_cells,
     GPD_KIND_CORE_OPS(gp_spec2d), .progress_detail = progress_detail,
     .plan = plan, .result_cost = result_cost, .result = result, .pack = pack,
     .done_detail = done_detail, .views = views, .export_dim = 2, .pack_what = "ODEC discs",

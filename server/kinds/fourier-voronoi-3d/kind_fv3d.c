@@ -67,25 +67,6 @@ static json_t *progress_detail(const gp_progress *p)
     return json_pack("{s:I, s:o}", "steps", (json_int_t)p->steps, "error", gpd_jreal(p->error));
 }
 
-/* The brief: the grains (the spec's count, or the one its sieve law derives, as the run will;
- * once succeeded those made) and the solid fraction. */
-static json_t *brief(const json_t *spec, const json_t *stats)
-{
-    json_t *particles = NULL, *achieved = NULL;
-    if (stats) {
-        particles =
-            json_deep_copy(json_object_get(json_object_get(stats, "particles"), "achieved"));
-        achieved =
-            json_deep_copy(json_object_get(json_object_get(stats, "solid_fraction"), "achieved"));
-    } else {
-        gp_spec_bounds_t b;
-        gp_spec_problem p;
-        if (gp_spec_bounds(spec, &b, &p) == 0 && b.cells >= 1)
-            particles = json_integer((json_int_t)b.cells);
-    }
-    return gpd_brief_new(spec, "solid_fraction", particles, achieved);
-}
-
 /* ---- the progress plan (progress.h): seconds on one core, measured on the development VM
  * (bench_imc3d's step rate; a 60- and a 1,000-grain job of the contract's example) ---- */
 #define COST_CELL_S 15e-6     /* a Voronoi cell ... */
@@ -188,7 +169,7 @@ static const char example[] =
 static const char *const phases[] = {"imc", "grains", "stats", "total", NULL};
 
 const gpd_kind gpd_kind_fv3d = {
-    .name = KIND_NAME, .example = example, .bounds = gp_spec_check_result, .brief = brief,
+    .name = KIND_NAME, .example = example, .bounds = gp_spec_check_result, .brief = gpd_brief_cells,
     GPD_KIND_CORE_OPS(gp_spec_fv3d), .progress_detail = progress_detail, .plan = plan,
     .result_cost = result_cost, .result = result, .pack = pack, .done_detail = done_detail,
     .views = views, .export_dim = GP_EXPORT_FV3D, .pack_what = "grains", .pack_output = "grains",
