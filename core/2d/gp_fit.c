@@ -55,7 +55,7 @@ static double ks_at(double d, double u, size_t i, size_t n)
     return d;
 }
 
-static double ks_of_sorted_u(const double *u, size_t n)
+double gp_fit_ks_uniform(const double *u, size_t n)
 {
     double d = 0;
     for (size_t i = 0; i < n; i++)
@@ -333,7 +333,7 @@ static gp_status area_measures(const double *x, size_t n, const gp_law *law, siz
         return GP_ERR_NOMEM;
     for (size_t i = 0; i < n; i++)
         u[i] = gp_law_cdf(law, x[i]);
-    out->ks = ks_of_sorted_u(u, n);
+    out->ks = gp_fit_ks_uniform(u, n);
     free(u);
     moments(x, n, &out->mean, &out->cov);
     out->min = x[0];
@@ -411,7 +411,7 @@ gp_status gp_fit_orient_measure(const double *theta_deg, size_t n, double mean_d
     for (size_t i = 0; i < n; i++)
         u[i] = gp_orient_cdf(mean_deg, anisotropy, theta_deg[i]);
     qsort(u, n, sizeof *u, cmp_double);
-    out->ks = ks_of_sorted_u(u, n);
+    out->ks = gp_fit_ks_uniform(u, n);
     free(u);
     out->present = 1;
     return GP_OK;

@@ -76,6 +76,10 @@ typedef struct gp_fit_passing {
 /* 5 % critical value of D: 1.36 / sqrt(n) (asymptotic; 0 for n = 0). */
 double gp_fit_ks_critical(size_t n);
 
+/* The two-sided KS distance to the uniform law of the ascending values u[0..n) in [0, 1] (the
+ * u_i = F(x_(i)) of a sample against its law's CDF F). */
+double gp_fit_ks_uniform(const double *u, size_t n);
+
 /* The two-sided KS distance of the ascending values x[0..n) to law's CDF (the ks that
  * gp_fit_area_measure reports, alone and without a copy). */
 double gp_fit_ks_sorted(const double *x, size_t n, const gp_law *law);

@@ -31,6 +31,7 @@
 
 #include "gp_adstat.h"
 #include "gp_clock.h"
+#include "gp_fit.h"
 #include "gp_rng.h"
 #include "gp_team.h"
 
@@ -52,15 +53,20 @@
  * figures in docs/design/imc.md). */
 #define GP_IMC_AD_THRESHOLD 0.05
 /* the KS goals a run at the default threshold stops on (gp_imc.h "Stopping"): fractions of the
- * 5 % critical value 1.36 / sqrt(N); the threshold tightened by 0.7 while they are missed, down
- * to 0.25 of the params' (at 0.05: 0.035, 0.0245, 0.01715), within twice the steps the params'
- * took (ks_budget_spent) */
-#define GP_IMC_KS_CRIT 1.36
+ * 5 % critical value 1.36 / sqrt(N) (gp_fit_ks_critical); the threshold tightened by 0.7 while
+ * they are missed, down to 0.25 of the params' (at 0.05: 0.035, 0.0245, 0.01715), within twice
+ * the steps the params' took (ks_budget_spent) */
 #define GP_IMC_KS_GOAL_SIZE 0.15
 #define GP_IMC_KS_GOAL_ORIENT 0.3
 #define GP_IMC_KS_TIGHTEN 0.7
 #define GP_IMC_KS_TIGHTEST 0.25
 #define GP_IMC_KS_EXTRA 2
+/* a default run that falls slowly towards its threshold while its cells already meet the KS
+ * goals (the orientations' with a margin) and the COV within GP_IMC_COV_GOAL stops as stalled
+ * (slow_at_goals): the rate is taken over at least max(GP_IMC_SLOW_LAG, N) steps */
+#define GP_IMC_COV_GOAL 0.01
+#define GP_IMC_SLOW_GOAL_ORIENT 0.25 /* the orientations' goal with the areas' margin (0.15 for 0.2) */
+#define GP_IMC_SLOW_LAG 8192
 /* the orientations' excess counts half in the error and the descent (gp_imc.h "Objective") */
 #define GP_IMC_ORIENT_WEIGHT 0.5
 
@@ -976,6 +982,7 @@ static int cancel_raised(const volatile int *cancel)
 typedef struct run_out {
     long steps, accepted;
     gp_imc_stop why;
+    int at_goals;              /* stalled by slow_at_goals */
     double error0;             /* the error at the first progress report; < 0 before */
 } run_out;
 
@@ -1041,6 +1048,8 @@ typedef struct run_ctx {
     double cap;                /* from first_at on, p->threshold: no accepted move takes the
                                 * error back above it (the moves are judged on the descent,
                                 * which can fall while the error, a max, rises) */
+    long slow_at;              /* slow_at_goals: the step of the error the rate is taken from */
+    double slow_error;         /* (or -1: none yet) and that error */
 } run_ctx;
 
 static void round_fn(void *ctx, int tid)
@@ -1083,25 +1092,40 @@ static void run_round(run_ctx *C)
 static double ks_uniform(double *u, size_t n)
 {
     qsort(u, n, sizeof *u, cmp_double);
-    double d = 0.0;
-    for (size_t i = 0; i < n; i++) d = fmax(d, fmax((i + 1.0) / n - u[i], u[i] - (double)i / n));
-    return d;
+    return gp_fit_ks_uniform(u, n);
+}
+
+/* 1 when the cells' KS distances, from the values the AD statistics hold, meet the goals the
+ * default threshold stands for (gp_imc.h "Stopping"), the orientations' as given; 0 when either
+ * misses; -1 when the check cannot be made (out of memory). AD runs of n >= 2 only. */
+static int ks_goals_met(const imc_state *S, double goal_orient)
+{
+    double *u = malloc(S->n * sizeof *u), crit = gp_fit_ks_critical(S->n);
+    if (!u) return -1;
+    for (size_t i = 0; i < S->n; i++) u[i] = exp(S->adv[i].sg);
+    int met = ks_uniform(u, S->n) <= GP_IMC_KS_GOAL_SIZE * crit;
+    for (size_t i = 0; met && i < S->n; i++) u[i] = S->adv[i].tk;
+    met = met && ks_uniform(u, S->n) <= goal_orient * crit;
+    free(u);
+    return met;
 }
 
 /* 1 when the run is at its threshold but the cells' KS distances miss the goals that threshold
- * stands for (gp_imc.h "Stopping"); 0 when they meet them, when the params ask for no check, or
- * when it cannot be made (out of memory: the run stops as it would without it). */
+ * stands for; 0 when they meet them, when the params ask for no check, or when it cannot be
+ * made (out of memory: the run stops as it would without it). */
 static int ks_short(const imc_state *S, const gp_imc_params *p)
 {
     if (!p->ks_goals || S->kind != GP_IMC_ERROR_AD || S->n < 2) return 0;
-    double *u = malloc(S->n * sizeof *u), crit = GP_IMC_KS_CRIT / sqrt((double)S->n);
-    if (!u) return 0;
-    for (size_t i = 0; i < S->n; i++) u[i] = exp(S->adv[i].sg);
-    int short_ = ks_uniform(u, S->n) > GP_IMC_KS_GOAL_SIZE * crit;
-    for (size_t i = 0; !short_ && i < S->n; i++) u[i] = S->adv[i].tk;
-    short_ = short_ || ks_uniform(u, S->n) > GP_IMC_KS_GOAL_ORIENT * crit;
-    free(u);
-    return short_;
+    return ks_goals_met(S, GP_IMC_KS_GOAL_ORIENT) == 0;
+}
+
+/* The cell areas' population COV within GP_IMC_COV_GOAL of the one aimed at (from the sum of
+ * squared areas the area statistic keeps). */
+static int cov_goal_met(const imc_state *S)
+{
+    double n = (double)S->n, var = gp_adstat_sum_extra(S->ads) / n - S->mu * S->mu;
+    double cov = sqrt(fmax(var, 0.0)) / S->mu;
+    return fabs(cov / S->cov_t - 1.0) <= GP_IMC_COV_GOAL;
 }
 
 /* At the threshold in force: 1 to stop; 0 to go on to a tighter one, while the KS goals are
@@ -1127,6 +1151,28 @@ static int ks_budget_spent(const run_ctx *C)
     return C->ro.steps - C->first_at > (extra > sweep ? extra : sweep);
 }
 
+/* A default run before its threshold, at a progress report: 1 when the error, falling at its
+ * rate since the last look (at least max(GP_IMC_SLOW_LAG, N) steps back), would take more steps
+ * than the run has made to reach the threshold, while the cells already meet the goals the
+ * default threshold stands for (the KS goals, and the COV: ks_goals_met, cov_goal_met). Near-
+ * regular cells (COV 0.1) meet them in a fifth of the steps the threshold takes, then creep
+ * towards it (docs/design/imc.md). Reads the run at a step boundary only: the same on any
+ * thread count. */
+static int slow_at_goals(run_ctx *C)
+{
+    const imc_state *S = C->S;
+    long s = C->ro.steps, lag = (long)S->n > GP_IMC_SLOW_LAG ? (long)S->n : GP_IMC_SLOW_LAG;
+    if (!C->p->ks_goals || S->kind != GP_IMC_ERROR_AD || S->n < 2 || C->first_at >= 0 ||
+        s == 0 || s % GP_IMC_PROGRESS_EVERY != 0)
+        return 0;
+    if (C->slow_at >= 0 && s - C->slow_at < lag) return 0;
+    double e = C->cur.error, done = C->slow_at >= 0 ? log(C->slow_error / e) : 0.0;
+    int slow = C->slow_at >= 0 && !(done * (double)s > log(e / C->p->threshold) * (double)(s - C->slow_at));
+    C->slow_at = s;
+    C->slow_error = e;
+    return slow && ks_goals_met(S, GP_IMC_SLOW_GOAL_ORIENT) == 1 && cov_goal_met(S);
+}
+
 /* The checks each step starts with, in step order; 1 when the run stops here (ro.why). Past
  * the params' threshold (a tightened one in force) the run stops for "threshold" whatever
  * ends it. */
@@ -1139,6 +1185,11 @@ static int stop_before_step(run_ctx *C)
     ro->why = stop_check(C->S, C->p, &C->cur, ro, &C->best, &C->best_step);
     if (ro->why != GP_IMC_STOP_THRESHOLD) {
         if (C->cur.error <= C->p->threshold && ro->why != GP_IMC_STOP_SINGLE_CELL) ro->why = GP_IMC_STOP_THRESHOLD;
+        return 1;
+    }
+    if (slow_at_goals(C)) {
+        ro->why = GP_IMC_STOP_STALLED;
+        ro->at_goals = 1;
         return 1;
     }
     if ((ro->steps % GP_IMC_CANCEL_EVERY) == 0 && cancel_raised(C->cancel)) {
@@ -1424,7 +1475,7 @@ static gp_status run_steps(imc_state *S, const gp_imc_params *p, gp_voronoi *v, 
                            objective *cur, run_out *ro, gp_error *err)
 {
     run_ctx C = {.S = S, .p = p, .progress = progress, .user = user, .cancel = cancel, .cur = *cur,
-                 .ro = *ro, .thr = p->threshold, .first_at = -1,
+                 .ro = *ro, .thr = p->threshold, .first_at = -1, .slow_at = -1,
                  .cap = INFINITY};
     gp_status st = lanes_init(&C, v, J, err);
     if (st == GP_ERR_CANCELLED) {
@@ -1442,8 +1493,12 @@ static gp_status run_steps(imc_state *S, const gp_imc_params *p, gp_voronoi *v, 
 static void end_message(gp_status *st, const run_out *ro, const gp_imc_params *p, double e, gp_error *err)
 {
     if (*st != GP_OK) return;
-    if (ro->why == GP_IMC_STOP_MAX_STEPS || ro->why == GP_IMC_STOP_STALLED ||
-        ro->why == GP_IMC_STOP_SINGLE_CELL)
+    if (ro->at_goals)
+        *st = gp_error_set(err, GP_ERR_NOT_CONVERGED, "imc: stalled after %ld steps without reaching %g "
+                           "(error %g), falling slowly with the cells within the KS goals it stands for",
+                           ro->steps, p->threshold, e);
+    else if (ro->why == GP_IMC_STOP_MAX_STEPS || ro->why == GP_IMC_STOP_STALLED ||
+             ro->why == GP_IMC_STOP_SINGLE_CELL)
         *st = gp_error_set(err, GP_ERR_NOT_CONVERGED, "imc: %s after %ld steps without reaching %g (error %g)",
                            gp_imc_stop_name(ro->why), ro->steps, p->threshold, e);
     else if (ro->why == GP_IMC_STOP_CANCELLED)
@@ -1470,7 +1525,7 @@ gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *
     memset(&S, 0, sizeof S);
     gp_voronoi *v = NULL;
     gp_law *own_law = NULL;
-    run_out ro = {0, 0, GP_IMC_STOP_MAX_STEPS, -1.0};
+    run_out ro = {0, 0, GP_IMC_STOP_MAX_STEPS, 0, -1.0};
     if (!seeds) {
         st = gp_error_set(err, GP_ERR_NOMEM, "imc: out of memory");
         goto done;
@@ -1524,6 +1579,7 @@ gp_status gp_imc_run(const gp_vec2 *outer, size_t nouter, const gp_vec2 *const *
         rep->accepted = ro.accepted;
         rep->error = cur.error;
         rep->stop_reason = ro.why;
+        rep->at_goals = ro.at_goals;
         if (fill_report(rep, &S, p) != GP_OK) {
             gp_imc_report_free(rep);
             st = gp_error_set(err, GP_ERR_NOMEM, "imc: out of memory");

@@ -910,6 +910,7 @@ static gp_status run_imc(build_ctx *b, const gp_vec2 *seeds, gp_error *err)
         out->imc_error_floor = rep.floor;
         out->imc_wall_ties = rep.wall_ties;
         out->imc_error_ties = 0.5 * rep.error_orient_ties;
+        out->imc_at_goals = rep.at_goals;
         out->imc_threshold = spec->imc_threshold;
         out->imc_error_kind = error_kind_name(spec->imc_error);
         hist_free(&out->size_hist);
@@ -1587,20 +1588,29 @@ static void warn_fit_area(gp_specimen2d *out, const char *what, const gp_fit_are
 /* The IMC stopped above its threshold. Near-regular cells (COV 0.1 and less) against a long
  * straight wall have their thinnest side across it and share its direction, a tie that no move
  * undoes without spoiling the areas (a 256-gon reaches the threshold where the square stalls:
- * docs/design/imc.md); when the ties carry a quarter of the error or more the warning says so. */
+ * docs/design/imc.md); when the ties carry a quarter of the error or more the warning says so.
+ * A default run that stalled with its cells within the KS goals (gp_imc.h "Stopping") says so,
+ * with their KS distances as measured on the cells. */
 static void warn_imc(gp_specimen2d *out)
 {
+    char goals[200] = "";
+    const gp_fit_area *a = &out->fit.cell_area;
+    const gp_fit_orient *o = &out->fit.cell_orientation;
+    if (out->imc_at_goals && a->present && o->present && a->ks_critical > 0)
+        snprintf(goals, sizeof goals, ", falling slowly with the cells within the KS goals the "
+                 "threshold stands for (areas %.3f, orientations %.3f of the critical value)",
+                 a->ks / a->ks_critical, o->ks / o->ks_critical);
     if (out->imc_error_ties >= 0.25 * out->imc_error)
         warn(out, "imc: the error %.4g (%s) is above the threshold %.4g: the run stopped (%s) "
-                  "after %ld steps; %zu cells have their thinnest side along a straight wall and "
+                  "after %ld steps%s; %zu cells have their thinnest side along a straight wall and "
                   "share its direction (%.4g of the error): near-regular cells against long "
                   "straight walls do",
              out->imc_error, out->imc_error_kind, out->imc_threshold, out->imc_stop_reason,
-             out->imc_steps, out->imc_wall_ties, out->imc_error_ties);
+             out->imc_steps, goals, out->imc_wall_ties, out->imc_error_ties);
     else
         warn(out, "imc: the error %.4g (%s) is above the threshold %.4g: the run stopped (%s) "
-                  "after %ld steps", out->imc_error, out->imc_error_kind, out->imc_threshold,
-             out->imc_stop_reason, out->imc_steps);
+                  "after %ld steps%s", out->imc_error, out->imc_error_kind, out->imc_threshold,
+             out->imc_stop_reason, out->imc_steps, goals);
 }
 
 static void warn_fit_orient(gp_specimen2d *out, const char *what, const gp_fit_orient *f)

@@ -282,6 +282,8 @@ typedef struct gp_specimen2d {
                                  * shared with another (gp_imc_report.wall_ties) */
     double imc_error_ties;      /* AD: their share of the error (half their term: the
                                  * orientations count half) */
+    int imc_at_goals;           /* AD: stalled with the cells within the KS goals the default
+                                 * threshold stands for (gp_imc_report.at_goals) */
     gp_fit2d fit;               /* measured on the cells and grains themselves */
     char **warnings;            /* nwarnings one-line messages: a target not reached, and how
                                  * close it came (IMC threshold, fit beyond its KS critical

@@ -277,6 +277,48 @@ static void ks_goals(size_t n, double cov, double aniso, int nseeds)
     CHECK(worst[1][0] <= 0.15 && worst[1][1] <= 0.3);
 }
 
+/* Near-regular cells meet the goals the default threshold stands for long before the threshold:
+ * over seeds 1 .. nseeds at N = 500, COV 0.1, runs without the check (ks_goals 0) reach the
+ * threshold in 92,000-215,000 steps; default runs stop on the slow descent (gp_imc.h
+ * "Stopping") in a fraction of that, as stalled, with the areas' KS distance within 0.15 and the
+ * orientations' within 0.25 of the critical value and the COV within 1 % (all recomputed here
+ * from the cells). */
+static void slow_at_goals(size_t n, double cov, int nseeds)
+{
+    double crit = 1.36 / sqrt((double)n), worst[3] = {0, 0, 0};
+    long steps[2] = {0, 0};
+    int stalled = 0;
+    for (int g = 0; g < 2; g++)
+        for (int seed = 1; seed <= nseeds; seed++) {
+            gp_imc_params p;
+            gp_imc_params_defaults(&p);
+            p.cov = cov;
+            p.seed = (uint64_t)seed;
+            p.ks_goals = g;
+            gp_voronoi *v = NULL;
+            gp_imc_report r;
+            gp_status st = run(SQ, 4, NULL, NULL, 0, n, &p, &v, &r, g ? "  default" : "  without the goals");
+            CHECK(g ? st == GP_OK || st == GP_ERR_NOT_CONVERGED : st == GP_OK);
+            if (!g) CHECK(r.stop_reason == GP_IMC_STOP_THRESHOLD);
+            stalled += g && r.stop_reason == GP_IMC_STOP_STALLED;
+            steps[g] += r.steps;
+            if (g && v) {
+                cell_stats c = cell_stats_of(v, &p);
+                worst[0] = fmax(worst[0], c.ks / crit);
+                worst[1] = fmax(worst[1], c.ks_orient / crit);
+                worst[2] = fmax(worst[2], fabs(c.cov / cov - 1));
+            }
+            gp_voronoi_destroy(v);
+            gp_imc_report_free(&r);
+        }
+    printf("slow at the goals, N %zu, COV %.2f, seeds 1-%d: %ld steps to the threshold, %ld by default "
+           "(%d stalled); worst area / orientation KS of critical %.3f / %.3f, COV off by %.2f %%\n", n, cov,
+           nseeds, steps[0], steps[1], stalled, worst[0], worst[1], 100 * worst[2]);
+    CHECK(stalled > 0);
+    CHECK(3 * steps[1] < steps[0]);
+    CHECK(worst[0] <= 0.15 && worst[1] <= 0.25 && worst[2] <= 0.01);
+}
+
 /* Past the threshold the KS phase accepts no move that takes the error back above it (moves are
  * judged on the descent, a sum, which can fall while the error, a max, rises): this run first
  * reaches 0.05 at step 1883, and a move at step 1888 used to lift the error to 0.0502, so that a
@@ -634,13 +676,13 @@ int main(void)
     converge(GP_IMC_ERROR_AD, 500, 0.8, 1.0, 0.0, 0, 1000000, "AD: config 1 (cov 0.8, a 1)");
     converge(GP_IMC_ERROR_AD, 500, 0.2, 0.1, 0.0, 1, 1000000, "AD: config 2 (cov 0.2, a 0.1)");
     converge(GP_IMC_ERROR_AD, 2000, 1.2, 0.3, 30.0, 0, 1000000, "AD: N 2000 (cov 1.2, a 0.3)");
-    converge(GP_IMC_ERROR_AD, 500, 0.1, 1.0, 0.0, 0, 1000000, "AD: cov 0.1");
 
     walls_untie(500, 1);
     walls_untie(2000, 2);
     ks_goals(500, 1.2, 0.3, 8);
     ks_goals(200, 0.8, 1.0, 8);
     ks_phase_keeps_threshold();
+    slow_at_goals(500, 0.1, 3);
 
     gp_imc_params p;
     /* --- a wrong specimen that a histogram error passes: 4 equal-probability classes at
