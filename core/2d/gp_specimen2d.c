@@ -1564,7 +1564,7 @@ static gp_status fit_report(build_ctx *b, gp_error *err)
 static void warn(gp_specimen2d *out, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void warn(gp_specimen2d *out, const char *fmt, ...)
 {
-    char buf[GP_ERROR_MESSAGE_MAX];
+    char buf[2 * GP_ERROR_MESSAGE_MAX]; /* the IMC's can name the run, the goals and the walls */
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
@@ -1597,8 +1597,8 @@ static void warn_imc(gp_specimen2d *out)
     const gp_fit_area *a = &out->fit.cell_area;
     const gp_fit_orient *o = &out->fit.cell_orientation;
     if (out->imc_at_goals && a->present && o->present && a->ks_critical > 0)
-        snprintf(goals, sizeof goals, ", falling slowly with the cells within the KS goals the "
-                 "threshold stands for (areas %.3f, orientations %.3f of the critical value)",
+        snprintf(goals, sizeof goals, ", falling slowly with the cells within its KS goals "
+                 "(areas %.3f, orientations %.3f of critical)",
                  a->ks / a->ks_critical, o->ks / o->ks_critical);
     if (out->imc_error_ties >= 0.25 * out->imc_error)
         warn(out, "imc: the error %.4g (%s) is above the threshold %.4g: the run stopped (%s) "

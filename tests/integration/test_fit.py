@@ -29,6 +29,7 @@ The daemon's own report (`stats.fit`, `warnings`) is then held to those numbers.
 Prints a table of what was measured (N, COV, a, KS vs critical, COV error, steps, seconds).
 """
 import json
+import re
 import math
 import os
 import sys
@@ -261,6 +262,15 @@ def test_grid(env):
         if m["mism"]:
             why.append("%d cells' orientation_deg differ from their min-caliper direction"
                        % m["mism"])
+        if r["stats"]["imc_error"]["stop_reason"] == "stalled" and cov <= 0.1:
+            # near-regular cells stop before the threshold once within the KS goals, and the
+            # warning quotes the cells' KS: the figures this test measured from the polygons
+            got = [re.search(r"within its KS goals \(areas ([0-9.]+), orientations ([0-9.]+) "
+                             r"of critical\)", w) for w in r["warnings"]]
+            got = [g for g in got if g]
+            want = (m["ks_area"] / m["crit"], m["ks_orient"] / m["crit"])
+            if len(got) != 1 or any(abs(float(g) - x) > 0.0015 for g, x in zip(got[0].groups(), want)):
+                why.append("the warnings do not quote KS %.3f / %.3f: %s" % (want + (r["warnings"],)))
         if why:
             bad.append(((n, cov, a), why, r["stats"]["imc_error"], r["warnings"]))
         if m["amb"]:
