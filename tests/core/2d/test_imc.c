@@ -457,6 +457,7 @@ static void threads_agree(const char *name, const gp_vec2 *outer, size_t no, con
     CHECK(r[0].accepted > 50);
     if (cancel) CHECK(r[0].stop_reason == GP_IMC_STOP_CANCELLED && r[0].steps == 8192);
     else if (max_steps < 100000) CHECK(r[0].stop_reason == GP_IMC_STOP_MAX_STEPS && r[0].steps == max_steps);
+    else if (cov <= 0.1) CHECK(r[0].stop_reason == GP_IMC_STOP_STALLED && r[0].at_goals); /* slow_at_goals */
     else CHECK(r[0].stop_reason == GP_IMC_STOP_THRESHOLD);
     for (int t = 0; t < 3; t++) {
         gp_voronoi_destroy(v[t]);
@@ -944,6 +945,7 @@ int main(void)
         threads_agree("threads: square, max_steps", SQ, 4, NULL, NULL, 0, 500, 0.1, 15001, 0);
         threads_agree("threads: annulus, cancel at 8192", c, nc, holes, &nh, 1, 300, 0.8, 1000000, 1);
         threads_agree("threads: L-shape, threshold", L, 6, NULL, NULL, 0, 400, 0.5, 1000000, 0);
+        threads_agree("threads: square, stalled at the goals", SQ, 4, NULL, NULL, 0, 500, 0.1, 1000000, 0);
         even_in_space();
         free(c);
         free(h);
