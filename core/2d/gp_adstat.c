@@ -646,6 +646,15 @@ static void find_blocks(const gp_adstat *s, size_t k, const size_t *ids, const d
     }
 }
 
+void gp_adstat_warm(const gp_adstat *s, const uint32_t *ids, size_t m)
+{
+    for (size_t j = 0; s && j < m; j++)
+        if (ids[j] < s->cap) {
+            __builtin_prefetch(&s->el[ids[j]]);
+            __builtin_prefetch(&s->xt[s->P + ids[j]]);
+        }
+}
+
 double gp_adstat_a2_if(const gp_adstat *s, size_t k, const size_t *ids, const double *key,
                        const double *g, const double *h, const double *extra, double *sum_extra)
 {

@@ -45,6 +45,7 @@
 #define GP_ADSTAT_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "gp_error.h"
 
@@ -85,6 +86,10 @@ double gp_adstat_sum_extra(const gp_adstat *s);
 double gp_adstat_a2_if(const gp_adstat *s, size_t k, const size_t *ids, const double *key,
                        const double *g, const double *h, const double *extra,
                        double *sum_extra);
+
+/* Asks the memory for the records of the m elements ids[] (those present): for a caller that
+ * knows which elements it will query or set soon. Reads only. */
+void gp_adstat_warm(const gp_adstat *s, const uint32_t *ids, size_t m);
 
 /* Recomputes every count and sum from the elements (exactly: they are integers) and checks the
  * structure's invariants (order, block sizes and balance, directory, chunk sums, Fenwick tree,

@@ -847,12 +847,14 @@ static int propose_anywhere(const gp_voronoi *v, gsl_rng *rng, const double *box
  * be accepted near convergence, short moves fine-tune, and jumps take a seed out of a crowd to
  * another region: without them the few largest cells of a wide law are never formed
  * (docs/design/imc.md). */
+#define GP_IMC_JUMP_FROM 0.8 /* a step whose first draw is at least this jumps */
+
 static int propose_ad(const gp_voronoi *v, gsl_rng *rng, size_t i, step_buf *b, const double *box,
                       gp_vec2 *q)
 {
     double r = gsl_rng_uniform(rng);
     if (r < 0.4) return propose(v, rng, i, b, q);
-    if (r >= 0.8) return propose_anywhere(v, rng, box, q);
+    if (r >= GP_IMC_JUMP_FROM) return propose_anywhere(v, rng, box, q);
     if (gp_voronoi_sample_cell(v, i, u01, rng, q) != 0) return 1;
     gp_vec2 s = gp_voronoi_seed(v, i);
     double lam = gsl_rng_uniform(rng);
@@ -1050,6 +1052,8 @@ typedef struct run_ctx {
                                 * which can fall while the error, a max, rises) */
     long slow_at;              /* slow_at_goals: the step of the error the rate is taken from */
     double slow_error;         /* (or -1: none yet) and that error */
+    gsl_rng *warm_rng;         /* warm_ahead (NULL: not at this N) */
+    long warm_next;            /* the first step whose jump it has not warmed */
 } run_ctx;
 
 static void round_fn(void *ctx, int tid)
@@ -1328,6 +1332,41 @@ static void number_lanes(run_ctx *C)
     for (int t = 0; t < C->nr; t++) C->lanes[t].step = C->ro.steps + 1 + t;
 }
 
+/* A jump (propose_ad) lands anywhere in the container: at large N in cells that no recent step
+ * touched, whose records, vertices and neighbour lists, and the run's values of them, are far
+ * from every cache; a jump then costs about 16 us more than a move among neighbours at
+ * N = 100,000 (bench_imc). Where each step's jump lands is known ahead -- its stream is named
+ * by its number (step_rng_set) and the point is its first draws after the one that chose the
+ * jump, whatever the tessellation -- so the run asks the memory for those cells
+ * GP_IMC_WARM_AHEAD steps before, GP_IMC_WARM_BATCH steps at once (gp_voronoi_warm). Only
+ * the speed depends on it: it reads, and only the run's own replica (lane 0). */
+#define GP_IMC_WARM_CELLS 20000 /* from this N on: below it the cells stay in the caches */
+#define GP_IMC_WARM_AHEAD 32
+#define GP_IMC_WARM_BATCH 16
+
+static void warm_ahead(run_ctx *C)
+{
+    if (!C->warm_rng) return;
+    const imc_state *S = C->S;
+    while (C->warm_next <= C->ro.steps + 1 + GP_IMC_WARM_AHEAD) {
+        gp_vec2 q[GP_IMC_WARM_BATCH];
+        size_t k = 0;
+        for (long t = C->warm_next; t < C->warm_next + GP_IMC_WARM_BATCH; t++) {
+            step_rng_set(C->warm_rng, C->p->seed, t);
+            if (gsl_rng_uniform(C->warm_rng) < GP_IMC_JUMP_FROM) continue;
+            q[k].x = S->box[0] + (S->box[2] - S->box[0]) * gsl_rng_uniform(C->warm_rng);
+            q[k].y = S->box[1] + (S->box[3] - S->box[1]) * gsl_rng_uniform(C->warm_rng);
+            k++;
+        }
+        C->warm_next += GP_IMC_WARM_BATCH;
+        uint32_t ids[GP_IMC_WARM_BATCH * 16];
+        size_t m = gp_voronoi_warm(C->lanes[0].v, q, k, ids, sizeof ids / sizeof ids[0]);
+        for (size_t j = 0; j < m; j++) __builtin_prefetch(&S->adv[ids[j]]);
+        gp_adstat_warm(S->ads, ids, m);
+        gp_adstat_warm(S->adt, ids, m);
+    }
+}
+
 static gp_status run_loop(run_ctx *C, gp_error *err)
 {
     gp_status st = GP_OK;
@@ -1337,6 +1376,7 @@ static gp_status run_loop(run_ctx *C, gp_error *err)
     C->stretch = 2; /* the first stretch (probe alone) starts at step 0 */
     C->stretch_end = 0;
     do {
+        warm_ahead(C);
         number_lanes(C);
         run_round(C);
     } while (!settle_round(C, &st, err));
@@ -1476,7 +1516,8 @@ static gp_status run_steps(imc_state *S, const gp_imc_params *p, gp_voronoi *v, 
 {
     run_ctx C = {.S = S, .p = p, .progress = progress, .user = user, .cancel = cancel, .cur = *cur,
                  .ro = *ro, .thr = p->threshold, .first_at = -1, .slow_at = -1,
-                 .cap = INFINITY};
+                 .cap = INFINITY, .warm_next = 1};
+    if (S->kind == GP_IMC_ERROR_AD && S->n >= GP_IMC_WARM_CELLS) C.warm_rng = gsl_rng_alloc(gsl_rng_taus2);
     gp_status st = lanes_init(&C, v, J, err);
     if (st == GP_ERR_CANCELLED) {
         C.ro.why = GP_IMC_STOP_CANCELLED;
@@ -1485,6 +1526,7 @@ static gp_status run_steps(imc_state *S, const gp_imc_params *p, gp_voronoi *v, 
         st = run_loop(&C, err);
     }
     lanes_free(&C);
+    if (C.warm_rng) gsl_rng_free(C.warm_rng);
     *cur = C.cur;
     *ro = C.ro;
     return st;

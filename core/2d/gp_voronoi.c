@@ -2403,6 +2403,54 @@ gp_status gp_voronoi_apply(gp_voronoi *dst, const gp_voronoi *src, gp_error *err
     return GP_OK;
 }
 
+/* a cell's arrays a move reads: its vertices and their tags, its neighbours */
+static void warm_cell(const vcell *c)
+{
+    __builtin_prefetch(c->v);
+    __builtin_prefetch((const char *)c->v + 64);
+    __builtin_prefetch(c->tag);
+    __builtin_prefetch(c->nb);
+}
+
+/* Level by level over the k points, so that each level's loads overlap: the bins, a seed of
+ * each, its record, its arrays, its neighbours' records and arrays. */
+size_t gp_voronoi_warm(const gp_voronoi *v, const gp_vec2 *q, size_t k, uint32_t *ids, size_t cap)
+{
+    int32_t b[GP_VORONOI_WARM_MAX], k0[GP_VORONOI_WARM_MAX];
+    if (!v || v->n == 0) return 0;
+    if (k > GP_VORONOI_WARM_MAX) k = GP_VORONOI_WARM_MAX;
+    for (size_t i = 0; i < k; i++) {
+        gp_vec2 p = {q[i].x - v->origin.x, q[i].y - v->origin.y};
+        b[i] = p.x >= 0 && p.x <= v->W && p.y >= 0 && p.y <= v->H ? bin_of(v, p) : -1;
+        if (b[i] >= 0) __builtin_prefetch(&v->bins[b[i]]);
+    }
+    for (size_t i = 0; i < k; i++) {
+        const vbin *B = b[i] >= 0 ? &v->bins[b[i]] : NULL;
+        k0[i] = B && B->cnt > 0 ? (B->s ? B->s : B->inl)[0] : -1;
+        if (k0[i] >= 0) __builtin_prefetch(&v->cell[k0[i]]);
+    }
+    for (size_t i = 0; i < k; i++)
+        if (k0[i] >= 0) __builtin_prefetch(v->cell[k0[i]]);
+    size_t m = 0;
+    for (size_t i = 0; i < k; i++) {
+        if (k0[i] < 0) continue;
+        const vcell *c = v->cell[k0[i]];
+        warm_cell(c);
+        if (m < cap) ids[m++] = (uint32_t)k0[i];
+        for (int32_t j = 0; j < c->nnb && m < cap; j++) {
+            int32_t t = c->nb[j];
+            __builtin_prefetch(&v->cell[t]);
+            __builtin_prefetch(&v->seed[t]);
+            __builtin_prefetch(&v->kst[t]);
+            __builtin_prefetch(&v->cst[t]);
+            ids[m++] = (uint32_t)t;
+        }
+    }
+    for (size_t j = 0; j < m; j++) __builtin_prefetch(v->cell[ids[j]]);
+    for (size_t j = 0; j < m; j++) warm_cell(v->cell[ids[j]]);
+    return m;
+}
+
 size_t gp_voronoi_footprint(const gp_voronoi *v, uint32_t *out, size_t cap)
 {
     if (!v || !v->pending) return 0;

@@ -135,6 +135,17 @@ gp_status gp_voronoi_apply(gp_voronoi *dst, const gp_voronoi *src, gp_error *err
  * test_voronoi's side-by-side moves pass with that too -- but that is not argued here.) */
 size_t gp_voronoi_footprint(const gp_voronoi *v, uint32_t *out, size_t cap);
 
+/* Asks the memory for what moves of seeds to the k points q[] (container coordinates; k <=
+ * GP_VORONOI_WARM_MAX) would read there: the cell of a seed near each point and its
+ * neighbours (their records, vertices, neighbour lists, seeds). Reads only, and only what a
+ * prefetch needs: nothing changes, so a caller that knows where its next moves go can ask
+ * ahead and find those cells in the caches when it moves (a move far away in a large
+ * tessellation otherwise waits on the memory for every cell it touches). Writes the cells
+ * warmed into ids (at most cap) for the caller's own per-cell data and returns their count.
+ * Not during a pending move's commit or rollback by another thread. */
+#define GP_VORONOI_WARM_MAX 16
+size_t gp_voronoi_warm(const gp_voronoi *v, const gp_vec2 *q, size_t k, uint32_t *ids, size_t cap);
+
 /* A point uniformly distributed in cell i (all parts), drawn with u01() (uniform in [0, 1),
  * called a variable number of times). Returns 0 and the point in *p, or -1 if 1000 rejection
  * attempts in a very thin part all failed (then *p is the seed). */

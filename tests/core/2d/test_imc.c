@@ -946,6 +946,8 @@ int main(void)
         threads_agree("threads: annulus, cancel at 8192", c, nc, holes, &nh, 1, 300, 0.8, 1000000, 1);
         threads_agree("threads: L-shape, threshold", L, 6, NULL, NULL, 0, 400, 0.5, 1000000, 0);
         threads_agree("threads: square, stalled at the goals", SQ, 4, NULL, NULL, 0, 500, 0.1, 1000000, 0);
+        /* from 20,000 cells on the run warms its jumps' cells ahead (gp_imc.c warm_ahead): reads only */
+        threads_agree("threads: square, N 20000, jumps warmed", SQ, 4, NULL, NULL, 0, 20000, 0.8, 3000, 0);
         even_in_space();
         free(c);
         free(h);
