@@ -22,14 +22,21 @@
  * where tied keys have equal g and h.
  *
  * Structure (gp_adstat.c): the elements in (key, id) order in blocks of at most 32 (keys, ids,
- * fixed w's, and chunk prefix sums of the w's), a directory of the blocks' first keys, and a
- * Fenwick tree of the blocks' counts and w-sums: a query is two short binary searches in
- * contiguous arrays and a Fenwick prefix -- a few cache lines, where a pointer tree walks
- * ~log2 N nodes spread over the heap. Blocks split when full and merge with a neighbour when
- * the two hold <= 20, so there are at most 2N / 21 + 1 of them; the pool for that is
- * allocated at create (calloc: untouched pages cost nothing) and nothing is allocated after.
- * The sum of extras is kept in a segment tree of fixed shape over ids (a function of the set
- * as well, in floating point).
+ * fixed w's, and chunk prefix sums of the w's), and a directory of the blocks in two levels:
+ * pages of up to 32 blocks (first keys, and the count and w-sum before each block in the
+ * page) and a page table in key order (first keys) with a Fenwick tree of the pages' counts
+ * and w-sums. Finding a key is a search in the page table (a few KB) and one in a page's keys;
+ * a present element's block is recorded with it, and a block's page and place in the page,
+ * so finding it needs no search. A query is then a search in a block, a Fenwick prefix over
+ * pages and one in-page prefix -- a few cache lines, where a pointer tree walks ~log2 N nodes
+ * spread over the heap -- and a change of a block's count or w-sum costs at most a page's
+ * prefixes and a Fenwick update: no operation costs more than O(sqrt(N)) in the directory.
+ * Blocks split when full and merge with a neighbour when the two hold <= 20, so there are at
+ * most 2N / 21 + 1 of them; pages split when full and merge when two neighbours hold <= 16
+ * blocks, so there are at most 2 blocks / 17 + 1 of them. The pools for both are allocated at
+ * create (untouched pages of memory cost nothing) and nothing is allocated after. The sum of
+ * extras is kept in a segment tree of fixed shape over ids (a function of the set as well, in
+ * floating point).
  *
  * The caller passes g and h with u, computed where they are accurate (ln F and ln(1 - F) from
  * the law, gp_law_log_cdf_sf), so that values deep in a tail keep their weight.
@@ -39,7 +46,8 @@
  *
  * Ownership: one object per statistic; not thread-safe (one writer). No global state.
  * Memory: about 90 bytes per element of capacity (per-id record 32, extras' tree 16-32, blocks
- * ~30 at their usual fill). Why blocks and not a balanced tree: docs/design/adstat.md.
+ * ~30 and their directory ~3 at their usual fill). Why blocks and not a balanced tree, and why
+ * the directory has two levels: docs/design/adstat.md.
  */
 #ifndef GP_ADSTAT_H
 #define GP_ADSTAT_H
@@ -92,9 +100,10 @@ double gp_adstat_a2_if(const gp_adstat *s, size_t k, const size_t *ids, const do
 void gp_adstat_warm(const gp_adstat *s, const uint32_t *ids, size_t m);
 
 /* Recomputes every count and sum from the elements (exactly: they are integers) and checks the
- * structure's invariants (order, block sizes and balance, directory, chunk sums, Fenwick tree,
- * the extras' tree). 0 when all hold, else the number of the first failed check. O(n + capacity);
- * for tests. */
+ * structure's invariants (order, block sizes and balance, chunk sums, the directory: page sizes
+ * and balance, page order, first keys, in-page and Fenwick prefixes, the records of where each
+ * element and block is; the extras' tree). 0 when all hold, else the number of the first failed
+ * check. O(n + capacity); for tests. */
 int gp_adstat_check(const gp_adstat *s);
 
 /* The least A^2 that n values can have. */

@@ -378,6 +378,85 @@ static void test_structure(void)
     free(m.on);
 }
 
+/* Many directory pages (50,000 elements: ~2,000 blocks in pages of up to 32): filled in random
+ * order, churned by removes, small moves and jumps, thinned to a twentieth (pages merge), a
+ * sorted run into one narrow range (one page splits again and again), then emptied; the
+ * structure recounts itself (gp_adstat_check) and A^2 is checked against the brute force at
+ * intervals, and the what-if against the change bit for bit. */
+static void test_many_pages(void)
+{
+    const size_t n = 50000, cap = 60000;
+    mirror m = {cap, calloc(cap, sizeof(double)), calloc(cap, sizeof(double)), calloc(cap, sizeof(int))};
+    gp_adstat *s = gp_adstat_create(cap, NULL);
+    int ok = 1;
+    for (size_t i = 0; i < n; i++) {
+        put(s, &m, below(cap), unif(), unif());
+        if (i % 5000 == 4999) check_against(s, &m);
+    }
+    for (size_t t = 0; t < 200000; t++) {
+        size_t id = below(cap), r = below(10);
+        if (r < 2) {
+            gp_adstat_remove(s, id);
+            m.on[id] = 0;
+        } else if (r < 6 && m.on[id]) {
+            double u = m.u[id] * (1 + 1e-3 * (unif() - 0.5));
+            put(s, &m, id, u < 1 ? u : m.u[id], unif());
+        } else {
+            put(s, &m, id, unif(), unif());
+        }
+        if (t % 2500 == 0) ok &= gp_adstat_check(s) == 0;
+        if (t % 20000 == 0) check_against(s, &m);
+    }
+    check_against(s, &m);
+    size_t ids[GP_ADSTAT_IF_MAX];
+    double key[GP_ADSTAT_IF_MAX], g[GP_ADSTAT_IF_MAX], h[GP_ADSTAT_IF_MAX], x[GP_ADSTAT_IF_MAX];
+    int same = 1;
+    for (int round = 0; round < 50; round++) { /* the what-if, far and near moves */
+        size_t k = 0;
+        for (size_t id = below(cap); k < 16; id = (id + 1 + below(997)) % cap) {
+            int dup = 0;
+            for (size_t j = 0; j < k; j++) dup |= ids[j] == id;
+            if (!m.on[id] || dup) continue;
+            double u = k % 2 ? unif() : fmin(fmax(m.u[id] + 1e-4 * (unif() - 0.5), 1e-9), 1 - 1e-9);
+            ids[k] = id;
+            key[k] = u;
+            g[k] = log(u);
+            h[k] = log1p(-u);
+            x[k++] = unif();
+        }
+        double judged = gp_adstat_a2_if(s, k, ids, key, g, h, x, NULL);
+        for (size_t i = 0; i < k; i++) put(s, &m, ids[i], key[i], x[i]);
+        same &= same_bits(judged, gp_adstat_a2(s));
+    }
+    CHECK(same);
+    check_against(s, &m);
+    for (size_t id = 0; id < cap; id++) /* thinned out: pages merge */
+        if (m.on[id] && below(20) != 0) {
+            gp_adstat_remove(s, id);
+            m.on[id] = 0;
+            if (id % 1000 == 0) ok &= gp_adstat_check(s) == 0;
+        }
+    check_against(s, &m);
+    for (size_t i = 0, id = 0; i < 20000; id++) /* a sorted run into (0.4, 0.4 + 1e-6) */
+        if (!m.on[id]) {
+            put(s, &m, id, 0.4 + 1e-6 * (double)i++ / 20000.0, 1.0);
+            if (i % 2000 == 0) ok &= gp_adstat_check(s) == 0;
+        }
+    check_against(s, &m);
+    for (size_t id = 0; id < cap; id++) {
+        gp_adstat_remove(s, id);
+        m.on[id] = 0;
+        if (id % 3000 == 0) ok &= gp_adstat_check(s) == 0;
+    }
+    check_against(s, &m);
+    CHECK(ok);
+    CHECK(gp_adstat_count(s) == 0 && gp_adstat_a2(s) == 0.0);
+    gp_adstat_destroy(s);
+    free(m.u);
+    free(m.x);
+    free(m.on);
+}
+
 /* g and h are taken to multiples of 2^-46 and clamped to [-65535, 65535] (NaN to the lower
  * end): a value deeper in a tail than that counts as at the limit, and A^2 stays finite */
 static void test_clamp(void)
@@ -417,6 +496,7 @@ int main(void)
     test_a2_if();
     test_random_sets();
     test_structure();
+    test_many_pages();
     test_clamp();
     test_bit_exact();
     test_floor();
