@@ -129,7 +129,8 @@ typedef struct gp_imc_params {
     double anisotropy;   /* min/max ratio of the orientation density, in (0, 1] */
     int error_kind;      /* 1, 2, 3 or GP_IMC_ERROR_AD */
     double threshold;    /* stop when the error is <= threshold (> 0) */
-    int ks_goals;        /* AD: at the threshold, also ask the KS goals ("Stopping" above) */
+    int ks_goals;        /* AD: the threshold stands for the KS goals: at it, ask them too;
+                          * before it, stop when slow within them ("Stopping" above) */
     long max_steps;      /* >= 0 */
     int init;            /* 0 uniform, 1 Halton (bases 2, 3), rejected outside / in holes */
     int classes_size;    /* number of area classes, 0 = automatic */
