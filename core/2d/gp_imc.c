@@ -831,12 +831,20 @@ static int propose(const gp_voronoi *v, gsl_rng *rng, size_t i, step_buf *b, gp_
     return gp_voronoi_sample_cell(v, j, u01, rng, q) != 0 ? 1 : 0;
 }
 
+/* A point uniform in the bounding box x0, y0, x1, y1: two draws (warm_ahead draws them again) */
+static gp_vec2 box_point(gsl_rng *rng, const double *box)
+{
+    gp_vec2 q;
+    q.x = box[0] + (box[2] - box[0]) * gsl_rng_uniform(rng);
+    q.y = box[1] + (box[3] - box[1]) * gsl_rng_uniform(rng);
+    return q;
+}
+
 /* A point uniform in the container (rejection in its bounding box; 1 when 64 draws missed). */
 static int propose_anywhere(const gp_voronoi *v, gsl_rng *rng, const double *box, gp_vec2 *q)
 {
     for (int t = 0; t < 64; t++) {
-        q->x = box[0] + (box[2] - box[0]) * gsl_rng_uniform(rng);
-        q->y = box[1] + (box[3] - box[1]) * gsl_rng_uniform(rng);
+        *q = box_point(rng, box);
         if (gp_voronoi_contains(v, *q)) return 0;
     }
     return 1;
@@ -1123,13 +1131,12 @@ static int ks_short(const imc_state *S, const gp_imc_params *p)
     return ks_goals_met(S, GP_IMC_KS_GOAL_ORIENT) == 0;
 }
 
-/* The cell areas' population COV within GP_IMC_COV_GOAL of the one aimed at (from the sum of
- * squared areas the area statistic keeps). */
+/* The cell areas' population COV within GP_IMC_COV_GOAL of the one aimed at: the COV term of
+ * the area excess, n (COV / cov_t - 1)^2, from the sum of squared areas the statistic keeps. */
 static int cov_goal_met(const imc_state *S)
 {
-    double n = (double)S->n, var = gp_adstat_sum_extra(S->ads) / n - S->mu * S->mu;
-    double cov = sqrt(fmax(var, 0.0)) / S->mu;
-    return fabs(cov / S->cov_t - 1.0) <= GP_IMC_COV_GOAL;
+    double n = (double)S->n;
+    return cov_term_of(S, gp_adstat_sum_extra(S->ads)) <= n * GP_IMC_COV_GOAL * GP_IMC_COV_GOAL;
 }
 
 /* At the threshold in force: 1 to stop; 0 to go on to a tighter one, while the KS goals are
@@ -1353,10 +1360,7 @@ static void warm_ahead(run_ctx *C)
         size_t k = 0;
         for (long t = C->warm_next; t < C->warm_next + GP_IMC_WARM_BATCH; t++) {
             step_rng_set(C->warm_rng, C->p->seed, t);
-            if (gsl_rng_uniform(C->warm_rng) < GP_IMC_JUMP_FROM) continue;
-            q[k].x = S->box[0] + (S->box[2] - S->box[0]) * gsl_rng_uniform(C->warm_rng);
-            q[k].y = S->box[1] + (S->box[3] - S->box[1]) * gsl_rng_uniform(C->warm_rng);
-            k++;
+            if (gsl_rng_uniform(C->warm_rng) >= GP_IMC_JUMP_FROM) q[k++] = box_point(C->warm_rng, S->box);
         }
         C->warm_next += GP_IMC_WARM_BATCH;
         uint32_t ids[GP_IMC_WARM_BATCH * 16];
